@@ -1,0 +1,273 @@
+"""Assembly of the reference lumped-parameter model from a :class:`TrainSpec`.
+
+Formulation: translational-torsional, each stage in the frame that turns with its
+carrier's nominal speed Omega (Lin & Parker 1999, J. Sound Vib. 210; Kiracofe &
+Parker 2007 for several stages).  Coordinates are small vibrations about nominal
+motion: central members (sun, ring, carrier) have x, y along the rotating frame's axes
+and theta; planets have radial, tangential (absolute displacement components along
+the carrier's radial and tangential directions at the planet) and theta.  All
+rotations are absolute angles in rad.
+
+Every elastic connection is a row: a scalar deflection delta = a . q with stiffness
+k (constant, or k(t) for a mesh) and damping c, so
+
+    M q'' + (C + Omega G) q' + (K_b + K_m(t) - Omega^2 K_Omega) q = F(t),
+    K_b = sum k a a^T,  C = sum c a a^T,  K_m(t) = sum_meshes k(t) a a^T,
+
+with G and K_Omega the Coriolis and centripetal terms of each member's translations
+(Lin & Parker 1999, Eq. 4).  A new member type or DOF (axial, eccentric shaft) adds
+entries to the DOF map and new rows; nothing here is specific to a stage layout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .contact import line_of_action, lever
+from .errors import GearcheckError
+from .excitation import Excitation
+from .kinematics import Kinematics, kinematics
+from .spec import TrainSpec
+
+CENTRAL_DOFS = ("x", "y", "theta")
+PLANET_DOFS = ("radial", "tangential", "theta")
+
+
+@dataclass(frozen=True)
+class Row:
+    """One elastic connection: deflection a . q, stiffness, damping."""
+
+    name: str
+    kind: str  # mesh | bearing | support | coupling | shaft
+    a: np.ndarray
+    stiffness: float
+    damping: float
+
+
+@dataclass
+class DofMap:
+    """Named coordinates: (member id, dof name) -> index."""
+
+    names: list[tuple[str, str]] = field(default_factory=list)
+    _index: dict[tuple[str, str], int] = field(default_factory=dict)
+
+    def add(self, member: str, dofs) -> None:
+        for d in dofs:
+            self._index[(member, d)] = len(self.names)
+            self.names.append((member, d))
+
+    def __call__(self, member: str, dof: str) -> int:
+        return self._index[(member, dof)]
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def of_member(self, member: str) -> list[int]:
+        return [i for i, (m, _) in enumerate(self.names) if m == member]
+
+    def labels(self) -> list[str]:
+        return [f"{m}.{d}" for m, d in self.names]
+
+
+@dataclass
+class LumpedModel:
+    """Matrices and rows of the reference model at one operating point."""
+
+    spec: TrainSpec
+    kin: Kinematics
+    dofs: DofMap
+    M: np.ndarray
+    G: np.ndarray  # gyroscopic matrix, already multiplied by each frame's Omega
+    K_omega: np.ndarray  # centripetal softening, Omega^2 m on translations
+    rows: list[Row]  # constant rows (bearings, supports, couplings, shaft)
+    mesh_rows: np.ndarray  # (n_mesh, n) line-of-action rows
+    mesh_damping: np.ndarray  # (n_mesh,)
+    F_static: np.ndarray  # constant forces (planet centripetal load)
+    b_input: np.ndarray  # generalized force of a unit torque on the input
+    b_output: np.ndarray
+    excitation: Excitation
+    rotating_frame_terms: bool = True
+
+    @property
+    def n(self) -> int:
+        return len(self.dofs)
+
+    @property
+    def K_b(self) -> np.ndarray:
+        return _sum_outer(self.rows, "stiffness", self.n)
+
+    @property
+    def C_b(self) -> np.ndarray:
+        return _sum_outer(self.rows, "damping", self.n)
+
+    def K_mesh(self, k: np.ndarray) -> np.ndarray:
+        return self.mesh_rows.T @ (k[:, None] * self.mesh_rows)
+
+    @property
+    def K_mean(self) -> np.ndarray:
+        """Stiffness with every mesh at its mean stiffness (no rotating-frame softening)."""
+        return self.K_b + self.K_mesh(self.excitation.mean_stiffness)
+
+    @property
+    def C(self) -> np.ndarray:
+        return self.C_b + self.mesh_rows.T @ (self.mesh_damping[:, None] * self.mesh_rows)
+
+    def without_rotating_frame_terms(self) -> "LumpedModel":
+        from dataclasses import replace
+
+        zero = np.zeros_like(self.M)
+        return replace(self, G=zero, K_omega=zero, F_static=np.zeros(self.n), rotating_frame_terms=False)
+
+
+def _sum_outer(rows, attr, n):
+    out = np.zeros((n, n))
+    for r in rows:
+        value = getattr(r, attr)
+        if value:
+            out += value * np.outer(r.a, r.a)
+    return out
+
+
+def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedModel:
+    """Assemble M, G, K_Omega, rows and force maps of ``spec`` (Lin & Parker 1999 form)."""
+    kin = kinematics(spec)
+    dofs = DofMap()
+    for mid, member in spec.members.items():
+        dofs.add(mid, PLANET_DOFS if member.is_planet else CENTRAL_DOFS)
+    n = len(dofs)
+    M = np.zeros((n, n))
+    G = np.zeros((n, n))
+    K_omega = np.zeros((n, n))
+    F = np.zeros(n)
+    for mid, member in spec.members.items():
+        u, v = (PLANET_DOFS if member.is_planet else CENTRAL_DOFS)[:2]
+        iu, iv, ith = dofs(mid, u), dofs(mid, v), dofs(mid, "theta")
+        M[iu, iu] = M[iv, iv] = member.mass
+        M[ith, ith] = member.inertia
+        omega = kin.speeds[f"{member.stage}.carrier"]
+        # Coriolis 2 m Omega k x q' and centripetal -m Omega^2 q of the translations (rotating frame)
+        G[iu, iv] -= 2.0 * member.mass * omega
+        G[iv, iu] += 2.0 * member.mass * omega
+        K_omega[iu, iu] = K_omega[iv, iv] = member.mass * omega**2
+        if member.is_planet:
+            F[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
+
+    rows = _support_rows(spec, dofs) + _bearing_rows(spec, dofs) + _coupling_rows(spec, dofs, kin)
+    if spec.operating.input_shaft_stiffness is not None:
+        a = np.zeros(n)
+        a[dofs(spec.input, "theta")] = 1.0
+        rows.append(Row("input_shaft", "shaft", a, spec.operating.input_shaft_stiffness,
+                        spec.operating.input_shaft_damping))
+
+    mesh_rows = np.array([_mesh_row(spec, dofs, kin, mesh) for mesh in spec.meshes])
+    excitation = Excitation(spec, kin)
+    damping = np.array([_mesh_damping(spec, mesh, row, dofs, k)
+                        for mesh, row, k in zip(spec.meshes, mesh_rows, excitation.mean_stiffness)])
+    b_in = np.zeros(n)
+    b_in[dofs(spec.input, "theta")] = 1.0
+    b_out = np.zeros(n)
+    b_out[dofs(spec.output, "theta")] = 1.0
+    model = LumpedModel(spec, kin, dofs, M, G, K_omega, rows, mesh_rows, damping, F, b_in, b_out, excitation)
+    return model if rotating_frame_terms else model.without_rotating_frame_terms()
+
+
+def _unit(n: int, *entries) -> np.ndarray:
+    a = np.zeros(n)
+    for i, value in entries:
+        a[i] += value
+    return a
+
+
+def _support_rows(spec, dofs) -> list[Row]:
+    n = len(dofs)
+    rows = []
+    for mid, m in spec.members.items():
+        if m.is_planet:
+            continue
+        s = m.support
+        rows.append(Row(f"{mid}.support_x", "support", _unit(n, (dofs(mid, "x"), 1.0)), s.radial_stiffness,
+                        s.radial_damping))
+        rows.append(Row(f"{mid}.support_y", "support", _unit(n, (dofs(mid, "y"), 1.0)), s.radial_stiffness,
+                        s.radial_damping))
+        if s.torsional_stiffness or s.torsional_damping:
+            rows.append(Row(f"{mid}.support_theta", "support", _unit(n, (dofs(mid, "theta"), 1.0)),
+                            s.torsional_stiffness, s.torsional_damping))
+    return rows
+
+
+def _bearing_rows(spec, dofs) -> list[Row]:
+    """Planet bearing: planet centre minus the carrier's pin point, radial and tangential."""
+    n = len(dofs)
+    rows = []
+    for stage in spec.stages:
+        c = stage.carrier
+        for pid in stage.planets:
+            p = spec.members[pid]
+            cs, sn = math.cos(p.angle), math.sin(p.angle)
+            radial = _unit(n, (dofs(pid, "radial"), 1.0), (dofs(c, "x"), -cs), (dofs(c, "y"), -sn))
+            tangential = _unit(n, (dofs(pid, "tangential"), 1.0), (dofs(c, "x"), sn), (dofs(c, "y"), -cs),
+                               (dofs(c, "theta"), -p.radius))
+            b = p.bearing
+            rows.append(Row(f"{pid}.bearing_radial", "bearing", radial, b.radial_stiffness, b.radial_damping))
+            rows.append(Row(f"{pid}.bearing_tangential", "bearing", tangential, b.radial_stiffness,
+                            b.radial_damping))
+    return rows
+
+
+def _coupling_rows(spec, dofs, kin) -> list[Row]:
+    n = len(dofs)
+    rows = []
+    for c in spec.couplings:
+        rows.append(Row(f"{c.name}.torsion", "coupling",
+                        _unit(n, (dofs(c.a, "theta"), 1.0), (dofs(c.b, "theta"), -1.0)),
+                        c.torsional_stiffness, c.torsional_damping))
+        if c.radial_stiffness or c.radial_damping:
+            wa = kin.speeds[f"{spec.members[c.a].stage}.carrier"]
+            wb = kin.speeds[f"{spec.members[c.b].stage}.carrier"]
+            if abs(wa - wb) > 1e-9 * max(abs(wa), abs(wb), 1.0):
+                raise GearcheckError(
+                    f"{spec.path}: couplings.{c.name}.radial_stiffness: the two members' stages turn at "
+                    f"different carrier speeds, so a radial coupling makes the rotating-frame model "
+                    f"time-periodic; not supported yet (set radial_stiffness = 0)")
+            for axis in ("x", "y"):
+                rows.append(Row(f"{c.name}.{axis}", "coupling",
+                                _unit(n, (dofs(c.a, axis), 1.0), (dofs(c.b, axis), -1.0)),
+                                c.radial_stiffness, c.radial_damping))
+    return rows
+
+
+def _mesh_row(spec, dofs, kin, mesh) -> np.ndarray:
+    """delta = (u_central(p) - u_planet(p)) . d with u(p) = translation + theta k x (p - centre)."""
+    stage = spec.stage_of(mesh.planet)
+    planet = spec.members[mesh.planet]
+    loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
+    d = loa.direction
+    e_r = np.array([math.cos(planet.angle), math.sin(planet.angle)])
+    e_t = np.array([-e_r[1], e_r[0]])
+    a = np.zeros(len(dofs))
+    c = mesh.central
+    a[dofs(c, "x")] += d[0]
+    a[dofs(c, "y")] += d[1]
+    a[dofs(c, "theta")] += lever(loa.pitch_point, np.zeros(2), d)
+    p = mesh.planet
+    a[dofs(p, "radial")] -= float(d @ e_r)
+    a[dofs(p, "tangential")] -= float(d @ e_t)
+    a[dofs(p, "theta")] -= lever(loa.pitch_point, loa.planet_centre, d)
+    return a
+
+
+def _mesh_damping(spec, mesh, row, dofs, k_mean) -> float:
+    """c = 2 zeta sqrt(k m_eq), m_eq = 1/(r_b1^2/I_1 + r_b2^2/I_2): the equivalent mass of the
+    gear pair's torsional motion along the line of action."""
+    if mesh.damping_coefficient is not None:
+        return mesh.damping_coefficient
+    if not mesh.damping_ratio:
+        return 0.0
+    inv = 0.0
+    for member in (mesh.central, mesh.planet):
+        arm = row[dofs(member, "theta")]
+        inv += arm**2 / spec.members[member].inertia
+    return 2.0 * mesh.damping_ratio * math.sqrt(k_mean / inv)

@@ -1,0 +1,36 @@
+"""The gearcheck exception family.
+
+Every error a user can provoke with a train file or a command-line option is a
+``GearcheckError``.  Messages name the file and the field path
+(``demo.toml: stages[0].sun.teeth: ...``) so the command-line interface can print
+them as one line and exit with status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+
+class GearcheckError(ValueError):
+    """Base class of every error gearcheck raises on bad input or an impossible request."""
+
+
+class TrainFileError(GearcheckError):
+    """A train file that cannot be read or violates the schema or the geometry rules."""
+
+    def __init__(self, source: str, field: str, message: str):
+        self.source = source
+        self.field = field
+        self.reason = message
+        where = f"{source}: {field}: " if field else f"{source}: "
+        super().__init__(where + message)
+
+
+class SolverError(GearcheckError):
+    """A solver request that cannot be honoured (for instance a time step that is unstable)."""
+
+
+class DivergenceError(SolverError):
+    """A time integration that produced NaN or runaway energy."""
+
+    def __init__(self, time: float, message: str):
+        self.time = time
+        super().__init__(f"diverged at t = {time:.6g} s: {message}")

@@ -1,0 +1,129 @@
+"""What drives the train: torques, mesh stiffness variation and transmission error.
+
+All functions of time here follow the nominal kinematics (the "nominal clock" of
+DESIGN.md section 4), so the lumped solver and the MuJoCo runner evaluate exactly the
+same excitation.  Signs: a static transmission error e > 0 compresses the mesh, so the
+mesh force is k(t) f(delta - e) + c (d delta/dt - de/dt).
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+
+import numpy as np
+
+from .contact import line_of_action
+from .kinematics import Kinematics
+from .mesh_stiffness import stiffness_model
+
+
+def smooth_ramp(t, duration: float):
+    """0 -> 1 over ``duration`` with zero slope at both ends (1 when duration is 0); array-valued."""
+    t = np.asarray(t, dtype=float)
+    if duration <= 0.0:
+        return np.ones_like(t)
+    s = np.clip(t / duration, 0.0, 1.0)
+    return s * s * (3.0 - 2.0 * s)
+
+
+class Excitation:
+    """Time functions of one train at its operating point."""
+
+    def __init__(self, spec, kin: Kinematics):
+        self.spec = spec
+        self.kin = kin
+        meshes = spec.meshes
+        self.mesh_ids = [m.id for m in meshes]
+        self.frequency = np.array([kin.mesh_frequency[m.id] for m in meshes])
+        self.phase = np.array([kin.mesh_phase[m.id] for m in meshes])
+        self.models = [stiffness_model(m) for m in meshes]
+        self.mean_stiffness = np.array([model.mean for model in self.models])
+        self.backlash = np.array([m.backlash for m in meshes])
+        self._ste = [(i, h, a, p) for i, m in enumerate(meshes) for (h, a, p) in m.ste]
+        self._eccentric = list(self._eccentric_terms(spec, kin))
+        op = spec.operating
+        self._ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
+        self._function = None
+        if op.torque_function:
+            module, _, name = op.torque_function.partition(":")
+            self._function = getattr(importlib.import_module(module), name)
+
+    # ------------------------------------------------------------------ meshes
+    def mesh_position(self, t) -> np.ndarray:
+        """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...)."""
+        return np.multiply.outer(np.asarray(t, dtype=float), self.frequency) - self.phase
+
+    def stiffness(self, t) -> np.ndarray:
+        """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...)."""
+        xi = self.mesh_position(t)
+        k = np.empty_like(xi)
+        for j, model in enumerate(self.models):
+            k[..., j] = model(xi[..., j])
+        return k
+
+    @property
+    def has_transmission_error(self) -> bool:
+        return bool(self._ste or self._eccentric)
+
+    def transmission_error(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Static transmission error e(t) and its rate per mesh, in m and m/s; shape (..., n_mesh)."""
+        t = np.asarray(t, dtype=float)
+        e = np.zeros(t.shape + (len(self.mesh_ids),))
+        de = np.zeros_like(e)
+        for i, h, amp, phi in self._ste:
+            arg = 2 * np.pi * h * (self.frequency[i] * t - self.phase[i]) + phi
+            e[..., i] += amp * np.cos(arg)
+            de[..., i] -= amp * 2 * np.pi * h * self.frequency[i] * np.sin(arg)
+        for i, amp, omega, beta0, dx, dy in self._eccentric:
+            beta = omega * t + beta0
+            e[..., i] += amp * (np.cos(beta) * dx + np.sin(beta) * dy)
+            de[..., i] += amp * omega * (-np.sin(beta) * dx + np.cos(beta) * dy)
+        return e, de
+
+    @staticmethod
+    def _eccentric_terms(spec, kin):
+        """Eccentricity of a gear: its pitch-circle centre offset, turning with the gear
+        relative to the carrier frame, projected on the line of action (+ for the
+        central gear, - for the planet)."""
+        for i, mesh in enumerate(spec.meshes):
+            stage = spec.stage_of(mesh.planet)
+            planet = spec.members[mesh.planet]
+            loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
+            w_c = kin.speeds[stage.carrier]
+            for gear, member, sign, base in ((mesh.central_gear, mesh.central, 1.0, 0.0),
+                                             (mesh.planet_gear, mesh.planet, -1.0, planet.angle)):
+                if gear.eccentricity > 0.0:
+                    omega = kin.speeds[member] - w_c
+                    dx, dy = sign * loa.direction
+                    yield i, gear.eccentricity, omega, base + gear.eccentricity_phase, dx, dy
+
+    # ------------------------------------------------------------------ torques
+    def _ripple_omega(self, ripple) -> float:
+        if ripple.frequency is not None:
+            return 2 * math.pi * ripple.frequency
+        member = self.spec.input if ripple.member == "input" else self.spec.output
+        return ripple.order * abs(self.kin.speeds[member])
+
+    def torques(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(torque on the input member, torque on the output member) in N·m, signed; array-valued.
+
+        A shaft-driven input gets its mean torque from the shaft spring; only ripple and
+        a user function act on it directly.  The load is ramped in over ``ramp_s``.
+        """
+        t = np.asarray(t, dtype=float)
+        op = self.spec.operating
+        ramp = smooth_ramp(t, op.ramp)
+        t_in_mean = self.kin.input_torque
+        t_out_mean = self.kin.output_torque
+        t_in = np.zeros_like(t) if op.input_shaft_stiffness is not None else t_in_mean * ramp
+        t_out = t_out_mean * ramp
+        for member, amp, omega, phase in self._ripple:
+            wave = amp * np.cos(omega * t + phase) * ramp
+            if member == "input":
+                t_in = t_in + t_in_mean * wave
+            else:
+                t_out = t_out + t_out_mean * wave
+        if self._function is not None:
+            t_in = t_in + np.vectorize(self._function, otypes=[float])(t)
+        return t_in, t_out

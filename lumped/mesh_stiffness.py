@@ -1,0 +1,74 @@
+"""Mesh stiffness models: k as a function of the mesh position.
+
+The mesh position xi is the number of mesh cycles elapsed (one cycle = one base pitch
+of travel along the line of action); xi = 0 is the instant a new tooth pair enters
+contact.  Every model is a class with a ``name``, the extra ``parameters`` it reads
+from the train file's ``stiffness`` table, a ``mean`` and ``__call__(xi) -> k``.
+Both solvers call the same objects, so a new model is one new class registered in
+:data:`MODELS`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+class MeshStiffness:
+    """Base class; subclasses set ``name`` and implement ``__call__``."""
+
+    name = ""
+    parameters: dict[str, str] = {}
+
+    def __init__(self, params: dict, contact_ratio: float):
+        self.mean = float(params["mean"])
+        self.contact_ratio = contact_ratio
+
+    def __call__(self, xi):
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(mean={self.mean:.6g} N/m)"
+
+
+class ConstantStiffness(MeshStiffness):
+    """k(xi) = k_mean."""
+
+    name = "constant"
+
+    def __call__(self, xi):
+        return np.full_like(np.asarray(xi, dtype=float), self.mean)
+
+
+class RectangularStiffness(MeshStiffness):
+    """Rectangular wave from the transverse contact ratio eps.
+
+    The number of tooth pairs in contact is ceil(eps) during the first eps - floor(eps)
+    of each cycle and floor(eps) for the rest; each pair carries k_mean/eps, so the
+    cycle average is k_mean.
+    """
+
+    name = "rectangular"
+
+    def __init__(self, params: dict, contact_ratio: float):
+        super().__init__(params, contact_ratio)
+        self.pairs_low = math.floor(contact_ratio)
+        self.multi_fraction = contact_ratio - self.pairs_low
+        self.pair_stiffness = self.mean / contact_ratio
+
+    def pairs(self, xi):
+        frac = np.mod(np.asarray(xi, dtype=float), 1.0)
+        return self.pairs_low + (frac < self.multi_fraction)
+
+    def __call__(self, xi):
+        return self.pair_stiffness * self.pairs(xi)
+
+
+MODELS: dict[str, type[MeshStiffness]] = {cls.name: cls for cls in (ConstantStiffness, RectangularStiffness)}
+
+
+def stiffness_model(mesh) -> MeshStiffness:
+    """The stiffness object of a :class:`~lumped.spec.MeshSpec`."""
+    params = mesh.stiffness
+    return MODELS[params["model"]](params, mesh.geometry.contact_ratio)

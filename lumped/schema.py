@@ -1,0 +1,483 @@
+"""Declarative schema of the train file (TOML).
+
+The schema is data: each field knows its type, unit, bounds, default and a one-line
+documentation string.  One walker (:func:`parse`) checks a parsed TOML document
+against it, converts suffixed units (``_mm``, ``_um``, ``_deg``, ``_rpm``) to SI once,
+fills defaults and returns plain dictionaries keyed by the SI names (the suffix
+dropped).  The README's field reference is generated from the same objects
+(:func:`markdown_reference`), so documentation and validation cannot drift apart.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+from .errors import TrainFileError
+
+_UNIT_SUFFIXES = {
+    "_mm": ("mm", 1e-3),
+    "_um": ("µm", 1e-6),
+    "_deg": ("deg", math.pi / 180.0),
+    "_rpm": ("rpm", 2.0 * math.pi / 60.0),
+}
+
+REQUIRED = object()
+
+
+class Context:
+    """Where the document came from, for error messages."""
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def fail(self, path: str, message: str) -> TrainFileError:
+        return TrainFileError(self.source, path, message)
+
+
+def _si_name(key: str) -> tuple[str, float]:
+    for suffix, (_, factor) in _UNIT_SUFFIXES.items():
+        if key.endswith(suffix):
+            return key[: -len(suffix)], factor
+    return key, 1.0
+
+
+@dataclass(frozen=True)
+class Number:
+    """A real number; ``minimum`` is exclusive when ``strict``."""
+
+    doc: str
+    unit: str = ""
+    default: Any = REQUIRED
+    minimum: float | None = None
+    strict: bool = False
+    maximum: float | None = None
+
+    def parse(self, value, path: str, ctx: Context) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ctx.fail(path, f"must be a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ctx.fail(path, f"must be finite, got {value}")
+        if self.minimum is not None:
+            if self.strict and value <= self.minimum:
+                raise ctx.fail(path, f"must be > {self.minimum:g}, got {value:g}")
+            if not self.strict and value < self.minimum:
+                raise ctx.fail(path, f"must be >= {self.minimum:g}, got {value:g}")
+        if self.maximum is not None and value > self.maximum:
+            raise ctx.fail(path, f"must be <= {self.maximum:g}, got {value:g}")
+        return value
+
+    def type_name(self) -> str:
+        return "number"
+
+
+def Positive(doc: str, unit: str = "", default=REQUIRED) -> Number:
+    return Number(doc, unit, default, minimum=0.0, strict=True)
+
+
+def NonNegative(doc: str, unit: str = "", default=0.0) -> Number:
+    return Number(doc, unit, default, minimum=0.0)
+
+
+@dataclass(frozen=True)
+class Integer:
+    doc: str
+    default: Any = REQUIRED
+    minimum: int | None = None
+    unit: str = ""
+
+    def parse(self, value, path: str, ctx: Context) -> int:
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ctx.fail(path, f"must be an integer, got {value!r}")
+        if self.minimum is not None and value < self.minimum:
+            raise ctx.fail(path, f"must be an integer >= {self.minimum}, got {value}")
+        return value
+
+    def type_name(self) -> str:
+        return "integer"
+
+
+@dataclass(frozen=True)
+class Text:
+    doc: str
+    default: Any = REQUIRED
+    choices: tuple[str, ...] | None = None
+    pattern: str | None = None
+    unit: str = ""
+
+    def parse(self, value, path: str, ctx: Context) -> str:
+        if not isinstance(value, str):
+            raise ctx.fail(path, f"must be a string, got {value!r}")
+        if self.choices is not None and value not in self.choices:
+            hint = _did_you_mean(value, self.choices)
+            raise ctx.fail(path, f"must be one of {', '.join(self.choices)}; got {value!r}{hint}")
+        if self.pattern is not None and not re.fullmatch(self.pattern, value):
+            raise ctx.fail(path, f"{value!r} is not of the form {self.pattern}")
+        return value
+
+    def type_name(self) -> str:
+        return "string"
+
+
+@dataclass(frozen=True)
+class ListOf:
+    item: Any
+    doc: str
+    default: Any = REQUIRED
+    min_length: int = 0
+    unit: str = ""
+
+    def parse(self, value, path: str, ctx: Context) -> list:
+        if not isinstance(value, list):
+            raise ctx.fail(path, f"must be a list, got {value!r}")
+        if len(value) < self.min_length:
+            raise ctx.fail(path, f"needs at least {self.min_length} entries, got {len(value)}")
+        return [self.item.parse(v, f"{path}[{i}]", ctx) for i, v in enumerate(value)]
+
+    def type_name(self) -> str:
+        return f"list of {self.item.type_name()}"
+
+
+@dataclass(frozen=True)
+class Table:
+    """A TOML table with named fields; ``patterns`` admits extra keys matching a regex."""
+
+    fields: dict[str, Any]
+    doc: str = ""
+    default: Any = REQUIRED
+    patterns: tuple[tuple[str, Any], ...] = ()
+    unit: str = ""
+    open: bool = False  # extra keys are passed through unchecked (validated by a plug-in)
+
+    def parse(self, value, path: str, ctx: Context) -> dict:
+        if not isinstance(value, dict):
+            raise ctx.fail(path, f"must be a table, got {value!r}")
+        out: dict[str, Any] = {}
+        for key, raw in value.items():
+            sub = f"{path}.{key}" if path else key
+            spec = self.fields.get(key) or self._pattern_field(key)
+            if spec is None:
+                if self.open:
+                    out[key] = raw
+                    continue
+                hint = _did_you_mean(key, list(self.fields))
+                raise ctx.fail(sub, f"unknown key{hint}")
+            name, factor = _si_name(key)
+            parsed = spec.parse(raw, sub, ctx)
+            out[name] = _scale(parsed, factor)
+        for key, spec in self.fields.items():
+            name, factor = _si_name(key)
+            if name in out:
+                continue
+            if spec.default is REQUIRED:
+                sub = f"{path}.{key}" if path else key
+                raise ctx.fail(sub, "missing required field")
+            if spec.default is not None:
+                out[name] = _scale(_default(spec, f"{path}.{key}", ctx), factor)
+            else:
+                out[name] = None
+        return out
+
+    def _pattern_field(self, key: str):
+        for regex, spec in self.patterns:
+            if re.fullmatch(regex, key):
+                return spec
+        return None
+
+    def type_name(self) -> str:
+        return "table"
+
+
+@dataclass(frozen=True)
+class TableList:
+    """A TOML array of tables (``[[name]]``)."""
+
+    table: Table
+    doc: str = ""
+    default: Any = REQUIRED
+    min_length: int = 0
+    unit: str = ""
+
+    def parse(self, value, path: str, ctx: Context) -> list[dict]:
+        if not isinstance(value, list):
+            raise ctx.fail(path, f"must be an array of tables ([[{path}]]), got {value!r}")
+        if len(value) < self.min_length:
+            raise ctx.fail(path, f"needs at least {self.min_length} entries, got {len(value)}")
+        return [self.table.parse(v, f"{path}[{i}]", ctx) for i, v in enumerate(value)]
+
+    def type_name(self) -> str:
+        return "array of tables"
+
+
+def _default(spec, path: str, ctx: Context):
+    if isinstance(spec, Table):
+        return spec.parse({}, path, ctx)
+    if isinstance(spec, (TableList, ListOf)):
+        return list(spec.default)
+    return spec.default
+
+
+def _scale(value, factor: float):
+    if factor == 1.0 or value is None:
+        return value
+    if isinstance(value, list):
+        return [v * factor for v in value]
+    return value * factor
+
+
+def _did_you_mean(word: str, candidates) -> str:
+    close = difflib.get_close_matches(word, list(candidates), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+# --------------------------------------------------------------------------------------
+# The train file
+# --------------------------------------------------------------------------------------
+
+MEMBER_REF = r"[A-Za-z0-9_\-]+\.(sun|ring|carrier)(_[A-Za-z0-9_]+)?"
+
+GEOMETRY = {
+    "teeth": Integer("number of teeth (ring: internal teeth)", minimum=1),
+    "module_mm": Positive("transverse module; defaults to the stage's module", "mm", None),
+    "pressure_angle_deg": Number("standard pressure angle; defaults to the stage's", "deg", None, 0.0, True, 45.0),
+    "face_width_mm": Positive("face width; defaults to the stage's", "mm", None),
+    "helix_angle_deg": Number("helix angle (reserved for helical gears: must be 0 for now)", "deg", 0.0),
+    "addendum_coefficient": NonNegative("addendum h_a* in modules; defaults to the stage's", "-", None),
+    "dedendum_coefficient": NonNegative("dedendum h_f* in modules; defaults to the stage's", "-", None),
+    "profile_shift": Number("profile shift coefficient x (ring: positive moves the teeth outward)", "-", 0.0),
+    "base_radius_mm": Positive("base radius; derived from module, teeth and pressure angle unless given", "mm", None),
+    "eccentricity_um": NonNegative("eccentricity (run-out) of the gear's pitch circle", "µm"),
+    "eccentricity_phase_deg": Number("angle of the eccentricity at t = 0, in the member's own frame", "deg", 0.0),
+}
+
+BODY = {
+    "mass": Positive("mass", "kg"),
+    "inertia": Positive("polar moment of inertia about the rotation axis", "kg·m²", None),
+    "inertia_over_r2": Positive(
+        "I/r² with r the base radius (carrier: carrier radius); give this or `inertia`", "kg", None
+    ),
+}
+
+SUPPORT = Table(
+    {
+        "radial_stiffness": Positive("stiffness of the bearing/support in x and in y (isotropic)", "N/m"),
+        "radial_damping": NonNegative("damping of the bearing/support in x and y", "N·s/m"),
+        "torsional_stiffness": NonNegative("torsional stiffness to the housing (0 = free rotation)", "N·m/rad"),
+        "torsional_damping": NonNegative("torsional damping to the housing", "N·m·s/rad"),
+    },
+    "support of a central member (sun, ring, carrier) on the housing",
+)
+
+PLANET_BEARING = Table(
+    {
+        "radial_stiffness": Positive("stiffness of the planet bearing, radial and tangential", "N/m"),
+        "radial_damping": NonNegative("damping of the planet bearing", "N·s/m"),
+    },
+    "planet bearing on the carrier pin",
+)
+
+STIFFNESS = Table(
+    {
+        "model": Text("mesh stiffness model (see lumped/mesh_stiffness.py)", "rectangular",
+                      ("constant", "rectangular")),
+        "mean": Positive("mean mesh stiffness over a mesh cycle", "N/m"),
+    },
+    "time-varying mesh stiffness model and its parameters",
+    default=None,
+    open=True,
+)
+
+DAMPING = Table(
+    {
+        "ratio": NonNegative("damping ratio ζ: c = 2ζ·sqrt(k_mean·m_eq), m_eq of the gear pair", "-", None),
+        "coefficient": NonNegative("mesh damping coefficient (instead of ratio)", "N·s/m", None),
+    },
+    "mesh damping",
+    default=None,
+)
+
+STE = Table(
+    {
+        "harmonic": Integer("harmonic of the mesh frequency", minimum=1),
+        "amplitude_um": NonNegative("amplitude along the line of action", "µm", REQUIRED),
+        "phase_deg": Number("phase of this harmonic (added to the mesh phase)", "deg", 0.0),
+    },
+    "static transmission error harmonic",
+)
+
+MESH = Table(
+    {
+        "stiffness": STIFFNESS,
+        "damping": DAMPING,
+        "backlash_um": NonNegative("total backlash 2b along the line of action (dead zone ±b)", "µm", None),
+        "ste": TableList(STE, "static transmission error: harmonic series at the mesh frequency", default=()),
+    },
+    "mesh properties; a stage-level [stages.mesh] gives defaults for its central gears",
+    default=None,
+)
+
+CENTRAL_GEAR = Table(
+    {
+        **GEOMETRY,
+        **BODY,
+        "support": SUPPORT,
+        "planet_gear": Text("name of the planet gear it meshes with (compound planets)", None),
+        "mesh": MESH,
+    },
+    "a central gear: sun (external) or ring (internal)",
+    default=None,
+)
+
+CARRIER = Table({**BODY, "support": SUPPORT}, "the planet carrier")
+
+PLANET_GEAR = Table({k: v for k, v in GEOMETRY.items()}, "one gear of a compound planet")
+
+PLANET = Table(
+    {
+        **{k: v for k, v in GEOMETRY.items() if k != "teeth"},
+        "teeth": Integer("teeth of a simple planet (omit when `gears` is given)", None, 1),
+        **BODY,
+        "bearing": PLANET_BEARING,
+        "gears": Table({}, "compound planet: named gears, e.g. [stages.planet.gears.f]", None,
+                       patterns=((r"[A-Za-z][A-Za-z0-9_]*", PLANET_GEAR),)),
+    },
+    "the planets of the stage (all identical)",
+)
+
+STAGE = Table(
+    {
+        "name": Text("stage name, used in member references (`stage1.sun`)", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
+        "planets": Integer("number of planets", minimum=1),
+        "planet_angles_deg": ListOf(Number("angle", "deg"), "planet angles (default: equally spaced)", None,
+                                    unit="deg"),
+        "module_mm": Positive("default transverse module of the stage's gears", "mm", None),
+        "pressure_angle_deg": Number("default pressure angle", "deg", 20.0, 0.0, True, 45.0),
+        "face_width_mm": Positive("default face width", "mm", None),
+        "addendum_coefficient": NonNegative("default addendum coefficient h_a*", "-", 1.0),
+        "dedendum_coefficient": NonNegative("default dedendum coefficient h_f*", "-", 1.25),
+        "mesh": MESH,
+        "carrier": CARRIER,
+        "planet": PLANET,
+        "sun": CENTRAL_GEAR,
+        "ring": CENTRAL_GEAR,
+    },
+    "a planetary stage ([[stages]]); extra central gears may be named sun_* or ring_*",
+    patterns=((r"(sun|ring)_[A-Za-z0-9_]+", CENTRAL_GEAR),),
+)
+
+RIPPLE = Table(
+    {
+        "member": Text("which torque it modulates", REQUIRED, ("input", "output")),
+        "order": Positive("frequency as a multiple of that member's rotation frequency", "-", None),
+        "frequency_hz": Positive("frequency (instead of order)", "Hz", None),
+        "amplitude": NonNegative("amplitude as a fraction of the mean torque", "-", REQUIRED),
+        "phase_deg": Number("phase", "deg", 0.0),
+    },
+    "harmonic torque ripple ([[operating.ripple]])",
+)
+
+OPERATING = Table(
+    {
+        "input_speed_rpm": Positive("nominal input speed (positive = counter-clockwise seen from +z)", "rpm"),
+        "output_torque": NonNegative("load torque on the output member, opposing its rotation", "N·m"),
+        "input_shaft_stiffness": Positive(
+            "torsional stiffness of the input shaft to a reference turning at the nominal speed "
+            "(omit for a torque-driven input with a rigid-body mode)", "N·m/rad", None),
+        "input_shaft_damping": NonNegative("damping of the input shaft", "N·m·s/rad"),
+        "ripple": TableList(RIPPLE, "torque ripple harmonics", default=()),
+        "torque_function": Text("Python `module:function` f(t) -> N·m added to the input torque", None,
+                                pattern=r"[A-Za-z_][\w.]*:[A-Za-z_]\w*"),
+        "ramp_s": NonNegative("duration of the smooth start-up ramp of the load torque (0 = start at the "
+                              "static deflection)", "s"),
+    },
+    "operating point",
+)
+
+COUPLING = Table(
+    {
+        "name": Text("coupling name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
+        "kind": Text("what it is", "spline", ("spline", "shaft")),
+        "from": Text("first member (`stage1.carrier`)", REQUIRED, pattern=MEMBER_REF),
+        "to": Text("second member (`stage2.sun`)", REQUIRED, pattern=MEMBER_REF),
+        "torsional_stiffness": Positive("torsional stiffness", "N·m/rad"),
+        "torsional_damping": NonNegative("torsional damping", "N·m·s/rad"),
+        "radial_stiffness": NonNegative("radial stiffness in x and y (0 = torsional only)", "N/m"),
+        "radial_damping": NonNegative("radial damping", "N·s/m"),
+    },
+    "a coupling between members of different stages ([[couplings]])",
+)
+
+TRAIN_TABLE = Table(
+    {
+        "name": Text("train name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
+        "description": Text("one-line description"),
+        "source": Text("where the train comes from (paper, design)", ""),
+        "input": Text("input member, `STAGE.MEMBER`", REQUIRED, pattern=MEMBER_REF),
+        "output": Text("output member", REQUIRED, pattern=MEMBER_REF),
+        "held": ListOf(Text("member", REQUIRED, pattern=MEMBER_REF),
+                       "members held by their torsional support stiffness", ()),
+    },
+    "identification and power flow",
+)
+
+TRAIN = Table(
+    {
+        "train": TRAIN_TABLE,
+        "operating": OPERATING,
+        "stages": TableList(STAGE, "planetary stages", min_length=1),
+        "couplings": TableList(COUPLING, "interstage couplings", default=()),
+    },
+    "a gear train file",
+)
+
+
+def parse(document: dict, source: str) -> dict:
+    """Validate a TOML document against :data:`TRAIN`; return SI dictionaries."""
+    return TRAIN.parse(document, "", Context(source))
+
+
+def markdown_reference() -> str:
+    """The field-by-field reference of the train file, as a Markdown table."""
+    rows = ["| field | type | unit | default | meaning |", "|---|---|---|---|---|"]
+
+    def walk(table: Table, prefix: str):
+        items = list(table.fields.items()) + [(rx.replace("|", "\\|"), spec) for rx, spec in table.patterns]
+        for key, spec in items:
+            path = f"{prefix}.{key}" if prefix else key
+            if isinstance(spec, Table) and not spec.fields and spec.patterns:
+                rows.append(_row(path, spec))
+                for rx, sub in spec.patterns:
+                    walk(sub, f"{path}.<{rx}>")
+                continue
+            if isinstance(spec, Table):
+                rows.append(_row(path, spec))
+                walk(spec, path)
+            elif isinstance(spec, TableList):
+                rows.append(_row(f"[[{path}]]", spec))
+                walk(spec.table, path)
+            else:
+                rows.append(_row(path, spec))
+
+    walk(TRAIN, "")
+    return "\n".join(rows) + "\n"
+
+
+def _row(path: str, spec) -> str:
+    if spec.default is REQUIRED:
+        default = "**required**"
+    elif spec.default is None:
+        default = "—"
+    elif isinstance(spec.default, tuple):
+        default = "[]"
+    else:
+        default = f"`{spec.default}`" if not isinstance(spec.default, float) else f"`{spec.default:g}`"
+    doc = spec.doc or getattr(getattr(spec, "table", None), "doc", "")
+    if getattr(spec, "choices", None):
+        doc += " (" + ", ".join(spec.choices) + ")"
+    return f"| `{path}` | {spec.type_name()} | {spec.unit or '-'} | {default} | {doc} |"

@@ -1,0 +1,471 @@
+"""The validated train description (``TrainSpec``) built from a parsed train file.
+
+This is the single source both models are built from.  It holds the members (sun,
+ring, carrier, planets of every stage), their gears, supports and bearings, the
+meshes with their operating geometry, the interstage couplings and the operating
+point, all in SI units.  Every geometric rule of a planetary stage is checked here
+with an error that names the file and the field.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+from math import gcd
+
+from .errors import TrainFileError
+from .geometry import Gear, MeshGeometry, mesh_geometry
+
+MIN_TEETH = 6
+CENTRE_DISTANCE_TOLERANCE = 1e-6  # m: sun-planet and ring-planet operating centre distances must match
+
+
+@dataclass(frozen=True)
+class Support:
+    radial_stiffness: float
+    radial_damping: float = 0.0
+    torsional_stiffness: float = 0.0
+    torsional_damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Member:
+    """A rigid body of the train: a central member (sun, ring, carrier) or a planet."""
+
+    id: str  # "stage1.sun", "stage1.planet2"
+    stage: str
+    kind: str  # sun | ring | carrier | planet
+    mass: float
+    inertia: float
+    support: Support | None = None  # central members: support on the housing
+    bearing: Support | None = None  # planets: bearing on the carrier pin
+    gears: dict[str, Gear] = field(default_factory=dict)
+    angle: float = 0.0  # planets: angle psi_n on the carrier circle
+    radius: float = 0.0  # planets: carrier radius (position of the centre)
+
+    @property
+    def is_planet(self) -> bool:
+        return self.kind == "planet"
+
+    @property
+    def label(self) -> str:
+        return self.id.replace(".", "_")
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """A central gear meshing with one planet gear."""
+
+    id: str  # "stage1.planet2.ring"
+    stage: str
+    central: str  # member id
+    planet: str  # member id
+    central_gear: Gear
+    planet_gear: Gear
+    geometry: MeshGeometry
+    stiffness: dict  # model name and its parameters
+    damping_ratio: float | None
+    damping_coefficient: float | None
+    backlash: float  # total backlash 2b along the line of action
+    ste: tuple[tuple[int, float, float], ...]  # (harmonic, amplitude m, phase rad)
+    planet_index: int
+
+    @property
+    def internal(self) -> bool:
+        return self.central_gear.internal
+
+    @property
+    def label(self) -> str:
+        stage, planet, central = self.id.split(".")
+        return f"{stage}_{planet}_{central}_mesh"
+
+
+@dataclass(frozen=True)
+class Coupling:
+    name: str
+    kind: str
+    a: str
+    b: str
+    torsional_stiffness: float
+    torsional_damping: float
+    radial_stiffness: float
+    radial_damping: float
+
+
+@dataclass(frozen=True)
+class Ripple:
+    member: str  # "input" | "output"
+    order: float | None
+    frequency: float | None  # Hz
+    amplitude: float
+    phase: float
+
+
+@dataclass(frozen=True)
+class Operating:
+    input_speed: float  # rad/s
+    output_torque: float
+    input_shaft_stiffness: float | None
+    input_shaft_damping: float
+    ripple: tuple[Ripple, ...]
+    torque_function: str | None
+    ramp: float
+
+
+@dataclass(frozen=True)
+class Stage:
+    name: str
+    carrier_radius: float
+    planet_angles: tuple[float, ...]
+    equally_spaced: bool
+    centrals: tuple[str, ...]  # member ids of sun/ring gears
+    planets: tuple[str, ...]
+    carrier: str
+
+
+@dataclass(frozen=True)
+class TrainSpec:
+    """A validated gear train in SI units."""
+
+    name: str
+    description: str
+    source: str
+    path: str  # file it was read from ("preset:NAME" for presets)
+    input: str
+    output: str
+    held: tuple[str, ...]
+    members: dict[str, Member]
+    stages: tuple[Stage, ...]
+    meshes: tuple[MeshSpec, ...]
+    couplings: tuple[Coupling, ...]
+    operating: Operating
+    text_hash: str = ""
+
+    def member(self, member_id: str) -> Member:
+        return self.members[member_id]
+
+    @cached_property
+    def member_ids(self) -> tuple[str, ...]:
+        return tuple(self.members)
+
+    def stage_of(self, member_id: str) -> Stage:
+        name = self.members[member_id].stage
+        return next(s for s in self.stages if s.name == name)
+
+    def with_operating(self, **changes) -> "TrainSpec":
+        """A copy with operating-point fields replaced (e.g. ``input_speed``)."""
+        from dataclasses import replace
+
+        return replace(self, operating=replace(self.operating, **changes))
+
+
+def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
+    """Turn a schema-checked document into a :class:`TrainSpec`, applying the geometric rules."""
+    fail = lambda path, msg: TrainFileError(source, path, msg)  # noqa: E731
+    members: dict[str, Member] = {}
+    stages: list[Stage] = []
+    meshes: list[MeshSpec] = []
+    names = [s["name"] for s in data["stages"]]
+    for i, name in enumerate(names):
+        if names.index(name) != i:
+            raise fail(f"stages[{i}].name", f"duplicate stage name {name!r}")
+
+    for i, st in enumerate(data["stages"]):
+        path = f"stages[{i}]"
+        stage_members, stage, stage_meshes = _build_stage(st, path, fail)
+        members.update(stage_members)
+        stages.append(stage)
+        meshes.extend(stage_meshes)
+
+    train = data["train"]
+    for key in ("input", "output"):
+        if train[key] not in members:
+            raise fail(f"train.{key}", f"no member {train[key]!r}{_known(train[key], members)}")
+    for j, ref in enumerate(train["held"]):
+        if ref not in members:
+            raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
+        if members[ref].support.torsional_stiffness <= 0.0:
+            raise fail(f"train.held[{j}]", f"{ref} is held but its support.torsional_stiffness is 0; "
+                                           "a held member is held by a support stiffness")
+        if ref in (train["input"], train["output"]):
+            raise fail(f"train.held[{j}]", f"{ref} cannot be both held and the input or output")
+    if train["input"] == train["output"]:
+        raise fail("train.output", "the output must differ from the input")
+
+    couplings = []
+    for j, c in enumerate(data["couplings"]):
+        for key in ("from", "to"):
+            if c[key] not in members:
+                raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{_known(c[key], members)}")
+        if members[c["from"]].stage == members[c["to"]].stage:
+            raise fail(f"couplings[{j}]", "a coupling joins members of different stages")
+        couplings.append(Coupling(c["name"], c["kind"], c["from"], c["to"], c["torsional_stiffness"],
+                                  c["torsional_damping"], c["radial_stiffness"], c["radial_damping"]))
+
+    op = data["operating"]
+    ripples = []
+    for j, r in enumerate(op["ripple"]):
+        if (r["order"] is None) == (r["frequency_hz"] is None):
+            raise fail(f"operating.ripple[{j}]", "give exactly one of order or frequency_hz")
+        ripples.append(Ripple(r["member"], r["order"], r["frequency_hz"], r["amplitude"], r["phase"]))
+    if op["torque_function"] is not None:
+        _check_torque_function(op["torque_function"], fail)
+    operating = Operating(op["input_speed"], op["output_torque"], op["input_shaft_stiffness"],
+                          op["input_shaft_damping"], tuple(ripples), op["torque_function"], op["ramp_s"])
+
+    return TrainSpec(
+        name=train["name"], description=train["description"], source=train["source"], path=source,
+        input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
+        stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
+        text_hash=text_hash,
+    )
+
+
+def _known(ref: str, members) -> str:
+    import difflib
+
+    close = difflib.get_close_matches(ref, list(members), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
+
+
+def _check_torque_function(ref: str, fail):
+    import importlib
+
+    module, _, func = ref.partition(":")
+    try:
+        obj = getattr(importlib.import_module(module), func)
+    except (ImportError, AttributeError) as exc:
+        raise fail("operating.torque_function", f"cannot import {ref!r}: {exc}") from None
+    if not callable(obj):
+        raise fail("operating.torque_function", f"{ref!r} is not callable")
+
+
+def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:
+    def pick(key, unit_key):
+        value = raw.get(key)
+        if value is None:
+            value = stage.get(key)
+        if value is None:
+            raise fail(f"{path}.{unit_key}", "missing required field (give it on the gear or the stage)")
+        return value
+
+    teeth = raw["teeth"]
+    if teeth < MIN_TEETH:
+        raise fail(f"{path}.teeth", f"an involute gear needs at least {MIN_TEETH} teeth, got {teeth}")
+    if raw["helix_angle"] != 0.0:
+        raise fail(f"{path}.helix_angle_deg", "helical gears are not supported yet; helix angle must be 0")
+    module = pick("module", "module_mm")
+    alpha = pick("pressure_angle", "pressure_angle_deg")
+    base = raw["base_radius"] if raw["base_radius"] is not None else 0.5 * module * teeth * math.cos(alpha)
+    return Gear(
+        name=name, teeth=teeth, module=module, pressure_angle=alpha, face_width=pick("face_width", "face_width_mm"),
+        addendum=pick("addendum_coefficient", "addendum_coefficient"),
+        dedendum=pick("dedendum_coefficient", "dedendum_coefficient"),
+        profile_shift=raw["profile_shift"], internal=internal, base_radius=base,
+        eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"],
+    )
+
+
+def _inertia(raw: dict, radius: float, path: str, fail) -> float:
+    if (raw["inertia"] is None) == (raw["inertia_over_r2"] is None):
+        raise fail(f"{path}.inertia", "give exactly one of inertia or inertia_over_r2")
+    return raw["inertia"] if raw["inertia"] is not None else raw["inertia_over_r2"] * radius**2
+
+
+def _support(raw: dict) -> Support:
+    return Support(raw["radial_stiffness"], raw["radial_damping"], raw.get("torsional_stiffness", 0.0),
+                   raw.get("torsional_damping", 0.0))
+
+
+def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:
+    merged: dict = {"stiffness": None, "damping": None, "backlash": None, "ste": []}
+    for layer in (stage_mesh, gear_mesh):
+        if layer:
+            for key, value in layer.items():
+                if value is not None and value != []:
+                    merged[key] = value
+    return merged
+
+
+def _build_stage(st: dict, path: str, fail):
+    name = st["name"]
+    n = st["planets"]
+    # --- planet gears
+    planet_raw = st["planet"]
+    if planet_raw["gears"] is not None and planet_raw["gears"]:
+        if planet_raw["teeth"] is not None:
+            raise fail(f"{path}.planet.teeth", "give teeth on each of planet.gears, not on the planet")
+        planet_gears = {g: _gear(g, raw, st, False, f"{path}.planet.gears.{g}", fail)
+                        for g, raw in planet_raw["gears"].items()}
+    else:
+        if planet_raw["teeth"] is None:
+            raise fail(f"{path}.planet.teeth", "missing required field (or give planet.gears)")
+        planet_gears = {"planet": _gear("planet", planet_raw, st, False, f"{path}.planet", fail)}
+
+    # --- central gears (sun, ring, sun_*, ring_*)
+    central_keys = [k for k in st if (k in ("sun", "ring") or k.startswith(("sun_", "ring_"))) and st[k] is not None]
+    if not central_keys:
+        raise fail(path, "a stage needs at least one central gear (sun or ring)")
+    centrals: dict[str, tuple[Gear, str, dict]] = {}
+    for key in central_keys:
+        raw = st[key]
+        gpath = f"{path}.{key}"
+        internal = key.startswith("ring")
+        gear = _gear(key, raw, st, internal, gpath, fail)
+        if raw["planet_gear"] is None:
+            if len(planet_gears) > 1:
+                raise fail(f"{gpath}.planet_gear", f"missing required field for compound planets "
+                                                   f"(one of {', '.join(planet_gears)})")
+            pg = next(iter(planet_gears))
+        else:
+            pg = raw["planet_gear"]
+            if pg not in planet_gears:
+                raise fail(f"{gpath}.planet_gear", f"no planet gear {pg!r} (have {', '.join(planet_gears)})")
+        centrals[key] = (gear, pg, raw)
+
+    # --- operating centre distances must agree (ring teeth consistent with sun and planet)
+    geoms = {key: mesh_geometry(gear, planet_gears[pg]) for key, (gear, pg, _) in centrals.items()}
+    first = central_keys[0]
+    a0 = geoms[first].centre_distance
+    for key in central_keys[1:]:
+        a = geoms[key].centre_distance
+        if abs(a - a0) > CENTRE_DISTANCE_TOLERANCE:
+            g, pg, _ = centrals[key]
+            hint = ""
+            if g.internal and not centrals[first][0].internal and len(planet_gears) == 1:
+                zs, zp = centrals[first][0].teeth, planet_gears[pg].teeth
+                hint = f"; with zero profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth"
+            raise fail(f"{path}.{key}.teeth", f"{key} with {g.teeth} teeth meets the planet at centre distance "
+                                              f"{a * 1e3:.4f} mm but {first} at {a0 * 1e3:.4f} mm{hint}")
+    for key, gm in geoms.items():
+        if gm.contact_ratio < 1.0:
+            raise fail(f"{path}.{key}.teeth", f"transverse contact ratio {gm.contact_ratio:.3f} < 1 with the "
+                                              "planet: the mesh cannot transmit motion continuously")
+
+    # --- planet angles and the assembly condition
+    if st["planet_angles"] is None:
+        angles = tuple(2.0 * math.pi * k / n for k in range(n))
+        equally = True
+    else:
+        if len(st["planet_angles"]) != n:
+            raise fail(f"{path}.planet_angles_deg", f"has {len(st['planet_angles'])} angles for {n} planets")
+        angles = tuple(st["planet_angles"])
+        spacing = [((angles[k] - angles[0]) - 2 * math.pi * k / n) for k in range(n)]
+        equally = max(abs(s) for s in spacing) < 1e-12
+    _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
+    carrier_radius = a0
+    _check_collision(planet_gears, angles, carrier_radius, path, fail)
+
+    # --- members
+    members: dict[str, Member] = {}
+    for key, (gear, _, raw) in centrals.items():
+        mid = f"{name}.{key}"
+        members[mid] = Member(mid, name, "ring" if gear.internal else "sun", raw["mass"],
+                              _inertia(raw, gear.base_radius, f"{path}.{key}", fail), support=_support(raw["support"]),
+                              gears={key: gear})
+    carrier_raw = st["carrier"]
+    carrier_id = f"{name}.carrier"
+    members[carrier_id] = Member(carrier_id, name, "carrier", carrier_raw["mass"],
+                                 _inertia(carrier_raw, carrier_radius, f"{path}.carrier", fail),
+                                 support=_support(carrier_raw["support"]))
+    first_planet_gear = next(iter(planet_gears.values()))
+    planet_inertia = _inertia(planet_raw, first_planet_gear.base_radius, f"{path}.planet", fail)
+    planet_ids = []
+    for k, psi in enumerate(angles):
+        pid = f"{name}.planet{k + 1}"
+        planet_ids.append(pid)
+        members[pid] = Member(pid, name, "planet", planet_raw["mass"], planet_inertia,
+                              bearing=_support(planet_raw["bearing"]), gears=dict(planet_gears), angle=psi,
+                              radius=carrier_radius)
+
+    # --- meshes
+    meshes = []
+    for key, (gear, pg, raw) in centrals.items():
+        mesh = _merge_mesh(st["mesh"], raw["mesh"])
+        mpath = f"{path}.{key}.mesh"
+        if mesh["stiffness"] is None:
+            raise fail(f"{mpath}.stiffness", "missing required field (give it here or in the stage's [mesh])")
+        _check_stiffness(mesh["stiffness"], f"{mpath}.stiffness", fail)
+        damping = mesh["damping"] or {"ratio": None, "coefficient": None}
+        if damping["ratio"] is not None and damping["coefficient"] is not None:
+            raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")
+        ste = tuple((s["harmonic"], s["amplitude"], s["phase"]) for s in mesh["ste"])
+        for k, pid in enumerate(planet_ids):
+            meshes.append(MeshSpec(
+                id=f"{pid}.{key}", stage=name, central=f"{name}.{key}", planet=pid, central_gear=gear,
+                planet_gear=planet_gears[pg], geometry=geoms[key], stiffness=dict(mesh["stiffness"]),
+                damping_ratio=damping["ratio"], damping_coefficient=damping["coefficient"],
+                backlash=mesh["backlash"] or 0.0, ste=ste, planet_index=k,
+            ))
+    stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in central_keys),
+                  tuple(planet_ids), carrier_id)
+    return members, stage, meshes
+
+
+def _check_stiffness(params: dict, path: str, fail):
+    from .mesh_stiffness import MODELS
+
+    model = MODELS[params["model"]]
+    extra = set(params) - {"model", "mean"} - set(model.parameters)
+    if extra:
+        import difflib
+
+        key = sorted(extra)[0]
+        close = difflib.get_close_matches(key, list(model.parameters) + ["mean", "model"], n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise fail(f"{path}.{key}", f"unknown key for the {params['model']!r} model{hint}")
+    for key in model.parameters:
+        value = params.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not math.isfinite(value) or value <= 0):
+            raise fail(f"{path}.{key}", f"must be a positive finite number, got {value!r}")
+
+
+def _assembly_number(a: tuple[Gear, Gear], b: tuple[Gear, Gear]) -> tuple[int, int]:
+    """Numerator and denominator of the planet-spacing condition for central gears a, b.
+
+    Each argument is (central gear, planet gear it meshes).  A planet can be placed at
+    angle psi when psi/(2 pi) * (z_A z_b +/- z_B z_a) / gcd(z_a, z_b) is an integer:
+    '+' for a sun and a ring, '-' for two gears of the same kind.  Simple planets
+    (z_a = z_b) reduce this to the classical (z_s + z_r) psi / (2 pi) integer.
+    """
+    (ga, pa), (gb, pb) = a, b
+    sign = 1 if ga.internal != gb.internal else -1
+    num = ga.teeth * pb.teeth + sign * gb.teeth * pa.teeth
+    return abs(num), gcd(pa.teeth, pb.teeth)
+
+
+def _check_assembly(centrals, planet_gears, angles, equally, n, path, fail):
+    keys = list(centrals)
+    for i in range(len(keys)):
+        for j in range(i + 1, len(keys)):
+            ga, pa, _ = centrals[keys[i]]
+            gb, pb, _ = centrals[keys[j]]
+            num, den = _assembly_number((ga, planet_gears[pa]), (gb, planet_gears[pb]))
+            for k, psi in enumerate(angles):
+                count = psi / (2 * math.pi) * num / den
+                if abs(count - round(count)) > 1e-6:
+                    if equally:
+                        simple = len(planet_gears) == 1 and ga.internal != gb.internal
+                        formula = (f"(z_s + z_r)/N = {num // den}/{n}" if simple
+                                   else f"{num}/({den}·{n})")
+                        raise fail(f"{path}.planets", f"{n} equally spaced planets cannot be assembled: "
+                                                      f"{formula} is not an integer")
+                    raise fail(f"{path}.planet_angles_deg[{k}]",
+                               f"planet at {math.degrees(psi):.4f} deg cannot mesh with both "
+                               f"{keys[i]} and {keys[j]}: psi/360·{num}/{den} = {count:.4f} is not an integer")
+
+
+def _check_collision(planet_gears, angles, carrier_radius, path, fail):
+    tip = max(g.tip_radius for g in planet_gears.values())
+    order = sorted(angles)
+    n = len(order)
+    if n < 2:
+        return
+    for k in range(n):
+        gap = (order[(k + 1) % n] - order[k]) % (2 * math.pi) or 2 * math.pi
+        chord = 2.0 * carrier_radius * math.sin(gap / 2.0)
+        if chord <= 2.0 * tip:
+            raise fail(f"{path}.planets", f"adjacent planets collide: centre spacing {chord * 1e3:.3f} mm "
+                                          f"<= tip diameter {2 * tip * 1e3:.3f} mm")

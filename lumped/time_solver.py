@@ -1,0 +1,231 @@
+"""Time response of the reference model: fixed-step RK4 and scipy's adaptive integrators.
+
+Equation of motion (rotating frame, see :mod:`lumped.assembly`):
+
+    M q'' = F_static + b_in T_in(t) + b_out T_out(t) - (C_b + G) q' - (K_b - K_Omega) q
+            - sum_m a_m [k_m(t) f(a_m.q - e_m(t)) + c_m (a_m.q' - e_m'(t))],
+
+f the backlash dead zone.  The start is the static deflection under the mean load
+(``ramp_s`` = 0) or the unloaded state with the load ramped in.
+
+Time step: RK4 is stable for omega_max h < 2.83 on undamped modes; the solver refuses a
+step above ``STABILITY_MARGIN`` times that limit and by default takes
+``POINTS_PER_PERIOD`` steps per period of the highest natural frequency (with the mesh
+stiffness at its cycle maximum) and ``POINTS_PER_MESH_CYCLE`` per mesh cycle.
+"""
+
+from __future__ import annotations
+
+import math
+import time as clock
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.integrate import solve_ivp
+
+from .errors import DivergenceError, SolverError
+from .results import TimeResult
+from .static import deadzone, mean_load, static_solution
+
+STABILITY_MARGIN = 0.9
+POINTS_PER_PERIOD = 20
+POINTS_PER_MESH_CYCLE = 64
+CHUNK = 20000
+ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+
+
+def max_angular_frequency(model) -> float:
+    """Highest natural angular frequency with every mesh at its largest stiffness over a cycle."""
+    xi = np.linspace(0.0, 1.0, 2001)
+    k_max = np.array([np.max(m(xi)) for m in model.excitation.models])
+    K = model.K_b + model.K_mesh(k_max) - model.K_omega
+    w2 = sla.eigh(K, model.M, eigvals_only=True)
+    return float(np.sqrt(max(w2.max(), 0.0)))
+
+
+def stable_step(model) -> float:
+    return STABILITY_MARGIN * 2.0 * math.sqrt(2.0) / max_angular_frequency(model)
+
+
+def default_step(model) -> float:
+    f_max = max_angular_frequency(model) / (2 * math.pi)
+    f_mesh = float(np.max(model.excitation.frequency)) if len(model.excitation.frequency) else 0.0
+    h = 1.0 / (POINTS_PER_PERIOD * f_max)
+    if f_mesh > 0:
+        h = min(h, 1.0 / (POINTS_PER_MESH_CYCLE * f_mesh))
+    return h
+
+
+def check_step(model, dt: float) -> None:
+    limit = stable_step(model)
+    if not (dt > 0 and math.isfinite(dt)):
+        raise SolverError(f"time step must be a positive number, got {dt}")
+    if dt > limit:
+        f_max = max_angular_frequency(model) / (2 * math.pi)
+        raise SolverError(
+            f"time step {dt:.4g} s cannot resolve the highest natural frequency {f_max:.6g} Hz: RK4 is stable "
+            f"only for dt < 2.83/omega_max = {limit / STABILITY_MARGIN:.4g} s; use dt <= {default_step(model):.4g} s "
+            f"(the default) or at most {limit:.4g} s")
+
+
+class _System:
+    """Right-hand side pieces of one model, vectorised over time where possible."""
+
+    def __init__(self, model):
+        self.model = model
+        self.exc = model.excitation
+        self.Minv = 1.0 / np.diag(model.M)
+        self.D = model.C_b + model.G
+        self.Kc = model.K_b - model.K_omega
+        self.A = model.mesh_rows
+        self.c = model.mesh_damping
+        self.b = 0.5 * self.exc.backlash
+        self.has_backlash = bool(np.any(self.b > 0))
+        self.F0 = model.F_static
+        self.b_in, self.b_out = model.b_input, model.b_output
+
+    def drive(self, t):
+        """Excitation at times t: (k, e, de, T_in, T_out), arrays with time along axis 0."""
+        k = self.exc.stiffness(t)
+        e, de = self.exc.transmission_error(t)
+        t_in, t_out = self.exc.torques(t)
+        return k, e, de, t_in, t_out
+
+    def mesh_force(self, q, v, k, e, de):
+        delta = self.A @ q if q.ndim == 1 else q @ self.A.T
+        rate = self.A @ v if v.ndim == 1 else v @ self.A.T
+        elastic = deadzone(delta - e, self.b) if self.has_backlash else delta - e
+        return delta, k * elastic + self.c * (rate - de)
+
+    def acceleration(self, q, v, k, e, de, t_in, t_out):
+        _, f = self.mesh_force(q, v, k, e, de)
+        force = self.F0 + self.b_in * t_in + self.b_out * t_out - self.D @ v - self.Kc @ q - self.A.T @ f
+        return force * self.Minv
+
+
+def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
+    """Static deflection under the mean load, or the unloaded state when the load is ramped."""
+    scale = 0.0 if model.spec.operating.ramp > 0 else 1.0
+    return static_solution(model, load_scale=scale).q, np.zeros(model.n)
+
+
+def mechanical_energy(model, q, v) -> np.ndarray:
+    """1/2 v'Mv + 1/2 q'(K_mean - Omega^2 K_Omega)q - q'F: conserved for constant stiffness, no damping
+    and constant load (the Coriolis forces do no work).  q, v with time along axis 0."""
+    K = model.K_mean - model.K_omega
+    F = mean_load(model)
+    return 0.5 * np.einsum("ti,ij,tj->t", v, model.M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, K, q) - q @ F
+
+
+def simulate(model, duration: float, dt: float | None = None, method: str = "rk4", output_dt: float | None = None,
+             settle: float | None = None, rtol: float = 1e-8, atol: float = 1e-14, y0=None,
+             progress=None) -> TimeResult:
+    """Integrate ``model`` over ``duration`` seconds.
+
+    dt: RK4 step (default :func:`default_step`), checked against the stability limit;
+    also the largest step of the adaptive methods.  output_dt: sampling of the result
+    (default: every step).  settle: start of the steady-state window (default: the
+    larger of the load ramp and half the duration).  progress: callable(fraction).
+    """
+    if not (duration > 0 and math.isfinite(duration)):
+        raise SolverError(f"duration must be a positive number of seconds, got {duration}")
+    if dt is None:
+        dt = default_step(model)
+    check_step(model, dt)
+    n_steps = max(1, math.ceil(duration / dt - 1e-9))
+    every = 1 if output_dt is None else max(1, round(output_dt / dt))
+    q0, v0 = initial_state(model) if y0 is None else y0
+    sys = _System(model)
+    started = clock.perf_counter()
+    if method == "rk4":
+        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress)
+        evaluations = 4 * n_steps
+    elif method in ADAPTIVE_METHODS:
+        t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
+    else:
+        raise SolverError(f"unknown method {method!r}: use rk4 or one of {', '.join(ADAPTIVE_METHODS)}")
+    wall = clock.perf_counter() - started
+    op = model.spec.operating
+    settle = max(op.ramp, 0.5 * duration) if settle is None else settle
+    info = {"method": method, "dt_s": dt, "steps": n_steps, "rhs_evaluations": evaluations, "wall_time_s": wall,
+            "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms}
+    return _result(model, sys, t_out, q_out, v_out, settle, info)
+
+
+def _rk4(sys, q, v, h, n_steps, every, progress):
+    n_out = n_steps // every + 1
+    t_out = np.empty(n_out)
+    q_out = np.empty((n_out, q.size))
+    v_out = np.empty((n_out, q.size))
+    t_out[0], q_out[0], v_out[0] = 0.0, q, v
+    acc = sys.acceleration
+    j = 1
+    for start in range(0, n_steps, CHUNK):
+        stop = min(start + CHUNK, n_steps)
+        times = 0.5 * h * np.arange(2 * start, 2 * stop + 1)
+        k, e, de, tin, tout = sys.drive(times)
+        for i in range(stop - start):
+            a = 2 * i
+            k1v = acc(q, v, k[a], e[a], de[a], tin[a], tout[a])
+            q2, v2 = q + 0.5 * h * v, v + 0.5 * h * k1v
+            k2v = acc(q2, v2, k[a + 1], e[a + 1], de[a + 1], tin[a + 1], tout[a + 1])
+            q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * k2v
+            k3v = acc(q3, v3, k[a + 1], e[a + 1], de[a + 1], tin[a + 1], tout[a + 1])
+            q4, v4 = q + h * v3, v + h * k3v
+            k4v = acc(q4, v4, k[a + 2], e[a + 2], de[a + 2], tin[a + 2], tout[a + 2])
+            q = q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4)
+            v = v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
+            step = start + i + 1
+            if step % every == 0:
+                t_out[j], q_out[j], v_out[j] = step * h, q, v
+                j += 1
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            raise DivergenceError(stop * h, "state became NaN or infinite")
+        if progress is not None:
+            progress(stop / n_steps)
+    return t_out[:j], q_out[:j], v_out[:j]
+
+
+def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
+    n = q0.size
+
+    def rhs(t, y):
+        k, e, de, tin, tout = sys.drive(t)
+        return np.concatenate([y[n:], sys.acceleration(y[:n], y[n:], k, e, de, tin, tout)])
+
+    t_eval = h * np.arange(0, n_steps + 1, every)
+    sol = solve_ivp(rhs, (0.0, n_steps * h), np.concatenate([q0, v0]), method=method, t_eval=t_eval,
+                    max_step=h * every, rtol=rtol, atol=atol)
+    if not sol.success:
+        raise DivergenceError(float(sol.t[-1]) if sol.t.size else 0.0, sol.message)
+    return sol.t, sol.y[:n].T, sol.y[n:].T, int(sol.nfev)
+
+
+def _result(model, sys, t, q, v, settle, info) -> TimeResult:
+    k, e, de, tin, tout = sys.drive(t)
+    qdd = np.array([sys.acceleration(q[i], v[i], k[i], e[i], de[i], tin[i], tout[i]) for i in range(t.size)])
+    delta, force = sys.mesh_force(q, v, k, e, de)
+    spec, dofs = model.spec, model.dofs
+    members = list(spec.members)
+    acc = np.empty((t.size, len(members), 3))
+    angle = np.empty((t.size, len(members)))
+    for j, mid in enumerate(members):
+        member = spec.members[mid]
+        iu, iv, ith = dofs.of_member(mid)
+        omega = model.kin.speeds[f"{member.stage}.carrier"] if model.rotating_frame_terms else 0.0
+        # inertial acceleration in rotating axes: q'' + 2 Omega k x q' + Omega k x (Omega k x (q + r0))
+        acc[:, j, 0] = qdd[:, iu] - 2 * omega * v[:, iv] - omega**2 * (q[:, iu] + member.radius)
+        acc[:, j, 1] = qdd[:, iv] + 2 * omega * v[:, iu] - omega**2 * q[:, iv]
+        acc[:, j, 2] = qdd[:, ith]
+        angle[:, j] = model.kin.speeds[f"{member.stage}.carrier"] * t + member.angle
+    bearings = [r for r in model.rows if r.kind == "bearing"]
+    bearing_force = np.array([[r.stiffness * (r.a @ q[i]) + r.damping * (r.a @ v[i]) for r in bearings]
+                              for i in range(t.size)]) if bearings else None
+    static = static_solution(model)
+    raw = {f"{label}": q[:, i] for i, label in enumerate(dofs.labels())}
+    return TimeResult(
+        train=spec.name, solver="lumped", t=t, members=members, acc_carrier=acc, carrier_angle=angle,
+        mesh_ids=[m.id for m in spec.meshes], mesh_deflection=delta, mesh_force=force, mesh_stiffness=k,
+        static_mesh_force=static.mesh_force, bearing_names=[r.name for r in bearings], bearing_force=bearing_force,
+        settle_time=settle, info=info, raw=raw,
+    )

@@ -240,8 +240,6 @@ def _did_you_mean(word: str, candidates) -> str:
 # The train file
 # --------------------------------------------------------------------------------------
 
-MEMBER_REF = r"[A-Za-z0-9_\-]+\.(sun|ring|carrier)(_[A-Za-z0-9_]+)?"
-
 GEOMETRY = {
     "teeth": Integer("number of teeth (ring: internal teeth)", minimum=1),
     "module_mm": Positive("transverse module; defaults to the stage's module", "mm", None),
@@ -403,8 +401,8 @@ COUPLING = Table(
     {
         "name": Text("coupling name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
         "kind": Text("what it is", "spline", ("spline", "shaft")),
-        "from": Text("first member (`stage1.carrier`)", REQUIRED, pattern=MEMBER_REF),
-        "to": Text("second member (`stage2.sun`)", REQUIRED, pattern=MEMBER_REF),
+        "from": Text("first member (`stage1.carrier`)", REQUIRED),
+        "to": Text("second member (`stage2.sun`)", REQUIRED),
         "torsional_stiffness": Positive("torsional stiffness", "N·m/rad"),
         "torsional_damping": NonNegative("torsional damping", "N·m·s/rad"),
         "radial_stiffness": NonNegative("radial stiffness in x and y (0 = torsional only)", "N/m"),
@@ -418,9 +416,9 @@ TRAIN_TABLE = Table(
         "name": Text("train name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
         "description": Text("one-line description"),
         "source": Text("where the train comes from (paper, design)", ""),
-        "input": Text("input member, `STAGE.MEMBER`", REQUIRED, pattern=MEMBER_REF),
-        "output": Text("output member", REQUIRED, pattern=MEMBER_REF),
-        "held": ListOf(Text("member", REQUIRED, pattern=MEMBER_REF),
+        "input": Text("input member, `STAGE.MEMBER`", REQUIRED),
+        "output": Text("output member", REQUIRED),
+        "held": ListOf(Text("member", REQUIRED),
                        "members held by their torsional support stiffness", ()),
     },
     "identification and power flow",

@@ -185,6 +185,8 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     for j, ref in enumerate(train["held"]):
         if ref not in members:
             raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
+        if members[ref].is_planet:
+            raise fail(f"train.held[{j}]", f"{ref} is a planet; only sun, ring or carrier can be held")
         if members[ref].support.torsional_stiffness <= 0.0:
             raise fail(f"train.held[{j}]", f"{ref} is held but its support.torsional_stiffness is 0; "
                                            "a held member is held by a support stiffness")
@@ -380,13 +382,15 @@ def _build_stage(st: dict, path: str, fail):
                               radius=carrier_radius)
 
     # --- meshes
+    for layer, lpath in [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]:
+        if layer and layer["stiffness"] is not None:
+            _check_stiffness(layer["stiffness"], f"{lpath}.stiffness", fail)
     meshes = []
     for key, (gear, pg, raw) in centrals.items():
         mesh = _merge_mesh(st["mesh"], raw["mesh"])
         mpath = f"{path}.{key}.mesh"
         if mesh["stiffness"] is None:
             raise fail(f"{mpath}.stiffness", "missing required field (give it here or in the stage's [mesh])")
-        _check_stiffness(mesh["stiffness"], f"{mpath}.stiffness", fail)
         damping = mesh["damping"] or {"ratio": None, "coefficient": None}
         if damping["ratio"] is not None and damping["coefficient"] is not None:
             raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")

@@ -222,7 +222,8 @@ def _result(model, sys, t, q, v, settle, info) -> TimeResult:
     bearing_force = np.array([[r.stiffness * (r.a @ q[i]) + r.damping * (r.a @ v[i]) for r in bearings]
                               for i in range(t.size)]) if bearings else None
     static = static_solution(model)
-    raw = {f"{label}": q[:, i] for i, label in enumerate(dofs.labels())}
+    raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
+    raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
     return TimeResult(
         train=spec.name, solver="lumped", t=t, members=members, acc_carrier=acc, carrier_angle=angle,
         mesh_ids=[m.id for m in spec.meshes], mesh_deflection=delta, mesh_force=force, mesh_stiffness=k,

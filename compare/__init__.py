@@ -1,0 +1,1 @@
+"""Alignment, metrics, reports and the command line."""

@@ -1,0 +1,225 @@
+"""The ``gearcheck`` command line.
+
+Every GearcheckError becomes one line on stderr and exit status 2; no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from lumped import GearcheckError, build_model, load_train, preset_names
+from lumped.errors import SolverError
+
+from .progress import ProgressBar
+
+SOLVERS = ("lumped", "mujoco")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except GearcheckError as exc:
+        print(f"gearcheck: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("gearcheck: interrupted", file=sys.stderr)
+        return 130
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="gearcheck", description="Cross-verify lumped-parameter planetary gear "
+                                                              "models against MuJoCo multibody twins.")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("presets", help="list the shipped train presets")
+    s.set_defaults(func=cmd_presets)
+
+    s = sub.add_parser("show", help="the validated train with derived quantities")
+    _train_arg(s)
+    s.add_argument("--json", action="store_true", help="machine-readable output")
+    s.set_defaults(func=cmd_show)
+
+    s = sub.add_parser("modes", help="natural frequencies and mode types")
+    _train_arg(s)
+    s.add_argument("--solver", choices=SOLVERS + ("both",), default="lumped")
+    s.add_argument("--json", action="store_true", help="machine-readable output")
+    s.set_defaults(func=cmd_modes)
+
+    s = sub.add_parser("run", help="time response at the operating point")
+    _train_arg(s)
+    s.add_argument("--solver", choices=SOLVERS, default="lumped")
+    s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
+    s.add_argument("--duration", type=float, default=0.2, metavar="S", help="simulated time (default 0.2 s)")
+    s.add_argument("--dt", type=float, metavar="S", help="time step (default: from the highest natural frequency)")
+    s.add_argument("--output-dt", type=float, metavar="S", help="output sampling interval (default: every step)")
+    s.add_argument("--method", default="rk4", help="lumped integrator: rk4 (default) or RK45, DOP853, Radau, "
+                                                   "BDF, LSODA")
+    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
+    s.set_defaults(func=cmd_run)
+    return p
+
+
+def _train_arg(s):
+    s.add_argument("train", metavar="TRAIN", help="preset name or path to a train TOML file")
+
+
+def _load(args):
+    spec = load_train(args.train)
+    speed = getattr(args, "speed", None)
+    if speed is not None:
+        if not (math.isfinite(speed) and speed > 0):
+            raise GearcheckError(f"--speed must be a positive number of rpm, got {speed}")
+        spec = spec.with_operating(input_speed=speed * 2 * math.pi / 60)
+    return spec
+
+
+# ----------------------------------------------------------------------------- commands
+def cmd_presets(args) -> int:
+    rows = []
+    for name in preset_names():
+        spec = load_train(name)
+        rows.append((name, spec.description, spec.source))
+    width = max(len(r[0]) for r in rows)
+    for name, description, source in rows:
+        print(f"{name:<{width}}  {description}  [{source}]")
+    return 0
+
+
+def describe(spec) -> dict:
+    """Derived quantities of a train (``gearcheck show``)."""
+    model = build_model(spec)
+    kin = model.kin
+    rpm = 60 / (2 * math.pi)
+    out = {
+        "train": spec.name, "description": spec.description, "source": spec.source, "file": spec.path,
+        "input": spec.input, "output": spec.output, "held": list(spec.held),
+        "ratio": kin.ratio, "input_speed_rpm": spec.operating.input_speed * rpm,
+        "input_torque_nm": kin.input_torque, "output_torque_nm": kin.output_torque,
+        "speeds_rpm": {m: w * rpm for m, w in kin.speeds.items()},
+        "stages": [], "meshes": [],
+    }
+    for stage in spec.stages:
+        out["stages"].append({
+            "name": stage.name, "planets": len(stage.planets), "carrier_radius_m": stage.carrier_radius,
+            "planet_angles_deg": [math.degrees(a) for a in stage.planet_angles],
+            "gears": {_gear_label(spec.members[mid], g): {
+                "teeth": g.teeth, "pitch_radius_m": g.pitch_radius, "base_radius_m": g.base_radius,
+                "tip_radius_m": g.tip_radius, "profile_shift": g.profile_shift}
+                for mid in stage.centrals + stage.planets[:1] for g in spec.members[mid].gears.values()},
+        })
+    for j, mesh in enumerate(spec.meshes):
+        g = mesh.geometry
+        out["meshes"].append({
+            "mesh": mesh.id, "contact_ratio": g.contact_ratio, "operating_pressure_angle_deg":
+                math.degrees(g.pressure_angle), "mesh_frequency_hz": kin.mesh_frequency[mesh.id],
+            "phase_cycles": kin.mesh_phase[mesh.id], "loaded_flank": kin.flanks[mesh.id],
+            "mean_stiffness_n_per_m": float(model.excitation.mean_stiffness[j]),
+            "damping_n_s_per_m": float(model.mesh_damping[j]), "backlash_m": mesh.backlash,
+            "stiffness_model": mesh.stiffness["model"],
+        })
+    return out
+
+
+def _gear_label(member, gear) -> str:
+    if member.is_planet:
+        return "planet" if gear.name == "planet" else f"planet.{gear.name}"
+    return gear.name
+
+
+def cmd_show(args) -> int:
+    spec = _load(args)
+    info = describe(spec)
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    print(f"{info['train']}: {info['description']}")
+    print(f"  source: {info['source']}    file: {info['file']}")
+    print(f"  input {info['input']} at {info['input_speed_rpm']:.6g} rpm, {info['input_torque_nm']:.6g} N·m; "
+          f"output {info['output']}, {info['output_torque_nm']:.6g} N·m; held {', '.join(info['held']) or '-'}")
+    print(f"  ratio input/output = {info['ratio']:.10g}")
+    print("  speeds (rpm): " + ", ".join(f"{m} {w:.6g}" for m, w in info["speeds_rpm"].items()))
+    for st in info["stages"]:
+        print(f"  stage {st['name']}: {st['planets']} planets at "
+              f"{', '.join(f'{a:.6g}' for a in st['planet_angles_deg'])} deg, carrier radius "
+              f"{st['carrier_radius_m'] * 1e3:.6g} mm")
+        for name, g in st["gears"].items():
+            print(f"    {name:<16} z={g['teeth']:<4d} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
+                  f"r_base={g['base_radius_m'] * 1e3:.6g} mm  r_tip={g['tip_radius_m'] * 1e3:.6g} mm")
+    print("  meshes:")
+    for m in info["meshes"]:
+        print(f"    {m['mesh']:<24} eps={m['contact_ratio']:.4f}  alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
+              f"f_mesh={m['mesh_frequency_hz']:.6g} Hz  phase={m['phase_cycles']:.4f}  "
+              f"k={m['mean_stiffness_n_per_m']:.4g} N/m ({m['stiffness_model']})  c={m['damping_n_s_per_m']:.4g} N·s/m")
+    return 0
+
+
+def modal_results(spec, solver: str) -> list:
+    from lumped.modal import modes
+
+    results = []
+    if solver in ("lumped", "both"):
+        results.append(modes(build_model(spec)))
+    if solver in ("mujoco", "both"):
+        from mbd_models import mujoco_modes
+
+        results.append(mujoco_modes(spec))
+    return results
+
+
+def cmd_modes(args) -> int:
+    spec = _load(args)
+    results = modal_results(spec, args.solver)
+    if args.json:
+        print(json.dumps({"train": spec.name, "unit": "Hz", "solvers": [r.to_dict() for r in results]}, indent=2))
+        return 0
+    header = f"{'mode':>4}  " + "  ".join(f"{r.solver + ' (Hz)':>16}  {'type':<13} {'mult':>4}" for r in results)
+    if len(results) == 2:
+        header += f"  {'rel. diff':>10}"
+    print(f"{spec.name}: natural frequencies at mean mesh stiffness")
+    print(header)
+    for i in range(len(results[0])):
+        line = f"{i + 1:>4}  " + "  ".join(
+            f"{r.frequencies[i]:>16.6f}  {r.types[i]:<13} {r.multiplicity[i]:>4}" for r in results)
+        if len(results) == 2:
+            a, b = results[0].frequencies[i], results[1].frequencies[i]
+            line += f"  {abs(a - b) / max(abs(a), 1e-300):>10.2e}"
+        print(line)
+    return 0
+
+
+def run_solver(spec, solver: str, duration: float, dt=None, output_dt=None, method="rk4", progress=None):
+    if solver == "lumped":
+        from lumped.time_solver import simulate
+
+        return simulate(build_model(spec), duration, dt=dt, method=method, output_dt=output_dt, progress=progress)
+    from mbd_models import simulate_mujoco
+
+    if method != "rk4":
+        raise SolverError("--method applies to the lumped solver only")
+    return simulate_mujoco(spec, duration, dt=dt, output_dt=output_dt, progress=progress)
+
+
+def cmd_run(args) -> int:
+    spec = _load(args)
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
+    bar = ProgressBar(f"{args.solver} {spec.name}")
+    result = run_solver(spec, args.solver, args.duration, args.dt, args.output_dt, args.method, bar)
+    bar.close()
+    out = args.out
+    written = result.write(out)
+    print(f"{spec.name} ({args.solver}): {result.t.size} samples over {result.t[-1]:.6g} s, "
+          f"dt = {result.info['dt_s']:.4g} s, wall {result.info['wall_time_s']:.3g} s")
+    for path in written:
+        print(f"  wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,52 @@
+"""The command line: listing, showing, modes as JSON, a lumped run writing its files."""
+
+import json
+
+import pandas as pd
+import pytest
+
+from compare.cli import main
+
+
+def test_presets_lists_every_preset_with_its_source(capsys):
+    assert main(["presets"]) == 0
+    out = capsys.readouterr().out
+    assert "demo-3p" in out and "demo-4p" in out and "gearcheck demo design" in out
+
+
+def test_show_json_derived_quantities(capsys):
+    assert main(["show", "demo-3p", "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["ratio"] == pytest.approx(1 + 62 / 22)
+    assert {m["mesh"] for m in info["meshes"]} >= {"stage1.planet1.sun", "stage1.planet3.ring"}
+    assert info["meshes"][0]["mesh_frequency_hz"] == pytest.approx(22 * (1500 - 1500 / info["ratio"]) / 60)
+
+
+def test_modes_json_schema(capsys):
+    assert main(["modes", "demo-4p", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    modes = data["solvers"][0]["modes"]
+    assert data["unit"] == "Hz" and len(modes) == 21
+    assert set(modes[0]) == {"mode", "frequency_hz", "type", "multiplicity"}
+
+
+def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
+    assert main(["run", "demo-3p", "--solver", "lumped", "--duration", "0.01", "--speed", "1000",
+                 "--output-dt", "2e-5", "--out", str(tmp_path)]) == 0
+    df = pd.read_csv(tmp_path / "timeseries.csv")
+    assert {"t", "stage1.ring.ay", "stage1.planet1.sun.force", "stage1.planet1.sun.dte"} <= set(df.columns)
+    assert df["t"].iloc[-1] == pytest.approx(0.01, rel=1e-3)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["solver"] == "lumped" and summary["info"]["method"] == "rk4"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["show", "no-such-train"], "no such train file or preset"),
+    (["run", "demo-3p", "--duration", "-1"], "--duration must be a positive number"),
+    (["run", "demo-3p", "--speed", "nan"], "--speed must be a positive number"),
+    (["run", "demo-3p", "--dt", "1e-3", "--duration", "0.001"], "cannot resolve the highest natural frequency"),
+])
+def test_bad_requests_exit_2_with_one_line(argv, message, capsys, tmp_path):
+    assert main(argv + (["--out", str(tmp_path)] if argv[0] == "run" else [])) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1

@@ -154,6 +154,7 @@ class Table:
     patterns: tuple[tuple[str, Any], ...] = ()
     unit: str = ""
     open: bool = False  # extra keys are passed through unchecked (validated by a plug-in)
+    pattern_label: str = "NAME"  # how pattern keys are shown in the documentation
 
     def parse(self, value, path: str, ctx: Context) -> dict:
         if not isinstance(value, dict):
@@ -343,7 +344,7 @@ PLANET = Table(
         **BODY,
         "bearing": PLANET_BEARING,
         "gears": Table({}, "compound planet: named gears, e.g. [stages.planet.gears.f]", None,
-                       patterns=((r"[A-Za-z][A-Za-z0-9_]*", PLANET_GEAR),)),
+                       patterns=((r"[A-Za-z][A-Za-z0-9_]*", PLANET_GEAR),), pattern_label="NAME"),
     },
     "the planets of the stage (all identical)",
 )
@@ -367,6 +368,7 @@ STAGE = Table(
     },
     "a planetary stage ([[stages]]); extra central gears may be named sun_* or ring_*",
     patterns=((r"(sun|ring)_[A-Za-z0-9_]+", CENTRAL_GEAR),),
+    pattern_label="sun_NAME / ring_NAME",
 )
 
 RIPPLE = Table(
@@ -443,22 +445,20 @@ def parse(document: dict, source: str) -> dict:
 def markdown_reference() -> str:
     """The field-by-field reference of the train file, as a Markdown table."""
     rows = ["| field | type | unit | default | meaning |", "|---|---|---|---|---|"]
+    seen: dict[int, str] = {}
 
     def walk(table: Table, prefix: str):
-        items = list(table.fields.items()) + [(rx.replace("|", "\\|"), spec) for rx, spec in table.patterns]
+        items = list(table.fields.items()) + [(f"<{table.pattern_label}>", spec) for _, spec in table.patterns]
         for key, spec in items:
             path = f"{prefix}.{key}" if prefix else key
-            if isinstance(spec, Table) and not spec.fields and spec.patterns:
-                rows.append(_row(path, spec))
-                for rx, sub in spec.patterns:
-                    walk(sub, f"{path}.<{rx}>")
+            inner = spec.table if isinstance(spec, TableList) else spec
+            if isinstance(inner, Table) and id(inner) in seen:
+                rows.append(_row(path, spec, f"same fields as `{seen[id(inner)]}`"))
                 continue
-            if isinstance(spec, Table):
-                rows.append(_row(path, spec))
-                walk(spec, path)
-            elif isinstance(spec, TableList):
-                rows.append(_row(f"[[{path}]]", spec))
-                walk(spec.table, path)
+            if isinstance(inner, Table):
+                seen[id(inner)] = path
+                rows.append(_row(f"[[{path}]]" if inner is not spec else path, spec))
+                walk(inner, path)
             else:
                 rows.append(_row(path, spec))
 
@@ -466,7 +466,7 @@ def markdown_reference() -> str:
     return "\n".join(rows) + "\n"
 
 
-def _row(path: str, spec) -> str:
+def _row(path: str, spec, note: str = "") -> str:
     if spec.default is REQUIRED:
         default = "**required**"
     elif spec.default is None:
@@ -476,6 +476,8 @@ def _row(path: str, spec) -> str:
     else:
         default = f"`{spec.default}`" if not isinstance(spec.default, float) else f"`{spec.default:g}`"
     doc = spec.doc or getattr(getattr(spec, "table", None), "doc", "")
+    if note:
+        doc = f"{doc}; {note}"
     if getattr(spec, "choices", None):
         doc += " (" + ", ".join(spec.choices) + ")"
     return f"| `{path}` | {spec.type_name()} | {spec.unit or '-'} | {default} | {doc} |"

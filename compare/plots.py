@@ -1,0 +1,132 @@
+"""Report figures (PNG, Agg backend, deterministic: no timestamps in the files)."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+LUMPED_STYLE = {"color": "tab:blue", "lw": 1.2, "label": "lumped"}
+MUJOCO_STYLE = {"color": "tab:orange", "lw": 1.0, "ls": "--", "label": "MuJoCo"}
+
+
+def _save(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, metadata={"Software": None})
+    plt.close(fig)
+
+
+def headline_quantities(result) -> list[str]:
+    """Carrier and ring accelerations (world y, as the accelerometers see them) and the first
+    sun-planet and ring-planet mesh forces of every stage."""
+    names = []
+    available = {q.name for q in result.quantities}
+    for stage in result.spec.stages:
+        for member in (stage.carrier, *[c for c in stage.centrals if result.spec.members[c].kind == "ring"]):
+            names.append(f"{member}.ay.world")
+        for mesh in result.spec.meshes:
+            if mesh.stage == stage.name and mesh.planet_index == 0:
+                names.append(f"{mesh.id}.force")
+    return [n for n in names if n in available]
+
+
+def _title(result, what: str) -> str:
+    s = result.settings
+    return (f"{result.spec.name} at {s['input_speed_rpm']:.6g} rpm: {what}\n"
+            f"lumped {s['lumped']['method']} dt={s['lumped']['dt_s']:.3g} s, "
+            f"MuJoCo {s['mujoco'].get('integrator', '')} dt={s['mujoco'].get('dt_s', float('nan')):.3g} s")
+
+
+def time_histories(result, path, cycles: int = 4):
+    names = headline_quantities(result)
+    units = {q.name: q.unit for q in result.quantities}
+    f_cycle = 1.0 / result.settings["steady_cycle_s"]
+    t = result.grid
+    t_end = t[-1]
+    window = t >= t_end - cycles / f_cycle
+    fig, axes = plt.subplots(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
+    for ax, name in zip(axes[:, 0], names):
+        a, b = result.series[name]
+        ax.plot(t[window] * 1e3, a[window], **LUMPED_STYLE)
+        ax.plot(t[window] * 1e3, b[window], **MUJOCO_STYLE)
+        ax.set_ylabel(f"[{units[name]}]")
+        ax.set_title(name, fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    axes[-1, 0].set_xlabel("time [ms]")
+    fig.suptitle(_title(result, f"steady-state time histories, last {cycles} mesh cycles"), fontsize=9)
+    _save(fig, path)
+
+
+def spectra(result, path):
+    names = headline_quantities(result)
+    units = {q.name: q.unit for q in result.quantities}
+    window = result.grid >= result.steady_start_s
+    fs = result.settings["common_sample_rate_hz"]
+    f_mesh = 1.0 / result.settings["steady_cycle_s"]
+    fig, axes = plt.subplots(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
+    for ax, name in zip(axes[:, 0], names):
+        for x, style in zip(result.series[name], (LUMPED_STYLE, MUJOCO_STYLE)):
+            seg = x[window] - np.mean(x[window])
+            w = np.hanning(seg.size)
+            amp = 2 * np.abs(np.fft.rfft(seg * w)) / np.sum(w)
+            freq = np.fft.rfftfreq(seg.size, 1 / fs)
+            ax.semilogy(freq, np.maximum(amp, 1e-30), **style)
+        for k in range(1, 6):
+            ax.axvline(k * f_mesh, color="gray", lw=0.5, ls=":")
+        ax.set_xlim(0, min(0.5 * fs, 6 * f_mesh))
+        ax.set_ylabel(f"amplitude [{units[name]}]")
+        ax.set_title(name, fontsize=9)
+        ax.grid(alpha=0.3, which="both")
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    axes[-1, 0].set_xlabel("frequency [Hz] (dotted: mesh harmonics)")
+    fig.suptitle(_title(result, "amplitude spectra of the steady window (Hann)"), fontsize=9)
+    _save(fig, path)
+
+
+def natural_frequencies(result, path):
+    rows = result.modal
+    idx = np.arange(1, len(rows) + 1)
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+    ax.plot(idx, [r["reference_hz"] for r in rows], "o", color="tab:blue", label="lumped")
+    ax.plot(idx, [r["test_hz"] for r in rows], "x", color="tab:orange", label="MuJoCo")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    errors = np.array([max(r["rel_error"], 1e-17) for r in rows])
+    ax2.semilogy(idx, errors, "s", color="tab:green", label="|f_MuJoCo - f_lumped| / f_lumped")
+    ax2.axhline(result.modal_tolerance, color="tab:red", ls="--", label="tolerance")
+    ax2.set_xlabel("mode")
+    ax2.set_ylabel("relative difference [-]")
+    ax2.legend(fontsize=8)
+    ax2.grid(alpha=0.3, which="both")
+    fig.suptitle(f"{result.spec.name}: natural frequencies at mean mesh stiffness", fontsize=9)
+    _save(fig, path)
+
+
+def error_bars(result, path):
+    gated = [q for q in result.quantities if q.status != "negligible" and q.metrics["nrmse"] is not None]
+    fig, ax = plt.subplots(figsize=(9, max(3.0, 0.22 * len(gated) + 1.5)))
+    y = np.arange(len(gated))
+    values = [max(q.metrics["nrmse"], 1e-12) for q in gated]
+    colors = ["tab:red" if q.status == "fail" else "tab:green" for q in gated]
+    ax.barh(y, values, color=colors)
+    ax.scatter([q.tolerance or np.nan for q in gated], y, marker="|", s=200, color="black", label="tolerance")
+    ax.set_yticks(y, [q.name for q in gated], fontsize=7)
+    ax.set_xscale("log")
+    ax.set_xlabel("normalised RMS error rms(b - a)/rms(a) [-]")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, axis="x", which="both")
+    fig.suptitle(_title(result, "waveform error per quantity"), fontsize=9)
+    _save(fig, path)
+
+
+FIGURES = {
+    "time_histories.png": time_histories,
+    "spectra.png": spectra,
+    "natural_frequencies.png": natural_frequencies,
+    "errors.png": error_bars,
+}

@@ -7,7 +7,9 @@
   stiffness makes mesh forces jump, and a jump has content up to any Nyquist frequency).
 * :func:`steady_start` — the start of the steady state: the first of
   ``STEADY_CYCLES`` consecutive cycles (a cycle = one period of the slowest mesh) whose
-  RMS and mean differ from the previous cycle's by less than ``threshold`` of the RMS.
+  mean and standard deviation differ from the previous cycle's by less than
+  ``threshold`` of the standard deviation (the fluctuation, not the mean load, sets the
+  scale).
 * :func:`estimate_lag` — the delay of ``b`` behind ``a`` by cross-correlation with
   parabolic sub-sample refinement, searched within +/- ``max_lag``.
 """
@@ -20,6 +22,7 @@ from scipy import signal
 ANTI_ALIAS_FRACTION = 0.8
 STEADY_CYCLES = 3
 STEADY_THRESHOLD = 2e-3
+CYCLE_POINTS = 256
 
 
 def uniform_grid(t0: float, t1: float, fs: float) -> np.ndarray:
@@ -37,9 +40,14 @@ def resample(t: np.ndarray, x: np.ndarray, grid: np.ndarray) -> np.ndarray:
     if cutoff < 0.5 * fs_old:
         sos = signal.butter(8, cutoff, fs=fs_old, output="sos")
         x = signal.sosfiltfilt(sos, x, axis=0)
+    return resample_at(t, x, grid)
+
+
+def resample_at(t: np.ndarray, x: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Linear interpolation of ``x`` (time along axis 0) at ``times``, no filtering."""
     if x.ndim == 1:
-        return np.interp(grid, t, x)
-    return np.stack([np.interp(grid, t, x[:, j]) for j in range(x.shape[1])], axis=1)
+        return np.interp(times, t, x)
+    return np.stack([np.interp(times, t, x[:, j]) for j in range(x.shape[1])], axis=1)
 
 
 def steady_start(t: np.ndarray, x: np.ndarray, cycle: float, threshold: float = STEADY_THRESHOLD,
@@ -51,17 +59,16 @@ def steady_start(t: np.ndarray, x: np.ndarray, cycle: float, threshold: float = 
     edges = np.arange(t[0], t[-1] + 1e-12, cycle)
     if edges.size < cycles + 2:
         return None
+    phase = np.arange(CYCLE_POINTS) / CYCLE_POINTS
     stats = []
-    for a, b in zip(edges[:-1], edges[1:]):
-        w = x[(t >= a) & (t < b)]
-        if w.shape[0] < 4:
-            return None
-        stats.append((np.sqrt(np.mean(w**2, axis=0)), np.mean(w, axis=0)))
+    for a in edges[:-1]:
+        w = resample_at(t, x, a + phase * cycle)  # the same phases in every cycle
+        stats.append((np.std(w, axis=0), np.mean(w, axis=0)))
     run = 0
     for k in range(1, len(stats)):
-        rms, mean = stats[k]
-        scale = np.maximum(rms, 1e-300)
-        change = np.maximum(np.abs(rms - stats[k - 1][0]), np.abs(mean - stats[k - 1][1])) / scale
+        std, mean = stats[k]
+        scale = np.maximum(std, 1e-300)
+        change = np.maximum(np.abs(std - stats[k - 1][0]), np.abs(mean - stats[k - 1][1])) / scale
         run = run + 1 if np.all(change < threshold) else 0
         if run >= cycles:
             return float(edges[k - cycles])

@@ -62,6 +62,28 @@ def _parser() -> argparse.ArgumentParser:
                                                    "BDF, LSODA")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_run)
+
+    s = sub.add_parser("crosscheck", help="run both solvers, compare them, write a report; exit 1 when a "
+                                          "tolerance is exceeded")
+    s.add_argument("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file")
+    s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
+    s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
+    s.add_argument("--duration", type=float, default=0.1, metavar="S", help="simulated time (default 0.1 s)")
+    s.add_argument("--dt-lumped", type=float, metavar="S", help="lumped RK4 step (default: derived)")
+    s.add_argument("--dt-mujoco", type=float, metavar="S", help="MuJoCo step (default: derived)")
+    s.add_argument("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table")
+    s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]")
+    s.add_argument("--baseline", type=Path, metavar="FILE", help="compare with a stored baseline (with --all: "
+                                                                 "the shipped baselines)", nargs="?",
+                   const="shipped")
+    s.add_argument("--update-baseline", action="store_true", help="rewrite the baseline instead of checking it")
+    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
+    s.set_defaults(func=cmd_crosscheck)
+
+    s = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a train")
+    _train_arg(s)
+    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)")
+    s.set_defaults(func=cmd_mjcf)
     return p
 
 
@@ -219,6 +241,40 @@ def cmd_run(args) -> int:
     for path in written:
         print(f"  wrote {path}")
     return 0
+
+
+
+
+def cmd_mjcf(args) -> int:
+    from mbd_models import build_mjcf
+
+    text = build_mjcf(_load(args))
+    if args.output is None:
+        sys.stdout.write(text)
+        return 0
+    _write_atomic(args.output, text)
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file, so nothing is left half-written."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
+
+
+def cmd_crosscheck(args) -> int:
+    from .crosscheck_cli import crosscheck_all, crosscheck_one
+
+    if args.all == (args.train is not None):
+        raise GearcheckError("give a TRAIN or --all, not both")
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
+    if args.all:
+        return crosscheck_all(args)
+    return crosscheck_one(args, _load(args), args.out)
 
 
 if __name__ == "__main__":  # pragma: no cover

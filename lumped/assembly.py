@@ -11,12 +11,28 @@ rotations are absolute angles in rad.
 Every elastic connection is a row: a scalar deflection delta = a . q with stiffness
 k (constant, or k(t) for a mesh) and damping c, so
 
-    M q'' + (C + Omega G) q' + (K_b + K_m(t) - Omega^2 K_Omega) q = F(t),
+    M q'' + (C + Omega G) q' + (K_b + K_m(t) + K_frame) q = F(t),
     K_b = sum k a a^T,  C = sum c a a^T,  K_m(t) = sum_meshes k(t) a a^T,
 
-with G and K_Omega the Coriolis and centripetal terms of each member's translations
-(Lin & Parker 1999, Eq. 4).  A new member type or DOF (axial, eccentric shaft) adds
-entries to the DOF map and new rows; nothing here is specific to a stage layout.
+with G the Coriolis terms of each member's translations and K_frame the stiffness-like
+terms of the rotating frame:
+
+* centripetal softening -m Omega^2 on every translation (Lin & Parker 1999, Eq. 4);
+* the geometric stiffness of the planets' centripetal preload, +m_p Omega^2 r_c^2 on the
+  carrier rotation.  Lin & Parker's model omits it: the bearing carries the preload
+  m_p Omega^2 r_c, and when the carrier turns by theta_c its pin moves by -r_c theta_c^2/2
+  radially (second order), which stores m_p Omega^2 r_c^2 theta_c^2/2.  Without it a rigid
+  rotation of the whole train is not free of the centripetal softening of the planets'
+  tangential motion, and a wound-up carrier feels a spurious torque
+  m_p Omega^2 r_c^2 theta_c per planet (found by the MuJoCo twin, which turns the pin
+  exactly);
+* circulatory terms of the supports' damping: a support damps the member's velocity
+  relative to the housing, q' + Omega k x q in rotating coordinates, so -c Omega k x q
+  appears beside -c q' (whirl damping), and a rotating member with torsional damping to the
+  housing feels the drag torque -c w_nominal (in F_static).
+
+A new member type or DOF (axial, eccentric shaft) adds entries to the DOF map and new rows;
+nothing here is specific to a stage layout.
 """
 
 from __future__ import annotations
@@ -81,11 +97,11 @@ class LumpedModel:
     dofs: DofMap
     M: np.ndarray
     G: np.ndarray  # gyroscopic matrix, already multiplied by each frame's Omega
-    K_omega: np.ndarray  # centripetal softening, Omega^2 m on translations
+    K_frame: np.ndarray  # rotating-frame stiffness terms (centripetal, geometric, circulatory)
     rows: list[Row]  # constant rows (bearings, supports, couplings, shaft)
     mesh_rows: np.ndarray  # (n_mesh, n) line-of-action rows
     mesh_damping: np.ndarray  # (n_mesh,)
-    F_static: np.ndarray  # constant forces (planet centripetal load)
+    F_static: np.ndarray  # constant forces (planet centripetal load, drag of rotating members)
     b_input: np.ndarray  # generalized force of a unit torque on the input
     b_output: np.ndarray
     excitation: Excitation
@@ -119,7 +135,7 @@ class LumpedModel:
         from dataclasses import replace
 
         zero = np.zeros_like(self.M)
-        return replace(self, G=zero, K_omega=zero, F_static=np.zeros(self.n), rotating_frame_terms=False)
+        return replace(self, G=zero, K_frame=zero, F_static=np.zeros(self.n), rotating_frame_terms=False)
 
 
 def _sum_outer(rows, attr, n):
@@ -140,20 +156,28 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     n = len(dofs)
     M = np.zeros((n, n))
     G = np.zeros((n, n))
-    K_omega = np.zeros((n, n))
+    K_frame = np.zeros((n, n))
     F = np.zeros(n)
     for mid, member in spec.members.items():
         u, v = (PLANET_DOFS if member.is_planet else CENTRAL_DOFS)[:2]
         iu, iv, ith = dofs(mid, u), dofs(mid, v), dofs(mid, "theta")
         M[iu, iu] = M[iv, iv] = member.mass
         M[ith, ith] = member.inertia
-        omega = kin.speeds[f"{member.stage}.carrier"]
+        carrier = f"{member.stage}.carrier"
+        omega = kin.speeds[carrier]
         # Coriolis 2 m Omega k x q' and centripetal -m Omega^2 q of the translations (rotating frame)
         G[iu, iv] -= 2.0 * member.mass * omega
         G[iv, iu] += 2.0 * member.mass * omega
-        K_omega[iu, iu] = K_omega[iv, iv] = member.mass * omega**2
+        K_frame[iu, iu] = K_frame[iv, iv] = -member.mass * omega**2
         if member.is_planet:
             F[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
+            ic = dofs(carrier, "theta")
+            K_frame[ic, ic] += member.mass * omega**2 * member.radius**2  # geometric stiffness of that load
+        else:
+            c = member.support.radial_damping  # damping relative to the housing: -c (q' + Omega k x q)
+            K_frame[iu, iv] -= c * omega
+            K_frame[iv, iu] += c * omega
+            F[ith] -= member.support.torsional_damping * kin.speeds[mid]  # drag of a turning member
 
     rows = _support_rows(spec, dofs) + _bearing_rows(spec, dofs) + _coupling_rows(spec, dofs, kin)
     if spec.operating.input_shaft_stiffness is not None:
@@ -170,7 +194,7 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     b_in[dofs(spec.input, "theta")] = 1.0
     b_out = np.zeros(n)
     b_out[dofs(spec.output, "theta")] = 1.0
-    model = LumpedModel(spec, kin, dofs, M, G, K_omega, rows, mesh_rows, damping, F, b_in, b_out, excitation)
+    model = LumpedModel(spec, kin, dofs, M, G, K_frame, rows, mesh_rows, damping, F, b_in, b_out, excitation)
     return model if rotating_frame_terms else model.without_rotating_frame_terms()
 
 

@@ -18,6 +18,28 @@ from .kinematics import Kinematics
 from .mesh_stiffness import stiffness_model
 
 
+STAGE_OFFSETS = (1e-9, 0.5, 1.0 - 1e-9)
+"""Where a fixed-step solver samples the drive within a step [t, t + h]: just after t, at the
+midpoint, just before t + h.  A stiffness switch that falls on a step boundary is then seen
+on the same side by every mesh, whatever the round-off in its phase (planets with equal
+phases stay identical, so the symmetry that mesh phasing relies on survives)."""
+
+
+def commensurate_step(h_max: float, mesh_frequencies, points_per_cycle: int) -> float:
+    """The largest step <= h_max that divides the slowest mesh period into whole steps, with at
+    least ``points_per_cycle`` steps per period of the fastest mesh.  A rectangular stiffness
+    then switches at the same point of the step in every cycle and the discrete steady
+    response is periodic, like the physical one (an incommensurate step dithers the switching
+    instants from cycle to cycle)."""
+    f = np.asarray(mesh_frequencies, dtype=float)
+    f = f[f > 0]
+    if f.size == 0:
+        return h_max
+    h = min(h_max, 1.0 / (points_per_cycle * f.max()))
+    period = 1.0 / f.min()
+    return period / math.ceil(period / h - 1e-9)
+
+
 def smooth_ramp(t, duration: float):
     """0 -> 1 over ``duration`` with zero slope at both ends (1 when duration is 0); array-valued."""
     t = np.asarray(t, dtype=float)

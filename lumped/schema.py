@@ -413,6 +413,20 @@ COUPLING = Table(
     "a coupling between members of different stages ([[couplings]])",
 )
 
+MEASUREMENT = Table(
+    {
+        "quantity": Text("a cross-check quantity name (`stage1.ring.ay.world`, see README)"),
+        "metric": Text("which statistic of the steady window", REQUIRED, ("peak", "rms", "peak_to_peak")),
+        "value": Number("the measured value, in the quantity's SI unit"),
+        "speed_rpm": Positive("input speed the value was measured at (attached only at that speed)", "rpm", None),
+        "source": Text("where the value comes from", ""),
+    },
+    "a measured reference value ([[measurements]])",
+)
+
+MEASUREMENTS_FILE = Table({"measurements": TableList(MEASUREMENT, "measured values", min_length=1)},
+                          "a measurements file")
+
 TRAIN_TABLE = Table(
     {
         "name": Text("train name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
@@ -432,6 +446,7 @@ TRAIN = Table(
         "operating": OPERATING,
         "stages": TableList(STAGE, "planetary stages", min_length=1),
         "couplings": TableList(COUPLING, "interstage couplings", default=()),
+        "measurements": TableList(MEASUREMENT, "measured reference values shown beside both solvers", default=()),
     },
     "a gear train file",
 )
@@ -440,6 +455,11 @@ TRAIN = Table(
 def parse(document: dict, source: str) -> dict:
     """Validate a TOML document against :data:`TRAIN`; return SI dictionaries."""
     return TRAIN.parse(document, "", Context(source))
+
+
+def parse_measurements(document: dict, source: str) -> list[dict]:
+    """Validate a measurements file (a ``[[measurements]]`` array) against :data:`MEASUREMENTS_FILE`."""
+    return MEASUREMENTS_FILE.parse(document, "", Context(source))["measurements"]
 
 
 def markdown_reference() -> str:

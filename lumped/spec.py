@@ -141,6 +141,7 @@ class TrainSpec:
     couplings: tuple[Coupling, ...]
     operating: Operating
     text_hash: str = ""
+    measurements: tuple[dict, ...] = ()  # measured reference values, SI (see schema.MEASUREMENT)
 
     def member(self, member_id: str) -> Member:
         return self.members[member_id]
@@ -220,7 +221,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         name=train["name"], description=train["description"], source=train["source"], path=source,
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
         stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
-        text_hash=text_hash,
+        text_hash=text_hash, measurements=tuple(data["measurements"]),
     )
 
 

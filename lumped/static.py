@@ -1,6 +1,6 @@
 """Static deflection and load sharing under the mean operating load.
 
-(K_b + K_m,mean - Omega^2 K_Omega) q = F_static + b_in T_in + b_out T_out + sum_m a_m k_m b_m,
+(K_b + K_m,mean + K_frame) q = F_static + b_in T_in + b_out T_out + sum_m a_m k_m b_m,
 
 where the last term shifts every mesh with backlash to its loaded flank (dead zone
 f(delta) = delta - b for delta > b).  Meshes found out of contact are dropped and the
@@ -39,7 +39,7 @@ class StaticResult:
 
 
 def stiffness_with_rotation(model, k_mesh: np.ndarray) -> np.ndarray:
-    return model.K_b + model.K_mesh(k_mesh) - model.K_omega
+    return model.K_b + model.K_mesh(k_mesh) + model.K_frame
 
 
 def mean_load(model, load_scale: float = 1.0) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 Equation of motion (rotating frame, see :mod:`lumped.assembly`):
 
-    M q'' = F_static + b_in T_in(t) + b_out T_out(t) - (C_b + G) q' - (K_b - K_Omega) q
+    M q'' = F_static + b_in T_in(t) + b_out T_out(t) - (C_b + G) q' - (K_b + K_frame) q
             - sum_m a_m [k_m(t) f(a_m.q - e_m(t)) + c_m (a_m.q' - e_m'(t))],
 
 f the backlash dead zone.  The start is the static deflection under the mean load
@@ -11,7 +11,10 @@ f the backlash dead zone.  The start is the static deflection under the mean loa
 Time step: RK4 is stable for omega_max h < 2.83 on undamped modes; the solver refuses a
 step above ``STABILITY_MARGIN`` times that limit and by default takes
 ``POINTS_PER_PERIOD`` steps per period of the highest natural frequency (with the mesh
-stiffness at its cycle maximum) and ``POINTS_PER_MESH_CYCLE`` per mesh cycle.
+stiffness at its cycle maximum) and ``POINTS_PER_MESH_CYCLE`` per mesh cycle, made a
+whole fraction of the slowest mesh period (:func:`lumped.excitation.commensurate_step`).
+The drive is evaluated at t + h (eps, 1/2, 1 - eps) for RK4's stages
+(:data:`lumped.excitation.STAGE_OFFSETS`).
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
 from .errors import DivergenceError, SolverError
+from .excitation import STAGE_OFFSETS, commensurate_step
 from .results import TimeResult
 from .static import deadzone, mean_load, static_solution
 
@@ -38,8 +42,8 @@ def max_angular_frequency(model) -> float:
     """Highest natural angular frequency with every mesh at its largest stiffness over a cycle."""
     xi = np.linspace(0.0, 1.0, 2001)
     k_max = np.array([np.max(m(xi)) for m in model.excitation.models])
-    K = model.K_b + model.K_mesh(k_max) - model.K_omega
-    w2 = sla.eigh(K, model.M, eigvals_only=True)
+    K = model.K_b + model.K_mesh(k_max) + model.K_frame
+    w2 = sla.eigh(0.5 * (K + K.T), model.M, eigvals_only=True)
     return float(np.sqrt(max(w2.max(), 0.0)))
 
 
@@ -48,12 +52,12 @@ def stable_step(model) -> float:
 
 
 def default_step(model) -> float:
+    """``POINTS_PER_PERIOD`` steps per period of the highest natural frequency and at least
+    ``POINTS_PER_MESH_CYCLE`` per mesh cycle, rounded down to a whole fraction of the slowest
+    mesh period: the rectangular stiffness then switches at the same sub-step position in
+    every cycle, so the discrete steady response is periodic like the physical one."""
     f_max = max_angular_frequency(model) / (2 * math.pi)
-    f_mesh = float(np.max(model.excitation.frequency)) if len(model.excitation.frequency) else 0.0
-    h = 1.0 / (POINTS_PER_PERIOD * f_max)
-    if f_mesh > 0:
-        h = min(h, 1.0 / (POINTS_PER_MESH_CYCLE * f_mesh))
-    return h
+    return commensurate_step(1.0 / (POINTS_PER_PERIOD * f_max), model.excitation.frequency, POINTS_PER_MESH_CYCLE)
 
 
 def check_step(model, dt: float) -> None:
@@ -76,7 +80,7 @@ class _System:
         self.exc = model.excitation
         self.Minv = 1.0 / np.diag(model.M)
         self.D = model.C_b + model.G
-        self.Kc = model.K_b - model.K_omega
+        self.Kc = model.K_b + model.K_frame
         self.A = model.mesh_rows
         self.c = model.mesh_damping
         self.b = 0.5 * self.exc.backlash
@@ -110,9 +114,9 @@ def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
 
 
 def mechanical_energy(model, q, v) -> np.ndarray:
-    """1/2 v'Mv + 1/2 q'(K_mean - Omega^2 K_Omega)q - q'F: conserved for constant stiffness, no damping
+    """1/2 v'Mv + 1/2 q'(K_mean + K_frame)q - q'F: conserved for constant stiffness, no damping
     and constant load (the Coriolis forces do no work).  q, v with time along axis 0."""
-    K = model.K_mean - model.K_omega
+    K = model.K_mean + model.K_frame
     F = mean_load(model)
     return 0.5 * np.einsum("ti,ij,tj->t", v, model.M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, K, q) - q @ F
 
@@ -132,8 +136,8 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
     if dt is None:
         dt = default_step(model)
     check_step(model, dt)
-    n_steps = max(1, math.ceil(duration / dt - 1e-9))
     every = 1 if output_dt is None else max(1, round(output_dt / dt))
+    n_steps = every * max(1, math.ceil(duration / (dt * every) - 1e-9))  # ends on an output sample
     q0, v0 = initial_state(model) if y0 is None else y0
     sys = _System(model)
     started = clock.perf_counter()
@@ -159,20 +163,23 @@ def _rk4(sys, q, v, h, n_steps, every, progress):
     v_out = np.empty((n_out, q.size))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     acc = sys.acceleration
+    stages = np.array(STAGE_OFFSETS)
     j = 1
     for start in range(0, n_steps, CHUNK):
         stop = min(start + CHUNK, n_steps)
-        times = 0.5 * h * np.arange(2 * start, 2 * stop + 1)
+        times = (np.arange(start, stop)[:, None] + stages[None, :]) * h
         k, e, de, tin, tout = sys.drive(times)
         for i in range(stop - start):
-            a = 2 * i
-            k1v = acc(q, v, k[a], e[a], de[a], tin[a], tout[a])
+            d1 = (k[i, 0], e[i, 0], de[i, 0], tin[i, 0], tout[i, 0])
+            d2 = (k[i, 1], e[i, 1], de[i, 1], tin[i, 1], tout[i, 1])
+            d4 = (k[i, 2], e[i, 2], de[i, 2], tin[i, 2], tout[i, 2])
+            k1v = acc(q, v, *d1)
             q2, v2 = q + 0.5 * h * v, v + 0.5 * h * k1v
-            k2v = acc(q2, v2, k[a + 1], e[a + 1], de[a + 1], tin[a + 1], tout[a + 1])
+            k2v = acc(q2, v2, *d2)
             q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * k2v
-            k3v = acc(q3, v3, k[a + 1], e[a + 1], de[a + 1], tin[a + 1], tout[a + 1])
+            k3v = acc(q3, v3, *d2)
             q4, v4 = q + h * v3, v + h * k3v
-            k4v = acc(q4, v4, k[a + 2], e[a + 2], de[a + 2], tin[a + 2], tout[a + 2])
+            k4v = acc(q4, v4, *d4)
             q = q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4)
             v = v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
             step = start + i + 1
@@ -202,7 +209,8 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
 
 
 def _result(model, sys, t, q, v, settle, info) -> TimeResult:
-    k, e, de, tin, tout = sys.drive(t)
+    # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
+    k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
     qdd = np.array([sys.acceleration(q[i], v[i], k[i], e[i], de[i], tin[i], tout[i]) for i in range(t.size)])
     delta, force = sys.mesh_force(q, v, k, e, de)
     spec, dofs = model.spec, model.dofs
@@ -217,7 +225,9 @@ def _result(model, sys, t, q, v, settle, info) -> TimeResult:
         acc[:, j, 0] = qdd[:, iu] - 2 * omega * v[:, iv] - omega**2 * (q[:, iu] + member.radius)
         acc[:, j, 1] = qdd[:, iv] + 2 * omega * v[:, iu] - omega**2 * q[:, iv]
         acc[:, j, 2] = qdd[:, ith]
-        angle[:, j] = model.kin.speeds[f"{member.stage}.carrier"] * t + member.angle
+        # the carrier axes turn with the carrier's actual angle: nominal plus its vibration (wind-up)
+        carrier = f"{member.stage}.carrier"
+        angle[:, j] = model.kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
     bearings = [r for r in model.rows if r.kind == "bearing"]
     bearing_force = np.array([[r.stiffness * (r.a @ q[i]) + r.damping * (r.a @ v[i]) for r in bearings]
                               for i in range(t.size)]) if bearings else None

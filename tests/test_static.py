@@ -23,29 +23,29 @@ def test_equal_load_sharing_and_torque_balance(preset):
     assert input_torque_through_meshes(spec, static) == pytest.approx(expected, rel=1e-12)
 
 
-def test_rotating_frame_torque_defect_of_the_linear_model(preset):
-    """Lin & Parker's rotating-frame terms are not invariant under a rigid rotation of the carrier:
-    a planet displaced tangentially by eta (here by the static twist of the input shaft) feels the
-    centripetal softening m Omega^2 eta along its tangent, a torque m Omega^2 r_c eta on the carrier
-    that the real, rotating bearing (whose preload turns with the pin) cancels.  The linear model
-    therefore transmits T_out/ratio plus sum m_p Omega^2 r_c eta_p / ratio; this test pins that defect
-    exactly, so the cross-check with MuJoCo (which has no such defect) can be read."""
+def test_centripetal_loads_in_the_torque_balance(preset):
+    """At speed, the only torque the centripetal loads add is that of a planet sitting off its pin:
+    the bearing carries m Omega^2 r_p at the pin, so a planet displaced tangentially by eta_b
+    relative to its pin loads the carrier with m Omega^2 r_c eta_b.  A wound-up carrier
+    (eta = r_c theta_c for every planet) must add nothing: that is the geometric stiffness of the
+    centripetal preload which Lin & Parker's rotating-frame model lacks (without it the linear
+    model transmits an extra m Omega^2 r_c^2 theta_c per planet)."""
     spec = load_train(preset)
     model = build_model(spec)
     static = static_solution(model)
     np.testing.assert_allclose(static.load_sharing(spec)["sharing"], 1.0, atol=1e-9)
-    defect = 0.0
+    off_pin = 0.0
     for stage in spec.stages:
         omega = model.kin.speeds[stage.carrier]
+        theta_c = static.q[model.dofs(stage.carrier, "theta")]
         for pid in stage.planets:
             p = spec.members[pid]
-            defect += p.mass * omega**2 * p.radius * static.q[model.dofs(pid, "tangential")]
-    # virtual work along the rigid motion (d theta_c = d theta_in / ratio, d eta = r_c d theta_c):
-    # T_in = -(T_out + defect) / ratio, T_out < 0 opposing the carrier
-    ratio = model.kin.ratio
-    expected = -(model.kin.output_torque + defect) / ratio
-    assert input_torque_through_meshes(spec, static) == pytest.approx(expected, rel=1e-9)
-    assert abs(defect / model.kin.output_torque) > 1e-6  # it is there, and small
+            eta_b = static.q[model.dofs(pid, "tangential")] - p.radius * theta_c
+            off_pin += p.mass * omega**2 * p.radius * eta_b
+    # virtual work along the rigid motion (d theta_c = d theta_in / ratio): T_in = -(T_out + off_pin) / ratio
+    expected = -(model.kin.output_torque + off_pin) / model.kin.ratio
+    assert input_torque_through_meshes(spec, static) == pytest.approx(expected, rel=1e-10)
+    assert abs(off_pin / model.kin.output_torque) > 1e-7  # the effect is there, and small
 
 
 def test_backlash_shifts_deflection_not_force():

@@ -1,0 +1,124 @@
+"""Benchmark of the MuJoCo runner (not a test).
+
+1. Per-step cost of ``simulate_mujoco`` against a bare ``mj_step`` loop on the same model
+   (same RK4 integrator, same sensors, same step): the runner's extra Python work per step.
+   Target: ratio <= 1.3.
+2. Steps per second of the runner for 1, 2 and 3 planetary stages (demo-3p's stage chained,
+   carrier k -> sun k+1 by a spline coupling).
+3. With ``--convergence``: normalised RMS differences between MuJoCo and the lumped RK4 run of
+   demo-3p as the step shrinks.
+
+Run:  python bench/bench_runner.py [--steps N] [--convergence]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import mujoco
+import numpy as np
+
+from lumped.loader import load_text, load_train, preset_text
+from mbd_models import compile_train, simulate_mujoco
+
+
+def chained_train(n_stages: int):
+    """n copies of demo-3p's stage in series, carrier k -> sun k+1 by a spline coupling."""
+    text = preset_text("demo-3p")
+    head, stage = text.split("[[stages]]", 1)
+    head = head.replace('output = "stage1.carrier"', f'output = "stage{n_stages}.carrier"')
+    head = head.replace('held = ["stage1.ring"]',
+                        "held = [" + ", ".join(f'"stage{i}.ring"' for i in range(1, n_stages + 1)) + "]")
+    parts = [head]
+    for i in range(1, n_stages + 1):
+        parts.append("[[stages]]" + stage.replace('name = "stage1"', f'name = "stage{i}"'))
+    for i in range(1, n_stages):
+        parts.append(f'\n[[couplings]]\nname = "spline{i}"\nfrom = "stage{i}.carrier"\nto = "stage{i + 1}.sun"\n'
+                     "torsional_stiffness = 2.0e6\ntorsional_damping = 5.0\n")
+    return load_text("\n".join(parts), f"chain-{n_stages}")
+
+
+def bare_step_cost(mb, n_steps: int, dt: float) -> float:
+    m = mb.model
+    m.opt.timestep = dt
+    m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    d = mujoco.MjData(m)
+    for mid, speed in mb.kin.speeds.items():
+        d.qvel[mb.dadr[mid][2]] = speed
+    mujoco.mj_forward(m, d)
+    started = time.perf_counter()
+    for _ in range(n_steps):
+        mujoco.mj_step(m, d)
+    return (time.perf_counter() - started) / n_steps
+
+
+def runner_step_cost(spec, mb, n_steps: int, dt: float) -> float:
+    res = simulate_mujoco(spec, n_steps * dt, dt=dt, mb=mb)
+    return res.info["wall_time_s"] / res.info["steps"]
+
+
+def cost_table(n_steps: int, repeats: int = 3):
+    print(f"runner vs bare mj_step (RK4, same model, same step), best of {repeats}, {n_steps} steps")
+    print(f"{'train':<10} {'bodies':>6} {'tendons':>7} {'dt [s]':>10} {'bare [us]':>10} {'runner [us]':>11} "
+          f"{'ratio':>6} {'steps/s':>9} {'sim s per wall s':>16}")
+    rows = []
+    for n_stages in (1, 2, 3):
+        spec = load_train("demo-3p") if n_stages == 1 else chained_train(n_stages)
+        mb = compile_train(spec)
+        dt = mb.model.opt.timestep  # the default step written into the MJCF
+        bare = min(bare_step_cost(mb, n_steps, dt) for _ in range(repeats))
+        run = min(runner_step_cost(spec, mb, n_steps, dt) for _ in range(repeats))
+        rows.append((n_stages, bare, run))
+        label = f"{n_stages} stage" + ("s" if n_stages > 1 else "")
+        print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>10.2f} "
+              f"{run * 1e6:>11.2f} {run / bare:>6.3f} {1 / run:>9.0f} {dt / run:>16.4f}")
+    return rows
+
+
+def convergence_table(duration: float = 0.05, settle: float = 0.025):
+    from lumped.assembly import build_model
+    from lumped.time_solver import simulate
+
+    spec = load_train("demo-3p")
+    model = build_model(spec)
+    mb = compile_train(spec)
+    h0 = mb.model.opt.timestep
+
+    def nrms(a, b):
+        return float(np.sqrt(np.mean((a - b) ** 2)) / np.sqrt(np.mean(b**2)))
+
+    print(f"\nMuJoCo vs lumped RK4, demo-3p, steady window t >= {settle} s of {duration} s "
+          "(normalised RMS of the difference)")
+    print(f"{'dt [s]':>11} {'mesh force':>11} {'mesh dyn.':>10} {'ring world':>11} {'ring carrier':>13} "
+          f"{'ring alpha':>11}")
+    for f in (1, 2, 4):
+        h = h0 / f
+        mj = simulate_mujoco(spec, duration, dt=h, settle=settle, mb=mb)
+        lp = simulate(model, duration, dt=h, settle=settle)
+        w = mj.steady
+        n = len(spec.meshes)
+        force = max(nrms(mj.mesh_force[w, i], lp.mesh_force[w, i]) for i in range(n))
+        dyn = max(nrms(mj.mesh_force[w, i] - lp.static_mesh_force[i], lp.mesh_force[w, i] - lp.static_mesh_force[i])
+                  for i in range(n))
+        aw, bw = mj.acceleration("stage1.ring", "world"), lp.acceleration("stage1.ring", "world")
+        ac, bc = mj.acceleration("stage1.ring", "carrier"), lp.acceleration("stage1.ring", "carrier")
+        world = max(nrms(aw[c].to_numpy()[w], bw[c].to_numpy()[w]) for c in ("ax", "ay"))
+        carrier = max(nrms(ac[c].to_numpy()[w], bc[c].to_numpy()[w]) for c in ("ax", "ay"))
+        alpha = nrms(aw.alpha.to_numpy()[w], bw.alpha.to_numpy()[w])
+        print(f"{h:>11.4e} {force:>11.3e} {dyn:>10.3e} {world:>11.3e} {carrier:>13.3e} {alpha:>11.3e}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=20000)
+    parser.add_argument("--convergence", action="store_true")
+    args = parser.parse_args()
+    print(f"mujoco {mujoco.__version__}")
+    cost_table(args.steps)
+    if args.convergence:
+        convergence_table()
+
+
+if __name__ == "__main__":
+    main()

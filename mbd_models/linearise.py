@@ -1,0 +1,140 @@
+"""Linearisation of the MuJoCo model and its natural frequencies.
+
+M comes from ``mujoco.mj_fullM`` and K from central differences of the generalized
+spring forces MuJoCo computes (``qfrc_passive`` + ``qfrc_actuator``: the input shaft's
+position servo is a spring too) at the nominal configuration (every joint at its
+reference, carrier angle 0), at rest, with every mesh tendon at its mean stiffness.
+As in the lumped modal analysis (Lin & Parker 1999, section 3) no rotation terms
+enter: the model is linearised at qvel = 0.
+
+Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions
+phi_S' M_SS phi_S / phi' M phi of the central members' slides (translation), the central
+members' hinges (rotation) and the planets' joints; a fraction below
+:data:`ENERGY_TOLERANCE` counts as zero.  Zero amplitude of a group is a physical
+statement (the sun, ring and carrier do not translate / do not turn), so the types do
+not depend on MuJoCo's choice of coordinates (planet slides relative to the carrier).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import mujoco
+
+from lumped.modal import ModalResult, generalized_modes, multiplicities
+
+from .mjcf_builder import MbdModel, compile_train
+
+ENERGY_TOLERANCE = 1e-8
+FD_STEP = 1e-6  # m or rad; the spring forces are linear in qpos, so the step only sets rounding
+
+
+def _set_rest(mb: MbdModel, data: mujoco.MjData, qpos: np.ndarray) -> None:
+    data.qpos[:] = qpos
+    data.qvel[:] = 0.0
+    data.ctrl[:] = 0.0
+    if "input_shaft" in mb.actuator:
+        data.ctrl[mb.actuator["input_shaft"]] = 0.0  # reference angle at the nominal configuration
+
+
+def mass_matrix(mb: MbdModel, qpos: np.ndarray | None = None) -> np.ndarray:
+    m = mb.model
+    d = mujoco.MjData(m)
+    _set_rest(mb, d, m.qpos0 if qpos is None else qpos)
+    mujoco.mj_forward(m, d)
+    M = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, M)
+    return M
+
+
+def stiffness_matrix(mb: MbdModel, tendon_stiffness: np.ndarray | None = None,
+                     qpos: np.ndarray | None = None) -> np.ndarray:
+    """-d(qfrc_passive + qfrc_actuator)/dqpos by central differences, at rest.
+
+    tendon_stiffness: optional stiffness of the mesh tendons (one per mesh) used
+    instead of the model's own values (which are restored afterwards).  A backlash
+    dead band is closed for the linearisation (the teeth in contact on their loaded
+    flank), so a mesh contributes its stiffness k and not the 0 of the band's inside.
+    """
+    m = mb.model
+    saved = m.tendon_stiffness.copy()
+    saved_length = m.tendon_lengthspring.copy()
+    try:
+        m.tendon_lengthspring[mb.mesh_tendon] = 0.0
+        if tendon_stiffness is not None:
+            m.tendon_stiffness[mb.mesh_tendon] = tendon_stiffness
+        d = mujoco.MjData(m)
+        q0 = (m.qpos0 if qpos is None else qpos).copy()
+        K = np.zeros((m.nv, m.nv))
+        for j in range(m.nv):  # hinge and slide joints only: qpos and dof addresses coincide
+            forces = []
+            for sign in (1.0, -1.0):
+                q = q0.copy()
+                q[j] += sign * FD_STEP
+                _set_rest(mb, d, q)
+                mujoco.mj_forward(m, d)
+                forces.append(d.qfrc_passive + d.qfrc_actuator)
+            K[:, j] = -(forces[0] - forces[1]) / (2.0 * FD_STEP)
+    finally:
+        m.tendon_stiffness[:] = saved
+        m.tendon_lengthspring[:] = saved_length
+    return 0.5 * (K + K.T)
+
+
+def max_angular_frequency(mb: MbdModel) -> float:
+    """Highest natural angular frequency of the MuJoCo model with every mesh at its cycle-maximum stiffness."""
+    xi = np.linspace(0.0, 1.0, 2001)
+    k_max = np.array([np.max(model(xi)) for model in mb.excitation.models])
+    w2 = np.linalg.eigvalsh(_reduce(stiffness_matrix(mb, k_max), mass_matrix(mb)))
+    return float(np.sqrt(max(w2.max(), 0.0)))
+
+
+def _reduce(K, M):
+    L = np.linalg.cholesky(M)
+    Li = np.linalg.inv(L)
+    A = Li @ K @ Li.T
+    return 0.5 * (A + A.T)
+
+
+def joint_labels(mb: MbdModel) -> list[str]:
+    m = mb.model
+    return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)]
+
+
+def classify(mb: MbdModel, M: np.ndarray, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
+    """Lin & Parker mode types from kinetic-energy fractions over MuJoCo's joints."""
+    trans, rot, planet = [], [], []
+    for mid, member in mb.spec.members.items():
+        x, y, rz = mb.dadr[mid]
+        if member.is_planet:
+            planet += [x, y, rz]
+        else:
+            trans += [x, y]
+            rot.append(rz)
+    types = []
+    for j, f in enumerate(frequencies):
+        if f == 0.0:
+            types.append("rigid")
+            continue
+        phi = shapes[:, j]
+        total = phi @ M @ phi
+        e_trans = phi[trans] @ M[np.ix_(trans, trans)] @ phi[trans] / total
+        e_rot = phi[rot] @ M[np.ix_(rot, rot)] @ phi[rot] / total
+        if e_trans < ENERGY_TOLERANCE and e_rot < ENERGY_TOLERANCE:
+            types.append("planet")
+        elif e_trans < ENERGY_TOLERANCE:
+            types.append("rotational")
+        elif e_rot < ENERGY_TOLERANCE:
+            types.append("translational")
+        else:
+            types.append("mixed")
+    return types
+
+
+def mujoco_modes(spec, mb: MbdModel | None = None) -> ModalResult:
+    """Natural frequencies and mode types of the MuJoCo model at mean mesh stiffness (solver="mujoco")."""
+    mb = compile_train(spec) if mb is None else mb
+    M = mass_matrix(mb)
+    K = stiffness_matrix(mb, mb.excitation.mean_stiffness)
+    frequencies, shapes = generalized_modes(K, M)
+    return ModalResult(spec.name, frequencies, shapes, classify(mb, M, shapes, frequencies),
+                       multiplicities(frequencies), joint_labels(mb), solver="mujoco")

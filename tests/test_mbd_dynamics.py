@@ -1,0 +1,260 @@
+"""The driven MuJoCo run: energy, centripetal load, dead band, agreement with the lumped solver, step checks."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import mujoco
+import numpy as np
+import pytest
+
+from lumped.assembly import build_model
+from lumped.errors import DivergenceError, SolverError
+from lumped.loader import load_text, load_train, preset_text
+from lumped.static import static_solution
+from lumped.time_solver import simulate
+from mbd_models import compile_train, simulate_mujoco, static_state
+from mbd_models.linearise import max_angular_frequency
+from mbd_models.runner import RK4_LIMIT, default_step
+
+
+def variant(pairs, name="variant"):
+    text = preset_text("demo-3p")
+    for old, new in pairs:
+        assert re.search(old, text, flags=re.M), old
+        text = re.sub(old, new, text, flags=re.M)
+    return load_text(text, name)
+
+
+UNDAMPED = [(r"damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.0 }"),
+            (r"radial_damping = [0-9.]+", "radial_damping = 0.0"),
+            (r"torsional_damping = [0-9.]+", "torsional_damping = 0.0")]
+CONSTANT = [(r'model = "rectangular"', 'model = "constant"')]
+FREE_INPUT = [(r"^input_shaft_(stiffness|damping).*$", "")]
+
+
+def nrms(a, b):
+    """RMS of the difference over the RMS of the reference."""
+    return float(np.sqrt(np.mean((a - b) ** 2)) / np.sqrt(np.mean(b**2)))
+
+
+# ---------------------------------------------------------------------------------------------- statics
+
+
+def test_static_state_matches_lumped_statics():
+    """MuJoCo's own steady rotating equilibrium: the load shared equally and the lumped static force.
+
+    The two differ by 3.4e-5 relative at 1500 rpm: the lumped model keeps the planets'
+    centripetal preload m r Omega^2 fixed in direction while the carrier winds up by
+    theta_c = -4.1 mrad under load (no geometric stiffness of the preload), MuJoCo turns
+    it with the planet.  At 0.001 rad/s input speed they agree to 1e-10.
+    """
+    spec = load_train("demo-3p")
+    mb = compile_train(spec)
+    st = static_state(mb)
+    ref = static_solution(build_model(spec)).mesh_force
+    assert np.all(st.mesh_deflection > 0)  # compressed under the nominal load
+    np.testing.assert_allclose(st.mesh_force, ref, rtol=1e-4)
+    slow = spec.with_operating(input_speed=1e-3)
+    np.testing.assert_allclose(static_state(compile_train(slow)).mesh_force,
+                               static_solution(build_model(slow)).mesh_force, rtol=1e-10)
+
+
+# ---------------------------------------------------------------------------------------------- energy
+
+
+def test_energy_conserved_free_spinning_undamped():
+    """Constant stiffness, no damping, no input shaft, no load: nothing does work on the train.
+
+    The train spins freely at its nominal speeds with a vibration added (0.01 m/s on every
+    planet).  MuJoCo's own energy (mjENBL_ENERGY) may only fall, by RK4's numerical
+    dissipation: per step a mode of frequency omega keeps 1 - (omega h)^6/72 of its energy,
+    so over N steps the loss is at most E_vib (1 - (1 - (omega_max h)^6/72)^N) (6.8 % here);
+    it must also fall as h^5 (halving the step divides it by about 32).  Energy may never rise
+    above its start beyond rounding (1e-12 of the total).
+    """
+    spec = variant(UNDAMPED + CONSTANT + FREE_INPUT + [(r"^output_torque = .*$", "output_torque = 0.0")],
+                   "energy-variant")
+    mb = compile_train(spec)
+    st = static_state(mb)
+    qvel = st.qvel.copy()
+    for mid, member in spec.members.items():
+        if member.is_planet:
+            dr, dt_, _ = mb.dadr[mid]
+            qvel[dr] += 0.01
+            qvel[dt_] -= 0.01
+    d = mujoco.MjData(mb.model)
+    d.qpos[:] = st.qpos
+    mujoco.mj_forward(mb.model, d)
+    M = np.zeros((mb.model.nv, mb.model.nv))
+    mujoco.mj_fullM(mb.model, d, M)
+    dv = qvel - st.qvel
+    e_vib = 0.5 * dv @ M @ dv
+    omega_max = max_angular_frequency(mb)
+    h0 = default_step(mb, omega_max)
+    losses = []
+    for h in (h0, h0 / 2):
+        res = simulate_mujoco(spec, 0.02, dt=h, initial_state=(st.qpos, qvel), record_energy=True,
+                              output_dt=1e-5, mb=mb)
+        energy = res.raw["energy_kinetic"] + res.raw["energy_potential"]
+        n = res.info["steps"]
+        bound = e_vib * (1 - (1 - (omega_max * h) ** 6 / 72) ** n)
+        loss = energy[0] - energy[-1]
+        assert np.max(energy - energy[0]) <= 1e-12 * energy[0], "energy rose: a force does work it should not"
+        assert 0 <= loss <= bound
+        losses.append(loss)
+        print(f"h = {h:.4g} s: energy loss {loss / e_vib:.3e} of the vibration energy, RK4 bound {bound / e_vib:.3e}")
+    assert 16 < losses[0] / losses[1] < 64, f"loss ratio {losses[0] / losses[1]:.3g} is not RK4's h^5"
+
+
+# ---------------------------------------------------------------------------------------------- centripetal
+
+
+def test_planet_bearings_carry_the_centripetal_load():
+    """Steady rotation: the planets' radial bearing force is m_p r_c Omega_c^2 (the radial mesh
+    components of sun and ring cancel).  Constant mesh stiffness, so the steady state is steady;
+    measured from the radial slide joints' passive force at two speeds."""
+    base = variant(CONSTANT, "centripetal")
+    for factor in (1.0, 2.0):
+        spec = base.with_operating(input_speed=base.operating.input_speed * factor)
+        res = simulate_mujoco(spec, 0.01, output_dt=1e-5)
+        kin = compile_train(spec).kin
+        w = res.steady
+        for pid in spec.stages[0].planets:
+            p = spec.members[pid]
+            expected = p.mass * p.radius * kin.speeds["stage1.carrier"] ** 2
+            force = res.bearing_force[w, res.bearing_names.index(f"{pid}.bearing_radial")]
+            assert np.mean(force) == pytest.approx(expected, rel=2e-3)
+            assert np.ptp(force) < 1e-3 * expected  # steady, and the carrier did turn
+        turned = res.carrier_angle[-1, res.member_index("stage1.carrier")] - res.carrier_angle[0, 0]
+        assert turned == pytest.approx(kin.speeds["stage1.carrier"] * res.t[-1], rel=1e-3)
+        print(f"speed x{factor:g}: radial bearing force {np.mean(force):.4f} N, m r Omega^2 = {expected:.4f} N")
+
+
+# ---------------------------------------------------------------------------------------------- dead band
+
+
+def test_backlash_dead_band_in_mujoco_tendon():
+    """MuJoCo's own spring force of a backlash mesh tendon is zero inside |delta| < b and
+    k(|delta| - b) beyond, read from qfrc_spring with and without that tendon's stiffness."""
+    spec = variant([(r"^\[stages.mesh\]$", "[stages.mesh]\nbacklash_um = 40.0")], "backlash")
+    mb = compile_train(spec)
+    m = mb.model
+    d = mujoco.MjData(m)
+    t = int(mb.mesh_tendon[0])
+    b = spec.meshes[0].backlash / 2
+    assert b == pytest.approx(20e-6)
+    row = np.zeros(m.nv)
+    for w in range(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t]):
+        row[m.jnt_dofadr[m.wrap_objid[w]]] = m.wrap_prm[w]
+    k = m.tendon_stiffness[t]
+    for delta in np.linspace(-2.5 * b, 2.5 * b, 11):
+        d.qpos[:] = row * delta / (row @ row)
+        forces = []
+        for stiffness in (k, 0.0):
+            m.tendon_stiffness[t] = stiffness
+            mujoco.mj_forward(m, d)
+            forces.append(d.qfrc_spring.copy())
+        m.tendon_stiffness[t] = k
+        assert d.ten_length[t] == pytest.approx(delta, abs=1e-15)
+        tendon_force = -(forces[0] - forces[1]) @ row / (row @ row)  # generalized force = -J' F
+        expected = k * (delta - b) if delta > b else k * (delta + b) if delta < -b else 0.0
+        assert tendon_force == pytest.approx(expected, abs=1e-6 * k * b)
+
+
+def test_backlash_mesh_separates_and_carries_no_force():
+    """Light load, rectangular stiffness, 40 um backlash, no mesh damping: the teeth separate in
+    the run; while |delta| < b the mesh force is zero, outside it is k(t)(|delta| - b)."""
+    spec = variant([(r"^\[stages.mesh\]$", "[stages.mesh]\nbacklash_um = 40.0"),
+                    (r"damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.0 }"),
+                    (r"^output_torque = .*$", "output_torque = 20.0")], "backlash-light")
+    res = simulate_mujoco(spec, 0.02)
+    b = spec.meshes[0].backlash / 2
+    inside = np.abs(res.mesh_deflection) < b
+    assert inside.any(), "no separation happened: the test needs a lighter load"
+    assert np.all(res.mesh_force[inside] == 0.0)
+    outside = ~inside
+    np.testing.assert_allclose(np.abs(res.mesh_force[outside]),
+                               res.mesh_stiffness[outside] * (np.abs(res.mesh_deflection[outside]) - b), rtol=1e-12)
+    print(f"fraction of samples with a mesh in its dead band: {inside.mean():.3f}")
+
+
+# ---------------------------------------------------------------------------------------------- lumped
+
+
+def test_time_response_matches_lumped():
+    """demo-3p at its operating point: steady mesh forces and the ring's world-frame accelerations of
+    MuJoCo and the lumped RK4 solver within 1 % normalised RMS, the difference shrinking with dt.
+
+    The world-frame ring acceleration difference levels off at ~4e-3: MuJoCo places the meshes at
+    the carrier's actual angle, which lags the nominal one by the static wind-up theta_c = -4.07 mrad
+    (input shaft twist), the lumped model at the nominal angle; in carrier axes it keeps shrinking.
+    """
+    spec = load_train("demo-3p")
+    model = build_model(spec)
+    mb = compile_train(spec)
+    h0 = default_step(mb)
+    duration, settle = 0.05, 0.025
+    table = []
+    for h in (h0, h0 / 2):
+        mj = simulate_mujoco(spec, duration, dt=h, settle=settle, mb=mb)
+        lp = simulate(model, duration, dt=h, settle=settle)
+        assert np.array_equal(mj.t, lp.t)
+        w = mj.steady
+        force = max(nrms(mj.mesh_force[w, i], lp.mesh_force[w, i]) for i in range(len(spec.meshes)))
+        a_mj, a_lp = mj.acceleration("stage1.ring", "world"), lp.acceleration("stage1.ring", "world")
+        world = max(nrms(a_mj[c].to_numpy()[w], a_lp[c].to_numpy()[w]) for c in ("ax", "ay", "alpha"))
+        c_mj, c_lp = mj.acceleration("stage1.ring", "carrier"), lp.acceleration("stage1.ring", "carrier")
+        carrier = max(nrms(c_mj[c].to_numpy()[w], c_lp[c].to_numpy()[w]) for c in ("ax", "ay"))
+        table.append((h, force, world, carrier))
+        assert force < 0.01 and world < 0.01
+    print("\n      dt [s]   mesh force   ring world   ring carrier axes  (normalised RMS difference)")
+    for h, force, world, carrier in table:
+        print(f"  {h:.4e}   {force:.3e}    {world:.3e}    {carrier:.3e}")
+    assert table[1][1] < 0.5 * table[0][1]  # mesh forces converge together
+    assert table[1][3] < 0.5 * table[0][3]  # and so do the ring accelerations in carrier axes
+
+
+# ---------------------------------------------------------------------------------------------- steps
+
+
+def test_unstable_step_refused():
+    spec = load_train("demo-3p")
+    mb = compile_train(spec)
+    omega_max = max_angular_frequency(mb)
+    with pytest.raises(SolverError, match=r"unstable.*use dt <="):
+        simulate_mujoco(spec, 0.001, dt=1.05 * RK4_LIMIT / omega_max, mb=mb)
+    with pytest.raises(SolverError):
+        simulate_mujoco(spec, 0.001, dt=-1.0, mb=mb)
+    # the default is well inside the limit: at least 20 points per period of the highest mode,
+    # rounded down to a whole fraction of the mesh period (at most one step more per cycle)
+    h = default_step(mb)
+    period = 1.0 / mb.excitation.frequency.min()
+    assert period / h == pytest.approx(round(period / h), abs=1e-6)
+    assert 2 * math.pi / 20 * (1 - h / period) <= h * omega_max <= 2 * math.pi / 20
+
+
+def test_result_shape_and_frames():
+    """Same result layout as the lumped solver; planet axes turn with carrier angle + psi."""
+    spec = load_train("demo-4p")
+    res = simulate_mujoco(spec, 0.002, output_dt=1e-4)
+    assert res.solver == "mujoco" and res.members == list(spec.members)
+    assert res.acc_carrier.shape == (res.t.size, len(spec.members), 3)
+    assert res.mesh_force.shape == (res.t.size, len(spec.meshes))
+    i2, ic = res.member_index("stage1.planet2"), res.member_index("stage1.carrier")
+    np.testing.assert_allclose(res.carrier_angle[:, i2] - res.carrier_angle[:, ic], math.pi / 2, atol=1e-12)
+    world = res.acceleration("stage1.planet2", "world")
+    np.testing.assert_allclose(world.ax, res.raw["stage1_planet2_linacc_x"], rtol=1e-12, atol=1e-9)
+    df = res.to_dataframe()
+    assert np.all(np.isfinite(df.to_numpy()))
+
+
+def test_divergence_is_reported():
+    spec = load_train("demo-3p")
+    mb = compile_train(spec)
+    st = static_state(mb)
+    qpos = st.qpos.copy()
+    qpos[mb.dadr["stage1.planet1"][0]] = np.nan
+    with pytest.raises(DivergenceError, match="diverged at t ="):
+        simulate_mujoco(spec, 0.001, initial_state=(qpos, st.qvel), mb=mb)

@@ -87,15 +87,15 @@ def _summary_row(name, data, moved, ok) -> dict:
     modes = data["modes"]
     gated = [q for q in data["quantities"] if q["status"] != "negligible"]
 
-    def worst(kind):
-        values = [q["errors"]["nrmse"]["value"] for q in gated if q["kind"] == kind and q["errors"]["nrmse"]]
+    def worst(*kinds):
+        values = [q["errors"]["nrmse"]["value"] for q in gated if q["kind"] in kinds and q["errors"]["nrmse"]]
         return max(values) if values else None
 
     return {
         "train": name, "status": "PASS" if ok else "FAIL",
         "modes": len(modes), "max_mode_rel_error": max(m["rel_error"]["value"] for m in modes),
         "quantities": len(data["quantities"]), "failed": len(data["verdict"]["failures"]), "moved": len(moved),
-        "worst_nrmse_mesh_force": worst("mesh_force"), "worst_nrmse_acceleration": worst("acceleration"),
+        "worst_nrmse_mesh_force": worst("mesh_force"), "worst_nrmse_acceleration": worst("acceleration", "angular_acceleration"),
         "speed_rpm": data["settings"]["input_speed"]["value"],
     }
 
@@ -103,13 +103,13 @@ def _summary_row(name, data, moved, ok) -> dict:
 SUMMARY_COLUMNS = [("train", "train"), ("status", "status"), ("speed_rpm", "speed [rpm]"), ("modes", "modes"),
                    ("max_mode_rel_error", "max mode rel. diff."), ("quantities", "quantities"),
                    ("worst_nrmse_mesh_force", "worst NRMSE mesh force"),
-                   ("worst_nrmse_acceleration", "worst NRMSE acceleration"), ("failed", "failed"),
+                   ("worst_nrmse_acceleration", "worst NRMSE acceleration (linear, angular)"), ("failed", "failed"),
                    ("moved", "moved vs baseline")]
 
 
 def _cell(value) -> str:
     if isinstance(value, float):
-        return f"{value:.3g}" if math.isfinite(value) else str(value)
+        return f"{value:.4g}" if math.isfinite(value) else str(value)
     return "—" if value is None else str(value)
 
 

@@ -1,0 +1,112 @@
+"""The cross-check end to end: demo presets pass, a broken twin fails by name, reports are
+reproducible byte for byte, baselines hold."""
+
+import dataclasses
+import json
+from pathlib import Path
+
+import pytest
+
+from compare.cli import main
+from compare.crosscheck import crosscheck
+from lumped import load_train
+
+DURATION = "0.05"
+
+
+def test_demo_presets_pass_with_default_tolerances():
+    for name in ("demo-3p", "demo-4p"):
+        result = crosscheck(load_train(name), duration=0.05)
+        assert result.passed, result.failures
+        assert result.steady_found
+        gated = [q for q in result.quantities if q.status == "pass"]
+        assert len(gated) >= 20
+        # mesh phasing: demo-4p's central members cannot translate (22 l +/- 1 is never a multiple of 4)
+        if name == "demo-4p":
+            assert {q.name for q in result.quantities if q.status == "negligible"} >= {
+                "stage1.sun.ax.world", "stage1.ring.ay.world", "stage1.carrier.ax.carrier"}
+
+
+def test_a_twin_with_a_wrong_planet_inertia_fails_by_name():
+    """A test hook changes the planets' inertia in the MuJoCo model only (x 1.3)."""
+    def heavier_planets(spec):
+        members = {k: dataclasses.replace(m, inertia=1.3 * m.inertia) if m.is_planet else m
+                   for k, m in spec.members.items()}
+        return dataclasses.replace(spec, members=members)
+
+    result = crosscheck(load_train("demo-3p"), duration=0.05, mujoco_hook=heavier_planets)
+    assert not result.passed
+    failures = set(result.failures)
+    assert any(f.startswith("mode ") for f in failures)  # the natural frequencies moved
+    assert "stage1.planet1.sun.force" in failures  # and the planets' mesh forces with them
+
+
+def _strip_volatile(path: Path) -> bytes:
+    if path.name == "report.json":
+        data = json.loads(path.read_text())
+        data.pop("volatile")
+        return json.dumps(data).encode()
+    if path.suffix in (".md", ".html"):
+        return "\n".join(line for line in path.read_text().splitlines() if "Run: " not in line).encode()
+    return path.read_bytes()
+
+
+def test_reports_identical_across_runs(tmp_path, capsys):
+    for run in ("a", "b"):
+        assert main(["crosscheck", "demo-3p", "--duration", DURATION, "--out", str(tmp_path / run)]) == 0
+    files = sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert {"report.json", "report.md", "report.html", "time_histories.png", "spectra.png",
+            "natural_frequencies.png", "errors.png"} <= set(files)
+    for name in files:
+        assert _strip_volatile(tmp_path / "a" / name) == _strip_volatile(tmp_path / "b" / name), name
+    # the volatile parts are exactly one field / one line
+    md = (tmp_path / "a" / "report.md").read_text().splitlines()
+    assert sum("Run: " in line for line in md) == 1
+    data = json.loads((tmp_path / "a" / "report.json").read_text())
+    assert data["schema"] == "gearcheck.crosscheck" and data["schema_version"] == 1
+    assert data["quantities"][0]["lumped"]["rms"]["unit"] == "m/s^2"
+    assert data["provenance"]["mujoco_version"] and data["provenance"]["train_sha256"]
+
+
+def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
+    """CI's regression dashboard: every preset cross-checked, nothing moved from compare/baselines/."""
+    assert main(["crosscheck", "--all", "--duration", DURATION, "--baseline", "--out", str(tmp_path)]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert {r["train"] for r in summary["presets"]} == {"demo-3p", "demo-4p"}
+    assert all(r["status"] == "PASS" and r["moved"] == 0 for r in summary["presets"])
+    assert (tmp_path / "summary.html").read_text().count("report.html") == len(summary["presets"])
+
+
+def test_a_moved_metric_is_flagged(tmp_path, capsys):
+    baseline = json.loads((Path(__file__).parent.parent / "compare" / "baselines" / "demo-3p.json").read_text())
+    baseline["quantities"]["stage1.ring.ay.world"]["lumped_rms"] *= 1.2
+    baseline["modes"][0]["mujoco_hz"] *= 1.001
+    path = tmp_path / "moved.json"
+    path.write_text(json.dumps(baseline))
+    assert main(["crosscheck", "demo-3p", "--duration", DURATION, "--baseline", str(path),
+                 "--out", str(tmp_path / "out")]) == 1
+    out = capsys.readouterr().out
+    assert "stage1.ring.ay.world lumped_rms" in out and "mode 1 mujoco_hz" in out
+
+
+def test_measured_values_appear_as_a_third_column(tmp_path, capsys):
+    measurements = tmp_path / "measured.toml"
+    measurements.write_text('[[measurements]]\nquantity = "stage1.ring.ay.world"\nmetric = "rms"\n'
+                            'value = 100.0\nspeed_rpm = 1500.0\nsource = "made up for the test"\n')
+    assert main(["crosscheck", "demo-3p", "--duration", DURATION, "--measurements", str(measurements),
+                 "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "report.json").read_text())
+    (row,) = data["measurements"]
+    assert row["measured"] == {"value": 100.0, "unit": "m/s^2"}
+    assert row["error_lumped"]["value"] == pytest.approx(row["lumped"]["value"] / 100.0 - 1.0)
+    assert "Measured reference values" in (tmp_path / "report.md").read_text()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["crosscheck"], "give a TRAIN or --all"),
+    (["crosscheck", "demo-3p", "--tolerances", "missing.toml"], "cannot read tolerances"),
+    (["crosscheck", "demo-3p", "--duration", "0"], "--duration must be a positive number"),
+])
+def test_crosscheck_bad_input_exits_2(argv, message, capsys, tmp_path):
+    assert main(argv + ["--out", str(tmp_path)]) == 2
+    assert message in capsys.readouterr().err

@@ -19,24 +19,9 @@ import time
 import mujoco
 import numpy as np
 
-from lumped.loader import load_text, load_train, preset_text
+from lumped.loader import load_train
 from mbd_models import compile_train, simulate_mujoco
-
-
-def chained_train(n_stages: int):
-    """n copies of demo-3p's stage in series, carrier k -> sun k+1 by a spline coupling."""
-    text = preset_text("demo-3p")
-    head, stage = text.split("[[stages]]", 1)
-    head = head.replace('output = "stage1.carrier"', f'output = "stage{n_stages}.carrier"')
-    head = head.replace('held = ["stage1.ring"]',
-                        "held = [" + ", ".join(f'"stage{i}.ring"' for i in range(1, n_stages + 1)) + "]")
-    parts = [head]
-    for i in range(1, n_stages + 1):
-        parts.append("[[stages]]" + stage.replace('name = "stage1"', f'name = "stage{i}"'))
-    for i in range(1, n_stages):
-        parts.append(f'\n[[couplings]]\nname = "spline{i}"\nfrom = "stage{i}.carrier"\nto = "stage{i + 1}.sun"\n'
-                     "torsional_stiffness = 2.0e6\ntorsional_damping = 5.0\n")
-    return load_text("\n".join(parts), f"chain-{n_stages}")
+from trains import chained_train
 
 
 def bare_step_cost(mb, n_steps: int, dt: float) -> float:

@@ -14,7 +14,7 @@ import time
 from lumped import build_model, load_train
 from lumped.modal import modes
 from lumped.time_solver import simulate
-from trains import chained_train, planets_train
+from lumped.variants import chained, wide_stage
 
 
 def timed_run(spec, duration):
@@ -45,9 +45,9 @@ def main():
     demo = load_train("demo-3p")
     table("duration (demo-3p at 1500 rpm)", "duration",
           [(f"{d:g} s", demo, d) for d in (0.05, 0.1, 0.2, 0.4)])
-    table("planets (z = 30/24/78, 0.1 s)", "planets", [(f"{n}", planets_train(n), 0.1) for n in (3, 4, 6)])
+    table("planets (z = 30/24/78, 0.1 s)", "planets", [(f"{n}", wide_stage(n), 0.1) for n in (3, 4, 6)])
     table("stages (demo-3p stage chained, 0.1 s)", "stages",
-          [(f"{n}", load_train("demo-3p") if n == 1 else chained_train(n), 0.1) for n in (1, 2, 3)])
+          [(f"{n}", load_train("demo-3p") if n == 1 else chained(n), 0.1) for n in (1, 2, 3)])
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ import numpy as np
 
 from lumped.loader import load_train
 from mbd_models import compile_train, simulate_mujoco
-from trains import chained_train
+from lumped.variants import chained
 
 
 def bare_step_cost(mb, n_steps: int, dt: float) -> float:
@@ -49,7 +49,7 @@ def cost_table(n_steps: int, repeats: int = 3):
           f"{'ratio':>6} {'steps/s':>9} {'sim s per wall s':>16}")
     rows = []
     for n_stages in (1, 2, 3):
-        spec = load_train("demo-3p") if n_stages == 1 else chained_train(n_stages)
+        spec = load_train("demo-3p") if n_stages == 1 else chained(n_stages)
         mb = compile_train(spec)
         dt = mb.model.opt.timestep  # the default step written into the MJCF
         bare = min(bare_step_cost(mb, n_steps, dt) for _ in range(repeats))

@@ -72,6 +72,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--dt-lumped", type=float, metavar="S", help="lumped RK4 step (default: derived)")
     s.add_argument("--dt-mujoco", type=float, metavar="S", help="MuJoCo step (default: derived)")
     s.add_argument("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table")
+    s.add_argument("--sensor-band", type=float, nargs=2, metavar=("LOW", "HIGH"),
+                   help="accelerometer chain: band-pass both solvers' accelerations to LOW-HIGH Hz")
     s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]")
     s.add_argument("--baseline", type=Path, metavar="FILE", help="compare with a stored baseline (with --all: "
                                                                  "the shipped baselines)", nargs="?",

@@ -29,7 +29,7 @@ from lumped.errors import SolverError
 from lumped.modal import modes
 from lumped.time_solver import simulate
 
-from .align import resample, steady_start, uniform_grid
+from .align import resample, sensor_filter, steady_start, uniform_grid
 from .metrics import modal_metrics, spectral_lines, spectral_metrics, waveform_metrics
 from .quantities import extract
 from .tolerances import Tolerances
@@ -86,15 +86,17 @@ def _stage_frequencies(spec, kin):
 
 
 def crosscheck(spec, duration: float = 0.1, tolerances: Tolerances | None = None, dt_lumped=None, dt_mujoco=None,
-               mujoco_hook=None, progress=None) -> CrosscheckResult:
+               sensor_band: tuple[float, float] | None = None, mujoco_hook=None, progress=None) -> CrosscheckResult:
     """Compare the lumped model of ``spec`` with its MuJoCo twin.
 
-    mujoco_hook: optional callable(spec) -> spec applied to the MuJoCo side only (a test
-    hook, to prove that the cross-check catches a model that differs).
+    tolerances: default :meth:`Tolerances.for_train`.  sensor_band: (low, high) Hz of an
+    accelerometer chain applied to both solvers' accelerations.  mujoco_hook: optional
+    callable(spec) -> spec applied to the MuJoCo side only (a test hook, to prove that the
+    cross-check catches a model that differs).
     """
     from mbd_models import mujoco_modes, simulate_mujoco
 
-    tolerances = tolerances or Tolerances()
+    tolerances = tolerances or Tolerances.for_train(spec)
     mj_spec = mujoco_hook(spec) if mujoco_hook else spec
     model = build_model(spec)
     kin = model.kin
@@ -123,6 +125,13 @@ def crosscheck(spec, duration: float = 0.1, tolerances: Tolerances | None = None
     fs = min(_rate(a.t), _rate(b.t))
     grid = uniform_grid(0.0, min(a.t[-1], b.t[-1]), fs)
     series = {n: (resample(a.t, qa[n][1], grid), resample(b.t, qb[n][1], grid)) for n in names}
+    if sensor_band is not None:
+        low, high = sensor_band
+        if not (0 < low < high < 0.5 * fs):
+            raise SolverError(f"sensor band {low:g}-{high:g} Hz must lie inside (0, {0.5 * fs:.6g}) Hz")
+        for n in names:
+            if qa[n][0].kind in ("acceleration", "angular_acceleration"):
+                series[n] = tuple(sensor_filter(x, fs, sensor_band) for x in series[n])
 
     stage_freq = _stage_frequencies(spec, kin)
     cycle = 1.0 / min(f for f, _ in stage_freq.values())
@@ -169,6 +178,7 @@ def crosscheck(spec, duration: float = 0.1, tolerances: Tolerances | None = None
         "lumped": {k: a.info.get(k) for k in ("method", "dt_s", "steps", "rotating_frame_terms")},
         "mujoco": {k: v for k, v in b.info.items() if k not in ("wall_time_s",) and _plain(v)},
         "common_sample_rate_hz": fs, "steady_cycle_s": cycle,
+        "sensor_band_hz": list(sensor_band) if sensor_band else None,
         "tolerances": dict(sorted(tolerances.values.items())),
     }
     return CrosscheckResult(spec, settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),

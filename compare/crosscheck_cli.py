@@ -28,10 +28,10 @@ def _baseline_path(args, spec) -> Path | None:
 
 def run_one(args, spec, out: Path) -> tuple[dict, list[str]]:
     """Cross-check ``spec``, write its report into ``out``; return (report data, moved baseline metrics)."""
-    tolerances = Tolerances.from_file(args.tolerances) if args.tolerances else Tolerances()
+    tolerances = Tolerances.for_train(spec, args.tolerances)
     bar = ProgressBar(f"crosscheck {spec.name}")
     result = crosscheck(spec, duration=args.duration, tolerances=tolerances, dt_lumped=args.dt_lumped,
-                        dt_mujoco=args.dt_mujoco, progress=bar)
+                        dt_mujoco=args.dt_mujoco, sensor_band=args.sensor_band, progress=bar)
     bar.close()
     entries = list(spec.measurements)
     if args.measurements:

@@ -97,6 +97,7 @@ def to_dict(result) -> dict:
 def _settings_with_units(settings: dict) -> dict:
     units = {"duration_s": ("duration", "s"), "input_speed_rpm": ("input_speed", "rpm"),
              "output_torque_nm": ("output_torque", "N·m"), "common_sample_rate_hz": ("common_sample_rate", "Hz"),
+             "sensor_band_hz": ("sensor_band", "Hz"),
              "steady_cycle_s": ("steady_cycle", "s")}
     out = {}
     for key, value in settings.items():

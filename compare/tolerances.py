@@ -11,16 +11,17 @@ Keys are ``KIND.METRIC`` (``mesh_force.nrmse``) or ``QUANTITY.METRIC``
   high-frequency content where the two time discretisations differ most;
 * ``bearing_force.nrmse`` 0.02.
 
-Overrides come from a ``[tolerances]`` table in a TOML file (``--tolerances``).
+Overrides come from the train file's ``[tolerances]`` table and then from a ``[tolerances]``
+table in a TOML file given with ``--tolerances`` (the file wins).
 """
 
 from __future__ import annotations
 
-import math
 import tomllib
 from pathlib import Path
 
-from lumped.errors import GearcheckError
+from lumped.errors import GearcheckError, TrainFileError
+from lumped.spec import flat_tolerances
 
 DEFAULTS = {
     "frequency.rel_error": 1e-6,
@@ -41,32 +42,19 @@ class Tolerances:
         return self.values.get(f"{quantity}.{metric}", self.values.get(f"{kind}.{metric}"))
 
     @classmethod
-    def from_file(cls, path: str | Path) -> "Tolerances":
-        try:
-            data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, tomllib.TOMLDecodeError) as exc:
-            raise GearcheckError(f"{path}: cannot read tolerances: {exc}") from None
-        table = data.get("tolerances")
-        if not isinstance(table, dict) or set(data) != {"tolerances"}:
-            raise GearcheckError(f"{path}: expected a single [tolerances] table")
-        overrides = {}
-        for key, value in _flatten(table).items():
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                    or value <= 0:
-                raise GearcheckError(f"{path}: tolerances.{key}: must be a positive number, got {value!r}")
-            if key.count(".") < 1:
-                raise GearcheckError(f"{path}: tolerances.{key}: expected KIND.METRIC or QUANTITY.METRIC")
-            overrides[key] = float(value)
+    def for_train(cls, spec, path: str | Path | None = None) -> "Tolerances":
+        """Defaults, then the train file's [tolerances], then those of ``path``."""
+        overrides = dict(spec.tolerances)
+        if path is not None:
+            overrides.update(read_tolerances(path))
         return cls(overrides)
 
 
-def _flatten(table: dict, prefix: str = "") -> dict:
-    """TOML dotted keys (``mesh_force.nrmse = 0.02``) arrive nested; join them back."""
-    flat = {}
-    for key, value in table.items():
-        name = f"{prefix}.{key}" if prefix else key
-        if isinstance(value, dict):
-            flat.update(_flatten(value, name))
-        else:
-            flat[name] = value
-    return flat
+def read_tolerances(path: str | Path) -> dict[str, float]:
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise GearcheckError(f"{path}: cannot read tolerances: {exc}") from None
+    if not isinstance(data.get("tolerances"), dict) or set(data) != {"tolerances"}:
+        raise GearcheckError(f"{path}: expected a single [tolerances] table")
+    return flat_tolerances(data["tolerances"], lambda key, msg: TrainFileError(str(path), f"tolerances.{key}", msg))

@@ -32,9 +32,6 @@ class Kinematics:
     input_torque: float  # N·m on the input member (power balance), signed
     output_torque: float  # N·m on the output member, signed (opposes its rotation)
 
-    def carrier_speed(self, spec, stage_name: str) -> float:
-        return self.speeds[f"{stage_name}.carrier"]
-
 
 def _torsional_rows(spec):
     """Rigid torsional constraint rows over the members' absolute rotations (flank +1)."""
@@ -128,9 +125,9 @@ def _sun_ring_offset(spec, mesh) -> float:
     if not mesh.internal:
         return 0.0
     suns = [m for m in spec.meshes if m.planet == mesh.planet and not m.internal]
-    if len(suns) != 1 or suns[0].planet_gear is not mesh.planet_gear:
+    if len(suns) != 1 or suns[0].planet_gear != mesh.planet_gear:
         return 0.0
-    sun, planet, ring = suns[0].central_gear, mesh.planet_gear, mesh.central_gear
+    planet, ring = mesh.planet_gear, mesh.central_gear
     a1, a2 = suns[0].geometry.pressure_angle, mesh.geometry.pressure_angle
     p = planet.base_pitch
     rpb, rrb = planet.base_radius, ring.base_radius

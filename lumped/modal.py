@@ -15,7 +15,6 @@ central rotation and the planets; a fraction below ``ENERGY_TOLERANCE`` counts a
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,9 +51,6 @@ class ModalResult:
             "modes": [{"mode": i + 1, "frequency_hz": float(f), "type": t, "multiplicity": m}
                       for i, (f, t, m) in enumerate(zip(self.frequencies, self.types, self.multiplicity))],
         }
-
-    def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2)
 
 
 def generalized_modes(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from .errors import TrainFileError
@@ -447,6 +447,8 @@ TRAIN = Table(
         "stages": TableList(STAGE, "planetary stages", min_length=1),
         "couplings": TableList(COUPLING, "interstage couplings", default=()),
         "measurements": TableList(MEASUREMENT, "measured reference values shown beside both solvers", default=()),
+        "tolerances": Table({}, "cross-check tolerances, `KIND.METRIC = value` or `QUANTITY.METRIC = value` "
+                                "(see README: tolerances)", None, open=True),
     },
     "a gear train file",
 )

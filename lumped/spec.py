@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
 from math import gcd
 
 from .errors import TrainFileError
@@ -142,13 +141,10 @@ class TrainSpec:
     operating: Operating
     text_hash: str = ""
     measurements: tuple[dict, ...] = ()  # measured reference values, SI (see schema.MEASUREMENT)
+    tolerances: dict = field(default_factory=dict)  # cross-check tolerance overrides, flat keys
 
     def member(self, member_id: str) -> Member:
         return self.members[member_id]
-
-    @cached_property
-    def member_ids(self) -> tuple[str, ...]:
-        return tuple(self.members)
 
     def stage_of(self, member_id: str) -> Stage:
         name = self.members[member_id].stage
@@ -222,7 +218,30 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
         stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
         text_hash=text_hash, measurements=tuple(data["measurements"]),
+        tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
     )
+
+
+def flat_tolerances(table: dict, fail) -> dict[str, float]:
+    """``[tolerances]`` entries as flat ``KIND.METRIC`` keys (TOML dotted keys arrive nested),
+    each a positive finite number."""
+    flat = {}
+
+    def walk(node, prefix):
+        for key, value in node.items():
+            name = f"{prefix}.{key}" if prefix else key
+            if isinstance(value, dict):
+                walk(value, name)
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or value <= 0:
+                raise fail(name, f"must be a positive number, got {value!r}")
+            elif "." not in name:
+                raise fail(name, "expected KIND.METRIC or QUANTITY.METRIC")
+            else:
+                flat[name] = float(value)
+
+    walk(table, "")
+    return flat
 
 
 def _known(ref: str, members) -> str:

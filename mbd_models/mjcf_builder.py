@@ -394,10 +394,6 @@ class MbdModel:
     rot_c0y: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rot_carrier_qadr: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
 
-    @property
-    def carrier_qadr(self) -> dict[str, int]:
-        return {s.name: self.qadr[s.carrier][2] for s in self.spec.stages}
-
     def refresh(self, qpos: np.ndarray) -> None:
         """Rotate the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
         phi = qpos[self.rot_carrier_qadr]
@@ -405,9 +401,6 @@ class MbdModel:
         prm = self.model.wrap_prm
         prm[self.rot_wrap_x] = self.rot_c0x * c - self.rot_c0y * s
         prm[self.rot_wrap_y] = self.rot_c0x * s + self.rot_c0y * c
-
-    def new_data(self) -> mujoco.MjData:
-        return mujoco.MjData(self.model)
 
 
 def compile_train(spec: TrainSpec, stiffness="mean", _xml: str | None = None) -> MbdModel:

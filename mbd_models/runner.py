@@ -334,10 +334,6 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
     dot = np.dot
     cos, sin = math.cos, math.sin
 
-    def refresh_multi():
-        phi = qpos[cadr2]
-        prm[widx] = A[:, 0] * np.cos(phi) + A[:, 1] * np.sin(phi)
-
     forward, rk = mujoco.mj_forward, mujoco.mj_RungeKutta
     b = mb.half_backlash
     lo_hi = np.stack([-b, b], axis=1)
@@ -386,7 +382,7 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
                     dot(A, cs, out=buf)
                     prm[widx] = buf
                 else:
-                    refresh_multi()
+                    mb.refresh(qpos)
                 if bodies:
                     k_now, k_later = _body_stiffness(mb, clock_info, qpos, qvel, h)
                     stiff[:n_mesh] = k_now
@@ -424,7 +420,7 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
             progress(stop / n_steps)
     if j < n_out:  # the final state (n_steps is a multiple of every)
         t_end = np.array([n_steps * h + STAGE_OFFSETS[0] * h])
-        refresh_multi()
+        mb.refresh(qpos)
         if bodies:
             k_now, _ = _body_stiffness(mb, clock_info, qpos, qvel, h)
             k_record[j] = k_now

@@ -110,3 +110,34 @@ def test_measured_values_appear_as_a_third_column(tmp_path, capsys):
 def test_crosscheck_bad_input_exits_2(argv, message, capsys, tmp_path):
     assert main(argv + ["--out", str(tmp_path)]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
+    """Tightening the mesh-force tolerance below the measured error must fail the run, by name."""
+    from lumped.variants import edited
+
+    strict = edited("demo-3p", [(r"^\[\[stages\]\]", "[tolerances]\nmesh_force.nrmse = 1e-9\n\n[[stages]]")])
+    assert strict.tolerances == {"mesh_force.nrmse": 1e-9}
+    result = crosscheck(strict, duration=0.05)
+    assert "stage1.planet1.sun.force" in result.failures and "stage1.ring.ay.world" not in result.failures
+    loose = tmp_path / "tol.toml"
+    loose.write_text("[tolerances]\n\"stage1.planet1.sun.force.nrmse\" = 0.5\n")
+    from compare.tolerances import Tolerances
+
+    tol = Tolerances.for_train(strict, loose)
+    assert tol.lookup("stage1.planet1.sun.force", "mesh_force", "nrmse") == 0.5
+    assert tol.lookup("stage1.planet2.sun.force", "mesh_force", "nrmse") == 1e-9
+
+
+def test_sensor_band_filters_both_solvers_alike():
+    """A 100-1000 Hz accelerometer chain keeps the 406 Hz mesh line and removes the 2 kHz resonance
+    content: the filtered ring acceleration is smaller and the solvers still agree."""
+    plain = crosscheck(load_train("demo-3p"), duration=0.05)
+    band = crosscheck(load_train("demo-3p"), duration=0.05, sensor_band=(100.0, 1000.0))
+    q0 = next(q for q in plain.quantities if q.name == "stage1.ring.ay.world")
+    q1 = next(q for q in band.quantities if q.name == "stage1.ring.ay.world")
+    assert q1.metrics["reference"]["rms"] < 0.5 * q0.metrics["reference"]["rms"]
+    assert band.passed and q1.metrics["nrmse"] < 0.01
+    force0 = next(q for q in plain.quantities if q.name == "stage1.planet1.sun.force")
+    force1 = next(q for q in band.quantities if q.name == "stage1.planet1.sun.force")
+    assert force1.metrics["reference"]["rms"] == force0.metrics["reference"]["rms"]  # forces unfiltered

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import text_variant
+from lumped.variants import edited
 from lumped import kinematics, load_train
 
 
@@ -70,7 +70,7 @@ def test_sun_ring_phase_even_planet_teeth_half_cycle():
 
 def test_sun_ring_phase_odd_planet_teeth_in_phase():
     """... and odd z_p gives gamma_rs = 0 (two planets: (22 + 64)/2 = 43 assembles)."""
-    spec = text_variant("demo-3p", [(r"^planets = 3", "planets = 2"), (r"^teeth = 20", "teeth = 21"),
+    spec = edited("demo-3p", [(r"^planets = 3", "planets = 2"), (r"^teeth = 20", "teeth = 21"),
                                     (r"^teeth = 62", "teeth = 64")])
     gamma = _sun_ring_phase_at_pitch_points(spec)
     assert min(gamma, 1.0 - gamma) < 1e-9

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import re
 
 import mujoco
 import numpy as np
@@ -11,20 +10,17 @@ import pytest
 
 from lumped.assembly import build_model
 from lumped.errors import DivergenceError, SolverError
-from lumped.loader import load_text, load_train, preset_text
+from lumped.loader import load_train
 from lumped.static import static_solution
 from lumped.time_solver import simulate
+from lumped.variants import edited
 from mbd_models import compile_train, simulate_mujoco, static_state
 from mbd_models.linearise import max_angular_frequency
 from mbd_models.runner import RK4_LIMIT, default_step
 
 
 def variant(pairs, name="variant"):
-    text = preset_text("demo-3p")
-    for old, new in pairs:
-        assert re.search(old, text, flags=re.M), old
-        text = re.sub(old, new, text, flags=re.M)
-    return load_text(text, name)
+    return edited("demo-3p", pairs, name)
 
 
 UNDAMPED = [(r"damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.0 }"),

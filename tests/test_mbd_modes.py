@@ -8,37 +8,20 @@ Lin & Parker mode types are evidence both are right.
 from __future__ import annotations
 
 import math
-import re
 
 import mujoco
 import numpy as np
 import pytest
 
 from lumped.assembly import build_model
-from lumped.loader import load_text, preset_names, preset_text, load_train
+from lumped.loader import load_train, preset_names
 from lumped.modal import modes
+from lumped.variants import chained, edited
 from mbd_models import build_mjcf, compile_train, mujoco_modes
 from mbd_models.mjcf_builder import mesh_jacobian_row
 
 RELATIVE_TOLERANCE = 1e-6
 RIGID_HZ = 1e-3  # below this a frequency is a rigid-body mode (0 in both)
-
-
-def chained_train(n_stages: int, radial: bool = False):
-    """n copies of demo-3p's stage in series, carrier k -> sun k+1 by a spline coupling."""
-    text = preset_text("demo-3p")
-    head, stage = text.split("[[stages]]", 1)
-    head = head.replace('output = "stage1.carrier"', f'output = "stage{n_stages}.carrier"')
-    head = head.replace('held = ["stage1.ring"]', "held = [" + ", ".join(f'"stage{i}.ring"' for i in
-                                                                         range(1, n_stages + 1)) + "]")
-    parts = [head]
-    for i in range(1, n_stages + 1):
-        parts.append("[[stages]]" + stage.replace('name = "stage1"', f'name = "stage{i}"'))
-    for i in range(1, n_stages):
-        parts.append(f'\n[[couplings]]\nname = "spline{i}"\nfrom = "stage{i}.carrier"\nto = "stage{i + 1}.sun"\n'
-                     f"torsional_stiffness = 2.0e6\ntorsional_damping = 5.0\n"
-                     + ("radial_stiffness = 5.0e8\n" if radial else ""))
-    return load_text("\n".join(parts), f"chain-{n_stages}")
 
 
 def _compare(spec):
@@ -67,14 +50,13 @@ def test_frequencies_and_types_match_lumped(name):
 
 def test_two_stage_chain_matches_lumped():
     """Coupling tendons between stages: the same frequencies as the lumped coupling rows."""
-    worst = _compare(chained_train(2))
+    worst = _compare(chained(2))
     print(f"chain-2: max relative frequency difference {worst:.2e}")
 
 
 def test_free_input_has_one_rigid_mode():
     """Without an input shaft the train turns freely: exactly one zero frequency in MuJoCo's linearisation."""
-    text = re.sub(r"^input_shaft_(stiffness|damping).*$", "", preset_text("demo-3p"), flags=re.M)
-    spec = load_text(text, "free-input")
+    spec = edited("demo-3p", [(r"^input_shaft_(stiffness|damping).*$", "")], "free-input")
     mj = mujoco_modes(spec)
     assert mj.types.count("rigid") == 1 and mj.frequencies[0] == 0.0
     _compare(spec)
@@ -141,7 +123,7 @@ def test_mesh_damping_from_tendon_geometry():
 
 def test_backlash_mesh_linearised_on_its_flank():
     """A dead band is closed for the linearisation: the same frequencies as without backlash."""
-    text = preset_text("demo-3p").replace("[stages.mesh]", "[stages.mesh]\nbacklash_um = 30.0")
-    with_backlash = mujoco_modes(load_text(text, "backlash"))
+    with_backlash = mujoco_modes(edited("demo-3p", [(r"^\[stages.mesh\]$", "[stages.mesh]\nbacklash_um = 30.0")],
+                                        "backlash"))
     np.testing.assert_allclose(with_backlash.frequencies, mujoco_modes(load_train("demo-3p")).frequencies,
                                rtol=1e-12)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import text_variant
+from lumped.variants import edited, wide_stage
 from lumped import build_model, load_train
 from lumped.modal import modes
 
@@ -15,7 +15,7 @@ RIGID = "1.0e16"  # N/m or N·m/rad: supports this stiff perturb a 1e8..1e9 N/m 
 def single_mesh_train():
     """Demo stage reduced to one sun-planet pair on fixed axes: carrier held, no ring, rigid supports,
     free sun (torque-driven), the planet as the output."""
-    return text_variant("demo-3p", [
+    return edited("demo-3p", [
         (r"^planets = 3", "planets = 1"),
         (r'^output = "stage1.carrier"', 'output = "stage1.planet1"'),
         (r'^held = \["stage1.ring"\]', 'held = ["stage1.carrier"]'),
@@ -47,16 +47,10 @@ def test_rigid_body_modes_count_free_rotations():
     # shaft-driven input, ring held: no free rotation
     assert modes(build_model(load_train("demo-3p"))).types.count("rigid") == 0
     # torque-driven input: the whole train turns freely -> one zero frequency
-    free_input = text_variant("demo-3p", [(r"^input_shaft_stiffness = .*\n", "")])
+    free_input = edited("demo-3p", [(r"^input_shaft_stiffness = .*\n", "")])
     result = modes(build_model(free_input))
     assert result.types.count("rigid") == 1
     assert result.frequencies[0] == 0.0
-
-
-def wide_stage(n_planets: int):
-    """Demo stage with z = 30/24/78: z_s + z_r = 108 admits 3, 4 and 6 equally spaced planets."""
-    return text_variant("demo-3p", [(r"^planets = 3", f"planets = {n_planets}"), (r"^teeth = 22", "teeth = 30"),
-                                    (r"^teeth = 20", "teeth = 24"), (r"^teeth = 62", "teeth = 78")])
 
 
 @pytest.mark.parametrize("n_planets", [3, 4, 6])

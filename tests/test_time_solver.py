@@ -5,6 +5,7 @@ import re
 import numpy as np
 import pytest
 
+from lumped.variants import edited
 from lumped import SolverError, build_model, load_train
 from lumped.loader import load_text, preset_text
 from lumped.static import static_solution
@@ -93,10 +94,8 @@ def test_matrix_step_equals_stage_by_stage_rk4():
     """The cached matrix form of an RK4 step (linear model, stiffness constant over the step) is the
     same arithmetic as the stage-by-stage RK4 that a backlash model takes: a 1e-12 um backlash
     forces that path and changes the physics by k b ~ 1e-9 N only."""
-    from conftest import text_variant
-
     plain = build_model(load_train("demo-3p"))
-    staged = build_model(text_variant("demo-3p", [
+    staged = build_model(edited("demo-3p", [
         (r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nbacklash_um = 1e-12")]))
     a, b = simulate(plain, 0.01), simulate(staged, 0.01)
     assert staged.excitation.backlash.max() > 0

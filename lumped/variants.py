@@ -1,0 +1,51 @@
+"""Train variants derived from a preset's text: for tests, benchmarks and parameter studies.
+
+Edits are regular-expression substitutions on the TOML text (multiline mode), so a variant
+goes through the same validation as any train file.
+"""
+
+from __future__ import annotations
+
+import re
+
+from .loader import load_text, preset_text
+from .spec import TrainSpec
+
+
+def edited_text(preset: str, pairs) -> str:
+    """The text of ``preset`` with each (pattern, replacement) applied; a pattern must match."""
+    text = preset_text(preset)
+    for old, new in pairs:
+        if not re.search(old, text, flags=re.M):
+            raise ValueError(f"{old!r} does not occur in preset {preset}")
+        text = re.sub(old, new, text, flags=re.M)
+    return text
+
+
+def edited(preset: str, pairs, name: str | None = None) -> TrainSpec:
+    return load_text(edited_text(preset, pairs), name or f"variant-of-{preset}")
+
+
+def chained(n_stages: int, radial_stiffness: float = 0.0) -> TrainSpec:
+    """n copies of demo-3p's stage in series, carrier k -> sun k+1 by a spline
+    (torsional 2e6 N·m/rad, optionally radial)."""
+    text = preset_text("demo-3p")
+    head, stage = text.split("[[stages]]", 1)
+    head = head.replace('output = "stage1.carrier"', f'output = "stage{n_stages}.carrier"')
+    head = head.replace('held = ["stage1.ring"]',
+                        "held = [" + ", ".join(f'"stage{i}.ring"' for i in range(1, n_stages + 1)) + "]")
+    parts = [head]
+    for i in range(1, n_stages + 1):
+        parts.append("[[stages]]" + stage.replace('name = "stage1"', f'name = "stage{i}"'))
+    for i in range(1, n_stages):
+        parts.append(f'\n[[couplings]]\nname = "spline{i}"\nfrom = "stage{i}.carrier"\nto = "stage{i + 1}.sun"\n'
+                     "torsional_stiffness = 2.0e6\ntorsional_damping = 5.0\n"
+                     + (f"radial_stiffness = {radial_stiffness!r}\n" if radial_stiffness else ""))
+    return load_text("\n".join(parts), f"chain-{n_stages}")
+
+
+def wide_stage(n_planets: int) -> TrainSpec:
+    """demo-3p's stage with z = 30/24/78: z_s + z_r = 108 admits 3, 4 and 6 equally spaced planets."""
+    return edited("demo-3p", [(r"^planets = 3", f"planets = {n_planets}"), (r"^teeth = 22", "teeth = 30"),
+                              (r"^teeth = 20", "teeth = 24"), (r"^teeth = 62", "teeth = 78")],
+                  f"wide-stage-{n_planets}")

@@ -61,6 +61,7 @@ class Excitation:
         self.phase = np.array([kin.mesh_phase[m.id] for m in meshes])
         self.models = [stiffness_model(m) for m in meshes]
         self.mean_stiffness = np.array([model.mean for model in self.models])
+        self.max_stiffness = np.array([model.maximum for model in self.models])
         self.backlash = np.array([m.backlash for m in meshes])
         self._ste = [(i, h, a, p) for i, m in enumerate(meshes) for (h, a, p) in m.ste]
         self._eccentric = list(self._eccentric_terms(spec, kin))

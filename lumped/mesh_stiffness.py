@@ -28,6 +28,12 @@ class MeshStiffness:
     def __call__(self, xi):
         raise NotImplementedError
 
+    @property
+    def maximum(self) -> float:
+        """The largest stiffness over a cycle (what the time step must resolve); sampled unless a
+        model knows it exactly."""
+        return float(np.max(self(np.linspace(0.0, 1.0, 2001))))
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}(mean={self.mean:.6g} N/m)"
 

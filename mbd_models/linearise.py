@@ -82,9 +82,7 @@ def stiffness_matrix(mb: MbdModel, tendon_stiffness: np.ndarray | None = None,
 
 def max_angular_frequency(mb: MbdModel) -> float:
     """Highest natural angular frequency of the MuJoCo model with every mesh at its cycle-maximum stiffness."""
-    xi = np.linspace(0.0, 1.0, 2001)
-    k_max = np.array([np.max(model(xi)) for model in mb.excitation.models])
-    w2 = np.linalg.eigvalsh(_reduce(stiffness_matrix(mb, k_max), mass_matrix(mb)))
+    w2 = np.linalg.eigvalsh(_reduce(stiffness_matrix(mb, mb.excitation.max_stiffness), mass_matrix(mb)))
     return float(np.sqrt(max(w2.max(), 0.0)))
 
 

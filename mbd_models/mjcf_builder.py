@@ -314,8 +314,7 @@ def _stiffness_values(spec: TrainSpec, exc: Excitation, stiffness) -> np.ndarray
         if stiffness == "mean":
             return exc.mean_stiffness.copy()
         if stiffness == "max":
-            xi = np.linspace(0.0, 1.0, 2001)
-            return np.array([np.max(m(xi)) for m in exc.models])
+            return exc.max_stiffness.copy()
         raise ValueError(f"stiffness must be 'mean', 'max' or an array of N/m per mesh, not {stiffness!r}")
     values = np.asarray(stiffness, dtype=float)
     if values.shape != (len(spec.meshes),):

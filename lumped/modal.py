@@ -78,26 +78,19 @@ def _same(a: float, b: float) -> bool:
     return abs(a - b) <= DEGENERACY_TOLERANCE * max(abs(a), abs(b)) or (a == 0.0 and b == 0.0)
 
 
-def classify(model, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
-    spec = model.spec
-    dofs = model.dofs
-    mass = np.diag(model.M)
-    central_trans, central_rot, planet = [], [], []
-    for i, (member, dof) in enumerate(dofs.names):
-        if spec.members[member].is_planet:
-            planet.append(i)
-        elif dof == "theta":
-            central_rot.append(i)
-        else:
-            central_trans.append(i)
+def mode_types(M: np.ndarray, shapes: np.ndarray, frequencies: np.ndarray, translation, rotation) -> list[str]:
+    """Lin & Parker types from each mode's kinetic-energy fractions phi_g' M_gg phi_g / phi' M phi
+    in the central members' translations and rotations (index lists over the coordinates)."""
+    translation, rotation = list(translation), list(rotation)
     types = []
     for j, f in enumerate(frequencies):
         if f == 0.0:
             types.append("rigid")
             continue
-        energy = mass * shapes[:, j] ** 2
-        energy = energy / energy.sum()
-        trans, rot = energy[central_trans].sum(), energy[central_rot].sum()
+        phi = shapes[:, j]
+        total = phi @ M @ phi
+        trans = phi[translation] @ M[np.ix_(translation, translation)] @ phi[translation] / total
+        rot = phi[rotation] @ M[np.ix_(rotation, rotation)] @ phi[rotation] / total
         if trans < ENERGY_TOLERANCE and rot < ENERGY_TOLERANCE:
             types.append("planet")
         elif trans < ENERGY_TOLERANCE:
@@ -107,6 +100,13 @@ def classify(model, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
         else:
             types.append("mixed")
     return types
+
+
+def classify(model, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
+    central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
+               if not model.spec.members[member].is_planet]
+    return mode_types(model.M, shapes, frequencies, [i for i, d in central if d != "theta"],
+                      [i for i, d in central if d == "theta"])
 
 
 def modes(model) -> ModalResult:

@@ -9,8 +9,8 @@ enter: the model is linearised at qvel = 0.
 
 Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions
 phi_S' M_SS phi_S / phi' M phi of the central members' slides (translation), the central
-members' hinges (rotation) and the planets' joints; a fraction below
-:data:`ENERGY_TOLERANCE` counts as zero.  Zero amplitude of a group is a physical
+members' hinges (rotation) and the planets' joints, classified by
+:func:`lumped.modal.mode_types` (a fraction below its tolerance counts as zero).  Zero amplitude of a group is a physical
 statement (the sun, ring and carrier do not translate / do not turn), so the types do
 not depend on MuJoCo's choice of coordinates (planet slides relative to the carrier).
 """
@@ -20,11 +20,10 @@ from __future__ import annotations
 import numpy as np
 import mujoco
 
-from lumped.modal import ModalResult, generalized_modes, multiplicities
+from lumped.modal import ModalResult, generalized_modes, mode_types, multiplicities
 
 from .mjcf_builder import MbdModel, compile_train
 
-ENERGY_TOLERANCE = 1e-8
 FD_STEP = 1e-6  # m or rad; the spring forces are linear in qpos, so the step only sets rounding
 
 
@@ -99,33 +98,10 @@ def joint_labels(mb: MbdModel) -> list[str]:
 
 
 def classify(mb: MbdModel, M: np.ndarray, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
-    """Lin & Parker mode types from kinetic-energy fractions over MuJoCo's joints."""
-    trans, rot, planet = [], [], []
-    for mid, member in mb.spec.members.items():
-        x, y, rz = mb.dadr[mid]
-        if member.is_planet:
-            planet += [x, y, rz]
-        else:
-            trans += [x, y]
-            rot.append(rz)
-    types = []
-    for j, f in enumerate(frequencies):
-        if f == 0.0:
-            types.append("rigid")
-            continue
-        phi = shapes[:, j]
-        total = phi @ M @ phi
-        e_trans = phi[trans] @ M[np.ix_(trans, trans)] @ phi[trans] / total
-        e_rot = phi[rot] @ M[np.ix_(rot, rot)] @ phi[rot] / total
-        if e_trans < ENERGY_TOLERANCE and e_rot < ENERGY_TOLERANCE:
-            types.append("planet")
-        elif e_trans < ENERGY_TOLERANCE:
-            types.append("rotational")
-        elif e_rot < ENERGY_TOLERANCE:
-            types.append("translational")
-        else:
-            types.append("mixed")
-    return types
+    """Lin & Parker mode types from kinetic-energy fractions over MuJoCo's own joints."""
+    central = [mb.dadr[mid] for mid, member in mb.spec.members.items() if not member.is_planet]
+    return mode_types(M, shapes, frequencies, [i for x, y, _ in central for i in (x, y)],
+                      [rz for _, _, rz in central])
 
 
 def mujoco_modes(spec, mb: MbdModel | None = None) -> ModalResult:

@@ -60,14 +60,19 @@ def _moved_rel(new, old, tol) -> bool:
     return abs(new - old) > tol * max(abs(old), 1e-300)
 
 
+def check_settings(baseline: dict, duration: float, input_speed_rpm: float) -> None:
+    """Refuse to compare runs made at another speed or over another duration than the baseline."""
+    if abs(duration - baseline["duration_s"]) > 1e-12 or \
+            abs(input_speed_rpm - baseline["input_speed_rpm"]) > 1e-9 * baseline["input_speed_rpm"]:
+        raise GearcheckError(f"baseline of {baseline['train']} was taken at {baseline['input_speed_rpm']:.6g} rpm over "
+                             f"{baseline['duration_s']:.6g} s; run with --speed and --duration to match")
+
+
 def compare_to_baseline(result, baseline: dict) -> list[str]:
     """Descriptions of every metric that moved by more than its tolerance (empty: none did)."""
     now = snapshot(result)
     moved = []
-    if abs(now["duration_s"] - baseline["duration_s"]) > 1e-12 or \
-            abs(now["input_speed_rpm"] - baseline["input_speed_rpm"]) > 1e-9 * baseline["input_speed_rpm"]:
-        raise GearcheckError(f"baseline of {baseline['train']} was taken at {baseline['input_speed_rpm']:.6g} rpm over "
-                             f"{baseline['duration_s']:.6g} s; run with --speed and --duration to match")
+    check_settings(baseline, now["duration_s"], now["input_speed_rpm"])
     tol_f = baseline["modes_tolerance"]
     for old, new in zip(baseline["modes"], now["modes"]):
         for key in ("lumped_hz", "mujoco_hz"):

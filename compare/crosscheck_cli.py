@@ -10,7 +10,7 @@ from pathlib import Path
 from lumped import load_train, preset_names
 from lumped.errors import GearcheckError
 
-from .baseline import BASELINE_DIR, compare_to_baseline, read_baseline, write_baseline
+from .baseline import BASELINE_DIR, check_settings, compare_to_baseline, read_baseline, write_baseline
 from .crosscheck import crosscheck
 from .measurements import attach, load_measurements
 from .progress import ProgressBar
@@ -29,6 +29,11 @@ def _baseline_path(args, spec) -> Path | None:
 def run_one(args, spec, out: Path) -> tuple[dict, list[str]]:
     """Cross-check ``spec``, write its report into ``out``; return (report data, moved baseline metrics)."""
     tolerances = Tolerances.for_train(spec, args.tolerances)
+    baseline = _baseline_path(args, spec)
+    stored = None
+    if baseline is not None and not args.update_baseline:
+        stored = read_baseline(baseline)  # before the run: a mismatch is refused at once
+        check_settings(stored, args.duration, spec.operating.input_speed * 60 / (2 * math.pi))
     bar = ProgressBar(f"crosscheck {spec.name}")
     result = crosscheck(spec, duration=args.duration, tolerances=tolerances, dt_lumped=args.dt_lumped,
                         dt_mujoco=args.dt_mujoco, sensor_band=args.sensor_band, progress=bar)
@@ -38,12 +43,10 @@ def run_one(args, spec, out: Path) -> tuple[dict, list[str]]:
         entries += load_measurements(args.measurements)
     attach(result, entries)
     moved = []
-    baseline = _baseline_path(args, spec)
-    if baseline is not None:
-        if args.update_baseline:
-            write_baseline(result, baseline)
-        else:
-            moved = compare_to_baseline(result, read_baseline(baseline))
+    if baseline is not None and args.update_baseline:
+        write_baseline(result, baseline)
+    elif stored is not None:
+        moved = compare_to_baseline(result, stored)
     data = write_report(result, out)
     return data, moved
 

@@ -163,6 +163,22 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]]]]:
     return tables
 
 
+UNIT_SUFFIXES = (("_rad_s", "rad/s"), ("_s", "s"), ("_hz", "Hz"))
+
+
+def _settings_line(settings: dict) -> str:
+    parts = []
+    for key, value in settings.items():
+        unit = ""
+        for suffix, name in UNIT_SUFFIXES:
+            if key.endswith(suffix):
+                key, unit = key[: -len(suffix)], f" {name}"
+                break
+        shown = _fmt(value, 6) if isinstance(value, float) else value
+        parts.append(f"{key.replace('_', ' ')} {shown}{unit}")
+    return ", ".join(parts)
+
+
 def _summary_lines(data) -> list[str]:
     s = data["settings"]
     verdict = "PASS" if data["verdict"]["passed"] else "FAIL: " + ", ".join(data["verdict"]["failures"])
@@ -174,8 +190,8 @@ def _summary_lines(data) -> list[str]:
         f"- Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
         f" simulated {s['duration']['value']:.6g} s; steady window from {data['steady_state']['start']['value']:.6g} s"
         f" ({'detected' if data['steady_state']['detected'] else 'NOT detected: second half used'})",
-        f"- Lumped solver: {s['lumped']}",
-        f"- MuJoCo solver: {s['mujoco']}",
+        f"- Lumped solver: {_settings_line(s['lumped'])}",
+        f"- MuJoCo solver: {_settings_line(s['mujoco'])}",
         f"- gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "
         f"NumPy {p['numpy_version']}, Python {p['python']}, {p['machine']}; train {p['train_file']} "
         f"sha256 {p['train_sha256'][:16]}…",

@@ -2,8 +2,10 @@
 
 The mesh position xi is the number of mesh cycles elapsed (one cycle = one base pitch
 of travel along the line of action); xi = 0 is the instant a new tooth pair enters
-contact.  Every model is a class with a ``name``, the extra ``parameters`` it reads
-from the train file's ``stiffness`` table, a ``mean`` and ``__call__(xi) -> k``.
+contact.  Every model is a class with a ``name``, a ``parameters`` table (the schema of
+its keys in the train file's ``stiffness`` table, checked and converted to SI like any
+other field), a ``mean`` and ``__call__(xi) -> k``; it is built from those parameters
+and the mesh (:class:`lumped.spec.MeshSpec`: both gears and the operating geometry).
 Both solvers call the same objects, so a new model is one new class registered in
 :data:`MODELS`.
 """
@@ -14,16 +16,18 @@ import math
 
 import numpy as np
 
+from .schema import Positive, Table
+
 
 class MeshStiffness:
-    """Base class; subclasses set ``name`` and implement ``__call__``."""
+    """Base class; subclasses set ``name``, ``parameters`` and implement ``__call__``."""
 
     name = ""
-    parameters: dict[str, str] = {}
+    parameters = Table({"mean": Positive("mean mesh stiffness over a mesh cycle", "N/m")})
 
-    def __init__(self, params: dict, contact_ratio: float):
+    def __init__(self, params: dict, mesh):
         self.mean = float(params["mean"])
-        self.contact_ratio = contact_ratio
+        self.contact_ratio = mesh.geometry.contact_ratio
 
     def __call__(self, xi):
         raise NotImplementedError
@@ -57,11 +61,11 @@ class RectangularStiffness(MeshStiffness):
 
     name = "rectangular"
 
-    def __init__(self, params: dict, contact_ratio: float):
-        super().__init__(params, contact_ratio)
-        self.pairs_low = math.floor(contact_ratio)
-        self.multi_fraction = contact_ratio - self.pairs_low
-        self.pair_stiffness = self.mean / contact_ratio
+    def __init__(self, params: dict, mesh):
+        super().__init__(params, mesh)
+        self.pairs_low = math.floor(self.contact_ratio)
+        self.multi_fraction = self.contact_ratio - self.pairs_low
+        self.pair_stiffness = self.mean / self.contact_ratio
 
     def pairs(self, xi):
         frac = np.mod(np.asarray(xi, dtype=float), 1.0)
@@ -75,6 +79,5 @@ MODELS: dict[str, type[MeshStiffness]] = {cls.name: cls for cls in (ConstantStif
 
 
 def stiffness_model(mesh) -> MeshStiffness:
-    """The stiffness object of a :class:`~lumped.spec.MeshSpec`."""
-    params = mesh.stiffness
-    return MODELS[params["model"]](params, mesh.geometry.contact_ratio)
+    """The stiffness object of a :class:`~lumped.spec.MeshSpec` (parameters already checked, SI)."""
+    return MODELS[mesh.stiffness["model"]](mesh.stiffness, mesh)

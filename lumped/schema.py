@@ -283,11 +283,10 @@ PLANET_BEARING = Table(
 
 STIFFNESS = Table(
     {
-        "model": Text("mesh stiffness model (see lumped/mesh_stiffness.py)", "rectangular",
-                      ("constant", "rectangular")),
-        "mean": Positive("mean mesh stiffness over a mesh cycle", "N/m"),
+        "model": Text("mesh stiffness model; its parameters are listed under *Mesh stiffness models*",
+                      "rectangular"),
     },
-    "time-varying mesh stiffness model and its parameters",
+    "time-varying mesh stiffness model and its parameters (checked by the model's own table)",
     default=None,
     open=True,
 )

@@ -428,22 +428,21 @@ def _build_stage(st: dict, path: str, fail):
 
 
 def _check_stiffness(params: dict, path: str, fail):
+    """Check a ``stiffness`` table against its model's parameter table; store SI values in place."""
     from .mesh_stiffness import MODELS
+    from .schema import Context
 
-    model = MODELS[params["model"]]
-    extra = set(params) - {"model", "mean"} - set(model.parameters)
-    if extra:
+    name = params["model"]
+    if name not in MODELS:
         import difflib
 
-        key = sorted(extra)[0]
-        close = difflib.get_close_matches(key, list(model.parameters) + ["mean", "model"], n=1)
+        close = difflib.get_close_matches(name, list(MODELS), n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise fail(f"{path}.{key}", f"unknown key for the {params['model']!r} model{hint}")
-    for key in model.parameters:
-        value = params.get(key)
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
-                                  or not math.isfinite(value) or value <= 0):
-            raise fail(f"{path}.{key}", f"must be a positive finite number, got {value!r}")
+        raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{hint}")
+    values = {k: v for k, v in params.items() if k != "model"}
+    checked = MODELS[name].parameters.parse(values, path, Context(fail("", "").source))
+    params.clear()
+    params.update({"model": name, **checked})
 
 
 def _assembly_number(a: tuple[Gear, Gear], b: tuple[Gear, Gear]) -> tuple[int, int]:

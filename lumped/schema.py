@@ -503,26 +503,3 @@ def _row(path: str, spec, note: str = "") -> str:
         doc += " (" + ", ".join(spec.choices) + ")"
     return f"| `{path}` | {spec.type_name()} | {spec.unit or '-'} | {default} | {doc} |"
 
-
-def update_readme(path) -> bool:
-    """Rewrite the block between the README's schema markers; True when it changed."""
-    from pathlib import Path
-
-    path = Path(path)
-    text = path.read_text(encoding="utf-8")
-    begin, end = "<!-- schema:begin -->\n", "<!-- schema:end -->"
-    head, rest = text.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    new = head + begin + markdown_reference() + end + tail
-    path.write_text(new, encoding="utf-8")
-    return new != text
-
-
-if __name__ == "__main__":  # python -m lumped.schema --update-readme [README.md]
-    import sys
-
-    if sys.argv[1:2] == ["--update-readme"]:
-        target = sys.argv[2] if len(sys.argv) > 2 else "README.md"
-        print(f"{target}: {'updated' if update_readme(target) else 'already current'}")
-    else:
-        sys.stdout.write(markdown_reference())

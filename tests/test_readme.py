@@ -4,17 +4,15 @@ exactly two fresh-machine commands, the second of which is what .ci/run runs."""
 import re
 from pathlib import Path
 
-from lumped.schema import markdown_reference
+from lumped.docs import BLOCKS, block
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def test_field_reference_matches_the_schema():
+def test_generated_references_match_the_code():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    block = re.search(r"<!-- schema:begin -->\n(.*?)<!-- schema:end -->", text, flags=re.S)
-    assert block, "README lost its schema markers"
-    assert block.group(1) == markdown_reference(), (
-        "README field reference is stale: python -m lumped.schema --update-readme")
+    for name, make in BLOCKS.items():
+        assert block(text, name) == make(), f"README {name} reference is stale: python -m lumped.docs"
 
 
 def test_two_setup_commands_and_ci_runs_the_test_one():

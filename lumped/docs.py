@@ -1,0 +1,51 @@
+"""The README's generated reference: train-file fields and mesh stiffness models.
+
+``python -m lumped.docs [README.md]`` rewrites the blocks between the README's
+``<!-- schema:begin -->``/``<!-- schema:end -->`` and ``<!-- models:begin -->``/
+``<!-- models:end -->`` markers; ``tests/test_readme.py`` fails when they are stale.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from .mesh_stiffness import MODELS
+from .schema import _row, markdown_reference
+
+
+def models_reference() -> str:
+    """One table of every mesh stiffness model's parameters."""
+    rows = ["| model | parameter | type | unit | default | meaning |", "|---|---|---|---|---|---|"]
+    for name, cls in MODELS.items():
+        doc = (cls.__doc__ or "").strip().splitlines()[0]
+        rows.append(f"| `{name}` | | | | | {doc} |")
+        for key, spec in cls.parameters.fields.items():
+            rows.append(_row(key, spec).replace(f"| `{key}` |", f"| | `{key}` |", 1))
+    return "\n".join(rows) + "\n"
+
+
+BLOCKS = {"schema": markdown_reference, "models": models_reference}
+
+
+def block(text: str, name: str) -> str:
+    begin, end = f"<!-- {name}:begin -->\n", f"<!-- {name}:end -->"
+    return text.split(begin, 1)[1].split(end, 1)[0]
+
+
+def update_readme(path) -> bool:
+    """Rewrite every generated block of the README; True when something changed."""
+    path = Path(path)
+    text = original = path.read_text(encoding="utf-8")
+    for name, make in BLOCKS.items():
+        begin, end = f"<!-- {name}:begin -->\n", f"<!-- {name}:end -->"
+        head, rest = text.split(begin, 1)
+        _, tail = rest.split(end, 1)
+        text = head + begin + make() + end + tail
+    path.write_text(text, encoding="utf-8")
+    return text != original
+
+
+if __name__ == "__main__":
+    target = sys.argv[1] if len(sys.argv) > 1 else "README.md"
+    print(f"{target}: {'updated' if update_readme(target) else 'already current'}")

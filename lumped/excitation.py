@@ -68,6 +68,7 @@ class Excitation:
         op = spec.operating
         self._ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
         self._function = None
+        self._profile = None if op.torque_profile is None else tuple(np.asarray(x) for x in op.torque_profile)
         if op.torque_function:
             module, _, name = op.torque_function.partition(":")
             self._function = getattr(importlib.import_module(module), name)
@@ -149,4 +150,8 @@ class Excitation:
                 t_out = t_out + t_out_mean * wave
         if self._function is not None:
             t_in = t_in + np.vectorize(self._function, otypes=[float])(t)
+        if self._profile is not None:
+            times, values = self._profile
+            phase = times[0] + np.mod(t - times[0], times[-1] - times[0])
+            t_in = t_in + np.interp(phase, times, values)
         return t_in, t_out

@@ -392,6 +392,8 @@ OPERATING = Table(
         "ripple": TableList(RIPPLE, "torque ripple harmonics", default=()),
         "torque_function": Text("Python `module:function` f(t) -> N·m added to the input torque", None,
                                 pattern=r"[A-Za-z_][\w.]*:[A-Za-z_]\w*"),
+        "torque_csv": Text("CSV file (relative to the train file) of time [s], torque [N·m] added to the input "
+                           "torque, repeated with the file's period", None),
         "ramp_s": NonNegative("duration of the smooth start-up ramp of the load torque (0 = start at the "
                               "static deflection)", "s"),
     },

@@ -109,6 +109,7 @@ class Operating:
     input_shaft_damping: float
     ripple: tuple[Ripple, ...]
     torque_function: str | None
+    torque_profile: tuple[tuple[float, ...], tuple[float, ...]] | None  # (times, torques) from torque_csv
     ramp: float
 
 
@@ -210,8 +211,9 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         ripples.append(Ripple(r["member"], r["order"], r["frequency_hz"], r["amplitude"], r["phase"]))
     if op["torque_function"] is not None:
         _check_torque_function(op["torque_function"], fail)
+    profile = _torque_profile(op["torque_csv"], source, fail) if op["torque_csv"] is not None else None
     operating = Operating(op["input_speed"], op["output_torque"], op["input_shaft_stiffness"],
-                          op["input_shaft_damping"], tuple(ripples), op["torque_function"], op["ramp_s"])
+                          op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"])
 
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,
@@ -249,6 +251,35 @@ def _known(ref: str, members) -> str:
 
     close = difflib.get_close_matches(ref, list(members), n=1)
     return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
+
+
+def _torque_profile(name: str, source: str, fail):
+    """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
+    from pathlib import Path
+
+    import numpy as np
+
+    base = Path(source).parent if not source.startswith("preset:") else Path(__file__).parent / "presets"
+    path = base / name
+    try:
+        data = np.loadtxt(path, delimiter=",", ndmin=2, skiprows=_header_rows(path))
+    except (OSError, ValueError) as exc:
+        raise fail("operating.torque_csv", f"cannot read {path}: {exc}") from None
+    if data.shape[1] != 2 or data.shape[0] < 2:
+        raise fail("operating.torque_csv", f"{path} needs two columns (time, torque) and at least two rows")
+    if not np.all(np.isfinite(data)) or np.any(np.diff(data[:, 0]) <= 0):
+        raise fail("operating.torque_csv", f"{path}: times must increase strictly and all values be finite")
+    return tuple(data[:, 0]), tuple(data[:, 1])
+
+
+def _header_rows(path) -> int:
+    with open(path, encoding="utf-8") as f:
+        first = f.readline()
+    try:
+        [float(x) for x in first.split(",")]
+        return 0
+    except ValueError:
+        return 1
 
 
 def _check_torque_function(ref: str, fail):

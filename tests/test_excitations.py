@@ -54,3 +54,21 @@ def test_load_ramp_settles_to_the_state_reached_from_the_static_start():
     assert a.mesh_force[0, 0] < 0.05 * b.mesh_force[0, 0]  # the ramped run starts unloaded
     tail = a.t > 0.07
     np.testing.assert_allclose(a.mesh_force[tail], b.mesh_force[tail], rtol=0, atol=2e-3 * b.static_mesh_force[0])
+
+
+def test_torque_profile_from_a_csv_file(tmp_path):
+    """A periodic torque profile (time, torque) next to the train file adds to the input torque."""
+    from lumped.loader import load_train
+    from lumped.variants import edited_text
+
+    (tmp_path / "pulse.csv").write_text("time_s,torque_nm\n0.0,0.0\n0.005,40.0\n0.01,0.0\n")
+    path = tmp_path / "pulsed.toml"
+    path.write_text(edited_text("demo-3p", [(r"^input_shaft_damping = .*",
+                                             'input_shaft_damping = 2.0\ntorque_csv = "pulse.csv"')]))
+    exc = build_model(load_train(path)).excitation
+    t_in, _ = exc.torques(np.array([0.0025, 0.005, 0.0125, 0.02]))
+    np.testing.assert_allclose(t_in, [20.0, 40.0, 20.0, 0.0])
+    bad = tmp_path / "bad.toml"
+    bad.write_text(edited_text("demo-3p", [(r"^input_shaft_damping = .*", 'torque_csv = "missing.csv"')]))
+    with pytest.raises(Exception, match="operating.torque_csv: cannot read"):
+        load_train(bad)

@@ -104,10 +104,21 @@ class _System:
         force = self.F0 + self.b_in * t_in + self.b_out * t_out - self.D @ v - self.Kc @ q - self.A.T @ f
         return force * self.Minv
 
+    def accelerations(self, q, v, k, e, de, t_in, t_out):
+        """:meth:`acceleration` for many states at once (time along axis 0)."""
+        _, f = self.mesh_force(q, v, k, e, de)
+        force = (self.F0 + np.multiply.outer(t_in, self.b_in) + np.multiply.outer(t_out, self.b_out)
+                 - v @ self.D.T - q @ self.Kc.T - f @ self.A)
+        return force * self.Minv
+
     def load(self, k, e, de, t_in, t_out):
-        """The state-independent part of the generalized force, F0 + b T + A^T (k e + c de); time first."""
+        """The state-independent part of the generalized force while every mesh is on its drive flank
+        (delta - e > b, where the dead zone is delta - e - b): F0 + b T + A^T (k (e + b) + c de)."""
         force = self.F0 + np.multiply.outer(t_in, self.b_in) + np.multiply.outer(t_out, self.b_out)
-        return force + (k * e + self.c * de) @ self.A
+        return force + (k * (e + self.b) + self.c * de) @ self.A
+
+    def on_drive_flanks(self, q, e) -> bool:
+        return bool(np.all(self.A @ q - e > self.b))
 
 
 class _LinearStep:
@@ -119,8 +130,8 @@ class _LinearStep:
     Q_2 = h/6 (4 I + 2 Z + Z^2/2),  Q_3 = h/6 I,
     so a step costs four matrix-vector products instead of four right-hand sides.  The maps
     are cached per stiffness vector (a rectangular stiffness takes a few values per cycle).
-    Only for models without backlash; a step across a stiffness switch takes the stage-by-stage
-    path.
+    With backlash the map holds while every mesh stays on its drive flank; a step that starts or
+    ends off it, or crosses a stiffness switch, takes the stage-by-stage path.
     """
 
     def __init__(self, sys: _System, h: float):
@@ -166,6 +177,9 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
              progress=None) -> TimeResult:
     """Integrate ``model`` over ``duration`` seconds.
 
+    method: "rk4" (matrix form of each step where the model is linear over it), "rk4-stages" (the
+    same RK4, stage by stage everywhere: the reference the matrix form is tested against) or
+    one of scipy's adaptive methods.
     dt: RK4 step (default :func:`default_step`), checked against the stability limit;
     also the largest step of the adaptive methods.  output_dt: sampling of the result
     (default: every step).  settle: start of the steady-state window (default: the
@@ -181,13 +195,13 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
     q0, v0 = initial_state(model) if y0 is None else y0
     sys = _System(model)
     started = clock.perf_counter()
-    if method == "rk4":
-        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress)
+    if method in ("rk4", "rk4-stages"):
+        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, method == "rk4-stages")
         evaluations = 4 * n_steps
     elif method in ADAPTIVE_METHODS:
         t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
     else:
-        raise SolverError(f"unknown method {method!r}: use rk4 or one of {', '.join(ADAPTIVE_METHODS)}")
+        raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
     wall = clock.perf_counter() - started
     op = model.spec.operating
     settle = max(op.ramp, 0.5 * duration) if settle is None else settle
@@ -196,7 +210,7 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
     return _result(model, sys, t_out, q_out, v_out, settle, info)
 
 
-def _rk4(sys, q, v, h, n_steps, every, progress):
+def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False):
     n = q.size
     n_out = n_steps // every + 1
     t_out = np.empty(n_out)
@@ -204,7 +218,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress):
     v_out = np.empty((n_out, n))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     acc = sys.acceleration
-    linear = None if sys.has_backlash else _LinearStep(sys, h)
+    linear = None if stage_by_stage else _LinearStep(sys, h)
     stages = np.array(STAGE_OFFSETS)
     y = np.concatenate([q, v])
     j = 1
@@ -216,10 +230,16 @@ def _rk4(sys, q, v, h, n_steps, every, progress):
             load = sys.load(k, e, de, tin, tout)
             smooth = np.all(k[:, 0, :] == k[:, 1, :], axis=1) & np.all(k[:, 1, :] == k[:, 2, :], axis=1)
         for i in range(stop - start):
+            mapped = None
             if linear is not None and smooth[i]:
                 P, Q1, Q2, Q3 = linear.maps(k[i, 0])
-                y = P @ y + Q1 @ load[i, 0] + Q2 @ load[i, 1] + Q3 @ load[i, 2]
-            else:  # stage by stage: backlash, or a stiffness switch inside the step
+                mapped = P @ y + Q1 @ load[i, 0] + Q2 @ load[i, 1] + Q3 @ load[i, 2]
+                if sys.has_backlash and not (sys.on_drive_flanks(y[:n], e[i, 0])
+                                             and sys.on_drive_flanks(mapped[:n], e[i, 2])):
+                    mapped = None
+            if mapped is not None:
+                y = mapped
+            else:  # stage by stage: a contact change, or a stiffness switch inside the step
                 q, v = y[:n], y[n:]
                 d1 = (k[i, 0], e[i, 0], de[i, 0], tin[i, 0], tout[i, 0])
                 d2 = (k[i, 1], e[i, 1], de[i, 1], tin[i, 1], tout[i, 1])
@@ -262,7 +282,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
 def _result(model, sys, t, q, v, settle, info) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
     k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
-    qdd = np.array([sys.acceleration(q[i], v[i], k[i], e[i], de[i], tin[i], tout[i]) for i in range(t.size)])
+    qdd = sys.accelerations(q, v, k, e, de, tin, tout)
     delta, force = sys.mesh_force(q, v, k, e, de)
     spec, dofs = model.spec, model.dofs
     members = list(spec.members)
@@ -280,8 +300,10 @@ def _result(model, sys, t, q, v, settle, info) -> TimeResult:
         carrier = f"{member.stage}.carrier"
         angle[:, j] = model.kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
     bearings = [r for r in model.rows if r.kind == "bearing"]
-    bearing_force = np.array([[r.stiffness * (r.a @ q[i]) + r.damping * (r.a @ v[i]) for r in bearings]
-                              for i in range(t.size)]) if bearings else None
+    bearing_force = None
+    if bearings:
+        rows = np.array([r.a for r in bearings])
+        bearing_force = (q @ rows.T) * [r.stiffness for r in bearings] + (v @ rows.T) * [r.damping for r in bearings]
     static = static_solution(model)
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})

@@ -82,6 +82,18 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_crosscheck)
 
+    s = sub.add_parser("calibrate", help="least-squares fit of train-file parameters to measured amplitudes")
+    _train_arg(s)
+    s.add_argument("--fit", action="append", required=True, metavar="PATH[=LOW:HIGH]",
+                   help="a train-file field in its own units, e.g. stages[0].mesh.ste[0].amplitude_um=0.05:20")
+    s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]] "
+                                                                     "(default: the train file's)")
+    s.add_argument("--fit-speed", type=float, action="append", metavar="RPM",
+                   help="use only the measurements at this speed for the fit; the others are predicted")
+    s.add_argument("--duration", type=float, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)")
+    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
+    s.set_defaults(func=cmd_calibrate)
+
     s = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a train")
     _train_arg(s)
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)")
@@ -265,6 +277,34 @@ def _write_atomic(path: Path, text: str) -> None:
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text(text, encoding="utf-8")
     tmp.replace(path)
+
+
+def cmd_calibrate(args) -> int:
+    from lumped.loader import read_train_text
+
+    from .calibrate import FitParameter, calibrate
+    from .calibrate_report import write_calibration
+    from .measurements import load_measurements
+
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
+    text, source = read_train_text(args.train)
+    spec = load_train(args.train)
+    entries = load_measurements(args.measurements) if args.measurements else list(spec.measurements)
+    fits = [FitParameter.parse(f) for f in args.fit]
+    done = [0]
+
+    def progress(runs):
+        done[0] = runs
+        if sys.stderr.isatty():
+            print(f"\rcalibrate {spec.name}: {runs} runs", end="", file=sys.stderr, flush=True)
+
+    result = calibrate(text, source, entries, fits, args.duration, args.fit_speed, progress)
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    for line in write_calibration(result, spec.name, args.out):
+        print(line)
+    return 0
 
 
 def cmd_crosscheck(args) -> int:

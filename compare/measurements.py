@@ -3,8 +3,10 @@
 A value names a cross-check quantity, a statistic of its steady window (``peak``,
 ``rms``, ``peak_to_peak``), the value in the quantity's SI unit, optionally the input
 speed it was measured at (attached only when the run is at that speed) and its source.
-They come from the train file's ``[[measurements]]`` or a file given with
-``--measurements`` holding the same array.  Errors are (solver - measured)/|measured|.
+They come from the train file's ``[[measurements]]`` (and its ``measurements_file``) or a file
+given with ``--measurements`` holding the same array.  An entry may name the band of its
+measuring chain and the value the source's own model gave (``published_model``).  Errors are
+(model - measured)/|measured|.
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ from pathlib import Path
 
 from lumped.errors import GearcheckError, TrainFileError
 from lumped.schema import parse_measurements
+
+from .measure import chain_statistic
 
 SPEED_MATCH = 1e-6  # relative
 
@@ -30,9 +34,13 @@ def load_measurements(path: str | Path) -> list[dict]:
 
 
 def attach(result, entries) -> None:
-    """Add the measured column to ``result`` (a CrosscheckResult) for entries at its speed."""
+    """Add the measured column to ``result`` (a CrosscheckResult) for entries at its speed: both
+    solvers read through the entry's measuring chain (:func:`compare.measure.chain_statistic`)
+    over the cross-check's steady window."""
     speed = result.spec.operating.input_speed
     by_name = {q.name: q for q in result.quantities}
+    fs = result.settings["common_sample_rate_hz"]
+    window = result.grid >= result.steady_start_s
     rows = []
     for entry in entries:
         if entry.get("speed") is not None and abs(entry["speed"] - speed) > SPEED_MATCH * speed:
@@ -41,16 +49,23 @@ def attach(result, entries) -> None:
         if q is None:
             raise GearcheckError(f"measurement for unknown quantity {entry['quantity']!r} "
                                  f"(quantities: {', '.join(sorted(by_name))[:400]}...)")
-        metric = entry["metric"]
-        lumped, mujoco = q.metrics["reference"][metric], q.metrics["test"][metric]
-        value = entry["value"]
+        metric, band, value = entry["metric"], entry.get("sensor_band_hz"), entry["value"]
+        lumped, mujoco = (chain_statistic(x, window, fs, metric, band) for x in result.series[q.name])
+        published = entry.get("published_model")
         row = {
             "quantity": q.name, "metric": metric, "source": entry.get("source", ""),
+            "sensor_band": None if band is None else {"value": list(band), "unit": "Hz"},
             "measured": {"value": value, "unit": q.unit}, "lumped": {"value": lumped, "unit": q.unit},
             "mujoco": {"value": mujoco, "unit": q.unit},
-            "error_lumped": {"value": (lumped - value) / abs(value) if value else math.nan, "unit": "1"},
-            "error_mujoco": {"value": (mujoco - value) / abs(value) if value else math.nan, "unit": "1"},
+            "published_model": None if published is None else {"value": published, "unit": q.unit},
+            "error_lumped": {"value": _error(lumped, value), "unit": "1"},
+            "error_mujoco": {"value": _error(mujoco, value), "unit": "1"},
+            "error_published_model": None if published is None else {"value": _error(published, value), "unit": "1"},
         }
         q.measured.append(row)
         rows.append(row)
     result.measurements = rows
+
+
+def _error(model: float, measured: float) -> float:
+    return (model - measured) / abs(measured) if measured else math.nan

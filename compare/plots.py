@@ -21,7 +21,8 @@ def _save(fig, path):
 
 def headline_quantities(result) -> list[str]:
     """Carrier and ring accelerations (world y, as the accelerometers see them) and the first
-    sun-planet and ring-planet mesh forces of every stage."""
+    sun-planet and ring-planet mesh forces of every stage; the first four quantities when none
+    of those is compared."""
     names = []
     available = {q.name for q in result.quantities}
     for stage in result.spec.stages:
@@ -30,7 +31,10 @@ def headline_quantities(result) -> list[str]:
         for mesh in result.spec.meshes:
             if mesh.stage == stage.name and mesh.planet_index == 0:
                 names.append(f"{mesh.id}.force")
-    return [n for n in names if n in available]
+    names = [n for n in names if n in available]
+    if not names:  # trains compared on other quantities (e.g. a published 4-DOF model): the first four
+        names = [q.name for q in result.quantities][:4]
+    return names
 
 
 def _title(result, what: str) -> str:

@@ -155,11 +155,17 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]]]]:
     tables.append(("Spectral lines (Hann-windowed amplitude)",
                    ["quantity", "line", "f [Hz]", "lumped", "MuJoCo", "rel. err."], rows))
     if data["measurements"]:
+        def value(x, digits=4):
+            return _fmt(x and x["value"], digits)
+
         tables.append(("Measured reference values",
-                       ["quantity", "metric", "measured", "lumped", "MuJoCo", "err. lumped", "err. MuJoCo", "source"],
-                       [[m["quantity"], m["metric"], _fmt(m["measured"]["value"]), _fmt(m["lumped"]["value"]),
-                         _fmt(m["mujoco"]["value"]), _fmt(m["error_lumped"]["value"], 3),
-                         _fmt(m["error_mujoco"]["value"], 3), m["source"]] for m in data["measurements"]]))
+                       ["quantity", "metric", "chain band [Hz]", "measured", "published model", "lumped", "MuJoCo",
+                        "err. published", "err. lumped", "err. MuJoCo", "source"],
+                       [[m["quantity"], m["metric"], "—" if m["sensor_band"] is None else
+                         "–".join(f"{f:g}" for f in m["sensor_band"]["value"]), value(m["measured"]),
+                         value(m["published_model"]), value(m["lumped"]), value(m["mujoco"]),
+                         value(m["error_published_model"], 3), value(m["error_lumped"], 3), value(m["error_mujoco"], 3),
+                         m["source"]] for m in data["measurements"]]))
     return tables
 
 

@@ -24,6 +24,12 @@ midpoint, just before t + h.  A stiffness switch that falls on a step boundary i
 on the same side by every mesh, whatever the round-off in its phase (planets with equal
 phases stay identical, so the symmetry that mesh phasing relies on survives)."""
 
+STEP_WEIGHTS = (4.0 / 5.0, 1.0 / 5.0)
+"""Per-step drive (MuJoCo holds model fields and controls constant over a step after its first
+RK4 stage): stage 1 sees x(t), stages 2-4 see (4 x(t + h/2) + x(t + h))/5.  With RK4's stage
+weights (2, 2, 1)/6 this integrates a drive linear in time over the step exactly; a stiffness
+switch inside a step is then seen as a weighted mean, the same in both solvers."""
+
 
 def commensurate_step(h_max: float, mesh_frequencies, points_per_cycle: int) -> float:
     """The largest step <= h_max that divides the slowest mesh period into whole steps, with at

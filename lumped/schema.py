@@ -420,6 +420,10 @@ MEASUREMENT = Table(
         "metric": Text("which statistic of the steady window", REQUIRED, ("peak", "rms", "peak_to_peak")),
         "value": Number("the measured value, in the quantity's SI unit"),
         "speed_rpm": Positive("input speed the value was measured at (attached only at that speed)", "rpm", None),
+        "sensor_band_hz": ListOf(Positive("frequency", "Hz"), "band (low, high) of the measuring chain, applied to "
+                                 "both solvers' series before the statistic", None, unit="Hz"),
+        "uncertainty": Positive("relative standard uncertainty of the value (calibration weights)", "-", 0.1),
+        "published_model": Number("the value the source's own model gave (shown beside both solvers)", "", None),
         "source": Text("where the value comes from", ""),
     },
     "a measured reference value ([[measurements]])",
@@ -437,6 +441,8 @@ TRAIN_TABLE = Table(
         "output": Text("output member", REQUIRED),
         "held": ListOf(Text("member", REQUIRED),
                        "members held by their torsional support stiffness", ()),
+        "measurements_file": Text("a TOML file of [[measurements]] (relative to the train file) shown in every "
+                                  "cross-check and used by calibrate", None),
     },
     "identification and power flow",
 )

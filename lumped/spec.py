@@ -219,7 +219,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         name=train["name"], description=train["description"], source=train["source"], path=source,
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
         stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
-        text_hash=text_hash, measurements=tuple(data["measurements"]),
+        text_hash=text_hash, measurements=tuple(_measurements(data, source, fail)),
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
     )
 
@@ -253,14 +253,42 @@ def _known(ref: str, members) -> str:
     return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
 
 
-def _torque_profile(name: str, source: str, fail):
-    """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
+def _beside(source: str, name: str):
+    """A file named in a train file: relative to that file (presets and their edited variants: the presets
+    folder)."""
     from pathlib import Path
 
+    base = Path(__file__).parent / "presets" if source.startswith("preset:") else Path(source).parent
+    return base / name
+
+
+def _measurements(data: dict, source: str, fail) -> list[dict]:
+    """Inline [[measurements]] plus those of train.measurements_file, checked; bands sorted."""
+    import tomllib
+
+    from .schema import parse_measurements
+
+    entries = list(data["measurements"])
+    name = data["train"]["measurements_file"]
+    if name is not None:
+        path = _beside(source, name)
+        try:
+            document = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (OSError, tomllib.TOMLDecodeError) as exc:
+            raise fail("train.measurements_file", f"cannot read {path}: {exc}") from None
+        entries += parse_measurements(document, str(path))
+    for j, entry in enumerate(entries):
+        band = entry.get("sensor_band_hz")
+        if band is not None and (len(band) != 2 or band[0] >= band[1]):
+            raise fail(f"measurements[{j}].sensor_band_hz", f"needs [low, high] with low < high, got {band}")
+    return entries
+
+
+def _torque_profile(name: str, source: str, fail):
+    """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
     import numpy as np
 
-    base = Path(source).parent if not source.startswith("preset:") else Path(__file__).parent / "presets"
-    path = base / name
+    path = _beside(source, name)
     try:
         data = np.loadtxt(path, delimiter=",", ndmin=2, skiprows=_header_rows(path))
     except (OSError, ValueError) as exc:

@@ -13,8 +13,13 @@ step above ``STABILITY_MARGIN`` times that limit and by default takes
 ``POINTS_PER_PERIOD`` steps per period of the highest natural frequency (with the mesh
 stiffness at its cycle maximum) and ``POINTS_PER_MESH_CYCLE`` per mesh cycle, made a
 whole fraction of the slowest mesh period (:func:`lumped.excitation.commensurate_step`).
-The drive is evaluated at t + h (eps, 1/2, 1 - eps) for RK4's stages
-(:data:`lumped.excitation.STAGE_OFFSETS`).
+The drive is sampled at t + h (eps, 1/2, 1 - eps) (:data:`lumped.excitation.STAGE_OFFSETS`).
+By default (``drive="steps"``) RK4's first stage sees x(t + eps) and the other three
+(4 x(t + h/2) + x(t + h - eps))/5, exactly as the MuJoCo runner drives its model
+(:data:`lumped.excitation.STEP_WEIGHTS`): exact for drives linear over a step, and a
+stiffness switch inside a step is treated alike by both solvers, so what the cross-check
+measures is the models, not two treatments of a discontinuity.  ``drive="stages"`` is the
+textbook RK4 with the drive at each stage's own time.
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
 from .errors import DivergenceError, SolverError
-from .excitation import STAGE_OFFSETS, commensurate_step
+from .excitation import STAGE_OFFSETS, STEP_WEIGHTS, commensurate_step
 from .results import TimeResult
 from .static import deadzone, mean_load, static_solution
 
@@ -154,7 +159,7 @@ class _LinearStep:
             Q1 = h / 6 * (I + Z + Z2 / 2 + Z3 / 4) @ to_v
             Q2 = h / 6 * (4 * I + 2 * Z + Z2 / 2) @ to_v
             Q3 = h / 6 * to_v
-            self.cache[key] = (P, Q1, Q2, Q3)
+            self.cache[key] = (P, Q1, Q2, Q3, Q2 + Q3)
         return self.cache[key]
 
 
@@ -174,12 +179,13 @@ def mechanical_energy(model, q, v) -> np.ndarray:
 
 def simulate(model, duration: float, dt: float | None = None, method: str = "rk4", output_dt: float | None = None,
              settle: float | None = None, rtol: float = 1e-8, atol: float = 1e-14, y0=None,
-             progress=None) -> TimeResult:
+             progress=None, drive: str = "steps") -> TimeResult:
     """Integrate ``model`` over ``duration`` seconds.
 
     method: "rk4" (matrix form of each step where the model is linear over it), "rk4-stages" (the
     same RK4, stage by stage everywhere: the reference the matrix form is tested against) or
     one of scipy's adaptive methods.
+    drive: "steps" (default, like-for-like with the MuJoCo runner) or "stages" (see the module doc).
     dt: RK4 step (default :func:`default_step`), checked against the stability limit;
     also the largest step of the adaptive methods.  output_dt: sampling of the result
     (default: every step).  settle: start of the steady-state window (default: the
@@ -195,8 +201,10 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
     q0, v0 = initial_state(model) if y0 is None else y0
     sys = _System(model)
     started = clock.perf_counter()
+    if drive not in ("steps", "stages"):
+        raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
     if method in ("rk4", "rk4-stages"):
-        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, method == "rk4-stages")
+        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, method == "rk4-stages", drive)
         evaluations = 4 * n_steps
     elif method in ADAPTIVE_METHODS:
         t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
@@ -205,12 +213,13 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
     wall = clock.perf_counter() - started
     op = model.spec.operating
     settle = max(op.ramp, 0.5 * duration) if settle is None else settle
-    info = {"method": method, "dt_s": dt, "steps": n_steps, "rhs_evaluations": evaluations, "wall_time_s": wall,
+    info = {"method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
+            "rhs_evaluations": evaluations, "wall_time_s": wall,
             "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms}
     return _result(model, sys, t_out, q_out, v_out, settle, info)
 
 
-def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False):
+def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="steps"):
     n = q.size
     n_out = n_steps // every + 1
     t_out = np.empty(n_out)
@@ -226,14 +235,19 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False):
         stop = min(start + CHUNK, n_steps)
         times = (np.arange(start, stop)[:, None] + stages[None, :]) * h
         k, e, de, tin, tout = sys.drive(times)
+        if drive == "steps":  # stages 2-4 all see the step's weighted drive (as MuJoCo's model fields)
+            k, e, de, tin, tout = (_per_step(x) for x in (k, e, de, tin, tout))
         if linear is not None:
             load = sys.load(k, e, de, tin, tout)
             smooth = np.all(k[:, 0, :] == k[:, 1, :], axis=1) & np.all(k[:, 1, :] == k[:, 2, :], axis=1)
         for i in range(stop - start):
             mapped = None
             if linear is not None and smooth[i]:
-                P, Q1, Q2, Q3 = linear.maps(k[i, 0])
-                mapped = P @ y + Q1 @ load[i, 0] + Q2 @ load[i, 1] + Q3 @ load[i, 2]
+                P, Q1, Q2, Q3, Q23 = linear.maps(k[i, 0])
+                if drive == "steps":
+                    mapped = P @ y + Q1 @ load[i, 0] + Q23 @ load[i, 1]
+                else:
+                    mapped = P @ y + Q1 @ load[i, 0] + Q2 @ load[i, 1] + Q3 @ load[i, 2]
                 if sys.has_backlash and not (sys.on_drive_flanks(y[:n], e[i, 0])
                                              and sys.on_drive_flanks(mapped[:n], e[i, 2])):
                     mapped = None
@@ -262,6 +276,13 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False):
         if progress is not None:
             progress(stop / n_steps)
     return t_out[:j], q_out[:j], v_out[:j]
+
+
+def _per_step(x: np.ndarray) -> np.ndarray:
+    """Drive samples (steps, 3 stage times, ...) -> stage 1 unchanged, stages 2-4 the weighted mean."""
+    out = x.copy()
+    out[:, 1] = out[:, 2] = STEP_WEIGHTS[0] * x[:, 1] + STEP_WEIGHTS[1] * x[:, 2]
+    return out
 
 
 def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):

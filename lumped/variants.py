@@ -22,8 +22,9 @@ def edited_text(preset: str, pairs) -> str:
     return text
 
 
-def edited(preset: str, pairs, name: str | None = None) -> TrainSpec:
-    return load_text(edited_text(preset, pairs), name or f"variant-of-{preset}")
+def edited(preset: str, pairs, label: str = "edited") -> TrainSpec:
+    """The edited preset; errors name it ``preset:NAME (label)`` and its files resolve beside the preset."""
+    return load_text(edited_text(preset, pairs), f"preset:{preset} ({label})")
 
 
 def chained(n_stages: int, radial_stiffness: float = 0.0) -> TrainSpec:

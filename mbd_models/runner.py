@@ -6,8 +6,8 @@ Per step (fixed step h, MuJoCo's RK4 integrator):
   clock, as the lumped solver) into ``m.tendon_stiffness``; a static transmission error
   e(t) shifts the tendons' spring length (``m.tendon_lengthspring`` = e -/+ b) and its
   rate enters as the generalized force J' c de/dt (``qfrc_applied``);
-* the input shaft's reference angle w_in t into the ``input_shaft`` position actuator
-  (w_in into its ``input_shaft_damper`` velocity actuator), the load torque T_out(t) and
+* the input speed w_in into the ``input_shaft`` integrated-velocity servo (whose activation
+  is the reference angle, 0 at t = 0) and its ``input_shaft_damper``, the load torque T_out(t) and
   any input torque into the ``output_load`` / ``input_torque`` motors;
 * the mesh tendons' world-frame slide coefficients rotated to the carrier's current
   angle (:meth:`MbdModel.refresh`; the angle-0 values came from ``mj_jac``).
@@ -45,7 +45,7 @@ import mujoco
 import numpy as np
 
 from lumped.errors import DivergenceError, SolverError
-from lumped.excitation import STAGE_OFFSETS, commensurate_step
+from lumped.excitation import STAGE_OFFSETS, STEP_WEIGHTS, commensurate_step
 from lumped.results import TimeResult
 
 from .linearise import max_angular_frequency
@@ -57,7 +57,6 @@ POINTS_PER_PERIOD = 20
 POINTS_PER_MESH_CYCLE = 64
 CHUNK = 10000
 DIVERGENCE_FACTOR = 1e3  # |delta| beyond this times the static scale counts as runaway
-STAGE_WEIGHT = (4.0 / 5.0, 1.0 / 5.0)  # weights of x(t + h/2) and x(t + h) for RK4 stages 2-4
 
 
 # --------------------------------------------------------------------------- time step
@@ -111,7 +110,7 @@ class _Drive:
         a = self.mb.actuator
         t_in, t_out = self.exc.torques(t)
         if "input_shaft" in a:
-            u[:, a["input_shaft"]] = self.w_in * t
+            u[:, a["input_shaft"]] = self.w_in  # the intvelocity servo integrates it into the reference angle
         if "input_shaft_damper" in a:
             u[:, a["input_shaft_damper"]] = self.w_in
         u[:, a["input_torque"]] = t_in
@@ -130,7 +129,7 @@ class _Drive:
             if x is None:
                 return None, None
             first = x[0::3]
-            later = STAGE_WEIGHT[0] * x[1::3] + STAGE_WEIGHT[1] * x[2::3]
+            later = STEP_WEIGHTS[0] * x[1::3] + STEP_WEIGHTS[1] * x[2::3]
             return first, later
 
         return split(k), split(u), split(e), split(de)
@@ -188,7 +187,7 @@ def static_state(mb: MbdModel, load_scale: float = 1.0, tol: float = 1e-13, max_
     Newton's method on r(q) = qacc(q) - qacc_steady(q), with MuJoCo's forward dynamics
     evaluated at the nominal speeds, every mesh at its mean stiffness and the Jacobian
     dr/dq by central differences; minimum-norm steps where a free rotation makes it
-    singular.  Backlash: solved first without the dead band, then with it.
+    singular.  Backlash: solved first without it, then with every mesh on its drive flank.
     """
     m = mb.model
     d = mujoco.MjData(m)
@@ -208,7 +207,10 @@ def static_state(mb: MbdModel, load_scale: float = 1.0, tol: float = 1e-13, max_
         q = m.qpos0.copy()
         iterations, res = 0, math.inf
         for band in (False, True):
-            m.tendon_lengthspring[t, 0] = -mb.half_backlash if band else 0.0
+            # with backlash the loaded teeth sit on their drive flanks: a spring whose rest length is
+            # +b (the dead band's upper edge) has the same force there and no flat zero-stiffness
+            # region for Newton to wander in (the lumped static solution does the same)
+            m.tendon_lengthspring[t, 0] = mb.half_backlash if band else 0.0
             m.tendon_lengthspring[t, 1] = mb.half_backlash if band else 0.0
             if band and not np.any(mb.half_backlash):
                 break
@@ -462,7 +464,7 @@ def _body_stiffness(mb: MbdModel, info, qpos, qvel, h):
     k_now = np.array([mdl(x) for mdl, x in zip(models, xi)], dtype=float)
     k_mid = np.array([mdl(x) for mdl, x in zip(models, xi + 0.5 * h * rate)], dtype=float)
     k_end = np.array([mdl(x) for mdl, x in zip(models, xi + h * rate)], dtype=float)
-    return k_now, STAGE_WEIGHT[0] * k_mid + STAGE_WEIGHT[1] * k_end
+    return k_now, STEP_WEIGHTS[0] * k_mid + STEP_WEIGHTS[1] * k_end
 
 
 # --------------------------------------------------------------------------- result

@@ -10,6 +10,7 @@ import pytest
 from compare.cli import main
 from compare.crosscheck import crosscheck
 from lumped import load_train
+from lumped.loader import preset_names
 
 DURATION = "0.05"
 
@@ -72,7 +73,7 @@ def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
     """CI's regression dashboard: every preset cross-checked, nothing moved from compare/baselines/."""
     assert main(["crosscheck", "--all", "--duration", DURATION, "--baseline", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert {r["train"] for r in summary["presets"]} == {"demo-3p", "demo-4p"}
+    assert {r["train"] for r in summary["presets"]} == set(preset_names())
     assert all(r["status"] == "PASS" and r["moved"] == 0 for r in summary["presets"])
     assert (tmp_path / "summary.html").read_text().count("report.html") == len(summary["presets"])
 

@@ -182,13 +182,16 @@ def test_backlash_mesh_separates_and_carries_no_force():
 
 def test_time_response_matches_lumped():
     """demo-3p at its operating point: steady mesh forces and the ring's world-frame accelerations of
-    MuJoCo and the lumped RK4 solver within 1 % normalised RMS, the difference shrinking with dt.
+    MuJoCo and the lumped RK4 solver within 1 % normalised RMS (issue 3's bound), and in fact within
+    1e-3, at the default step.
 
-    Measured (0.05 s, steady window from 0.025 s): at the default step 5.2e-4 (mesh force), 1.8e-3
-    (ring, world axes), 1.7e-3 (ring, carrier axes); at half the step 1.3e-4, 5.0e-4, 5.2e-4.  The
-    world-frame difference used to level off at 4e-3 because the lumped results were turned to world
-    axes by the carrier's nominal angle, not its actual one (nominal plus the wind-up theta_c =
-    -4.07 mrad, the input shaft twist); now both use the actual angle and it converges too.
+    Measured (0.05 s, steady window from 0.025 s), default step -> half step: mesh force 2.9e-5 ->
+    1.8e-5, ring world axes 1.70e-4 -> 1.70e-4, ring carrier axes 1.63e-4 -> 1.31e-4.  Both solvers
+    now drive their steps alike (stage 1 at t, stages 2-4 at the 4:1 weighted mean) and the input
+    servo is exact, so what is left is not the step but the models: MuJoCo turns the real geometry
+    by the carrier's finite wind-up and refreshes its mesh coefficients every step, the linear model
+    does neither (second order).  Before the integrated-velocity servo the differences were 5.2e-4
+    and 1.7e-3 and halved with the step.
     """
     spec = load_train("demo-3p")
     model = build_model(spec)
@@ -207,13 +210,13 @@ def test_time_response_matches_lumped():
         c_mj, c_lp = mj.acceleration("stage1.ring", "carrier"), lp.acceleration("stage1.ring", "carrier")
         carrier = max(nrms(c_mj[c].to_numpy()[w], c_lp[c].to_numpy()[w]) for c in ("ax", "ay"))
         table.append((h, force, world, carrier))
-        assert force < 0.01 and world < 0.01
+        assert force < 1e-3 and world < 1e-3 and carrier < 1e-3
     print("\n      dt [s]   mesh force   ring world   ring carrier axes  (normalised RMS difference)")
     for h, force, world, carrier in table:
         print(f"  {h:.4e}   {force:.3e}    {world:.3e}    {carrier:.3e}")
-    assert table[1][1] < 0.5 * table[0][1]  # mesh forces converge together
-    assert table[1][2] < 0.5 * table[0][2]  # and so do the ring accelerations in world axes
-    assert table[1][3] < 0.5 * table[0][3]  # and in carrier axes
+    # the step no longer dominates: halving it changes nothing by more than 10 % upwards
+    for col in (1, 2, 3):
+        assert table[1][col] < 1.1 * table[0][col]
 
 
 # ---------------------------------------------------------------------------------------------- steps

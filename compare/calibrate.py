@@ -1,0 +1,189 @@
+"""Least-squares calibration of uncertain train parameters against measured amplitudes.
+
+A parameter is addressed by its path in the train file, in the file's own units
+(``stages[0].mesh.ste[0].amplitude_um``, ``operating.output_torque``), with bounds.  The fit
+minimises sum_i ((ln y_i(p) - ln m_i)/s_i)^2 over ln p, y_i the lumped model's statistic of
+measurement i read through its measuring chain (:func:`compare.measure.measure`), m_i the
+measured value and s_i its relative uncertainty (``uncertainty``, default 0.1): relative
+errors, and positive parameters by construction.  Parameter uncertainties come from the
+Jacobian at the optimum, cov(ln p) = (J^T J)^-1 with the residuals already divided by s_i;
+they are the measurement uncertainties propagated, valid also when the fit is exactly
+determined (as many measurements as parameters), where the residuals carry no information.
+
+The honest protocol for a paper's table: fit on the measurements at one speed
+(``fit_speeds``), then predict the others and report the prediction errors.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+
+import numpy as np
+import tomli_w
+from scipy.optimize import least_squares
+
+from lumped import build_model
+from lumped.errors import GearcheckError
+from lumped.loader import load_text
+from lumped.time_solver import simulate
+
+from .measure import measure
+
+SPEED_MATCH = 1e-6
+
+
+@dataclass
+class FitParameter:
+    path: str
+    low: float
+    high: float
+    keys: list = field(default_factory=list)
+
+    @classmethod
+    def parse(cls, text: str) -> "FitParameter":
+        """``PATH`` or ``PATH=LOW:HIGH`` (bounds in the file's units; default 1/100 to 100 times the start)."""
+        path, _, bounds = text.partition("=")
+        keys = []
+        for part in path.split("."):
+            m = re.fullmatch(r"([A-Za-z_][\w\-]*)((?:\[\d+\])*)", part)
+            if not m:
+                raise GearcheckError(f"--fit {text!r}: {part!r} is not a key or key[index]")
+            keys.append(m.group(1))
+            keys += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+        low = high = math.nan
+        if bounds:
+            try:
+                low, high = (float(b) for b in bounds.split(":"))
+            except ValueError:
+                raise GearcheckError(f"--fit {text!r}: bounds must be LOW:HIGH numbers") from None
+            if not (0 < low < high and math.isfinite(high)):
+                raise GearcheckError(f"--fit {text!r}: need 0 < LOW < HIGH")
+        return cls(path, low, high, keys)
+
+    def get(self, document):
+        node = document
+        try:
+            for k in self.keys:
+                node = node[k]
+        except (KeyError, IndexError, TypeError):
+            raise GearcheckError(f"--fit {self.path}: no such field in the train file") from None
+        if isinstance(node, bool) or not isinstance(node, (int, float)):
+            raise GearcheckError(f"--fit {self.path}: {node!r} is not a number")
+        if node <= 0:
+            raise GearcheckError(f"--fit {self.path}: the start value {node} must be positive (fits are in ln p)")
+        return float(node)
+
+    def set(self, document, value: float) -> None:
+        node = document
+        for k in self.keys[:-1]:
+            node = node[k]
+        node[self.keys[-1]] = value
+
+
+@dataclass
+class Calibration:
+    names: list[str]
+    start: np.ndarray
+    fitted: np.ndarray
+    relative_uncertainty: np.ndarray  # standard uncertainty of each fitted value, relative
+    entries: list[dict]
+    speeds_rpm: list[float]
+    used: list[bool]  # which entries the fit used
+    before: list[float]  # model statistics with the start values
+    after: list[float]  # with the fitted values
+    evaluations: int
+    text: str  # the calibrated train file
+
+    def rows(self) -> list[dict]:
+        out = []
+        for entry, rpm, used, b, a in zip(self.entries, self.speeds_rpm, self.used, self.before, self.after):
+            m = entry["value"]
+            out.append({"quantity": entry["quantity"], "metric": entry["metric"], "speed_rpm": rpm,
+                        "measured": m, "published_model": entry.get("published_model"), "before": b, "after": a,
+                        "error_before": (b - m) / abs(m), "error_after": (a - m) / abs(m),
+                        "error_published_model": None if entry.get("published_model") is None
+                        else (entry["published_model"] - m) / abs(m),
+                        "role": "fit" if used else "prediction"})
+        return out
+
+
+def _speeds(entries, default_rpm):
+    out = []
+    for e in entries:
+        rpm = e.get("speed")
+        out.append(default_rpm if rpm is None else rpm * 60 / (2 * math.pi))
+    return out
+
+
+def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParameter], duration: float,
+              fit_speeds: list[float] | None = None, progress=None) -> Calibration:
+    """Fit ``fits`` of the train file ``text`` to the measurement ``entries`` (lumped solver)."""
+    document = tomllib.loads(text)
+    if not entries:
+        raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or --measurements")
+    base_spec = load_text(text, source)
+    base_rpm = base_spec.operating.input_speed * 60 / (2 * math.pi)
+    rpm = _speeds(entries, base_rpm)
+    used = [fit_speeds is None or any(abs(r - f) <= SPEED_MATCH * f for f in fit_speeds) for r in rpm]
+    if not any(used):
+        raise GearcheckError(f"no measurement at the fit speeds {fit_speeds} rpm (have {sorted(set(rpm))})")
+    start = np.array([f.get(document) for f in fits])
+    for f, x0 in zip(fits, start):
+        if math.isnan(f.low):
+            f.low, f.high = x0 / 100, x0 * 100
+        if not f.low <= x0 <= f.high:
+            raise GearcheckError(f"--fit {f.path}: start value {x0} outside its bounds {f.low}:{f.high}")
+    evaluations = 0
+
+    def model(values, which) -> list[float]:
+        nonlocal evaluations
+        doc = tomllib.loads(text)
+        for f, v in zip(fits, values):
+            f.set(doc, float(v))
+        spec = load_text(tomli_w.dumps(doc), source)
+        out = [math.nan] * len(entries)
+        for speed in sorted({rpm[i] for i in which}):
+            run = spec.with_operating(input_speed=speed * 2 * math.pi / 60)
+            lumped = build_model(run)
+            result = simulate(lumped, duration)
+            cycle = 1.0 / float(np.min(lumped.excitation.frequency))
+            idx = [i for i in which if rpm[i] == speed]
+            for i, value in zip(idx, measure(run, result, [entries[i] for i in idx], cycle)):
+                out[i] = value
+            evaluations += 1
+            if progress is not None:
+                progress(evaluations)
+        return out
+
+    fit_idx = [i for i, u in enumerate(used) if u]
+    measured = np.array([entries[i]["value"] for i in fit_idx])
+    sigma = np.array([entries[i]["uncertainty"] for i in fit_idx])
+
+    def residual(log_values):
+        y = np.array(model(np.exp(log_values), fit_idx))[fit_idx]
+        return (np.log(np.maximum(y, 1e-300)) - np.log(measured)) / sigma
+
+    solution = least_squares(residual, np.log(start), bounds=(np.log([f.low for f in fits]),
+                                                              np.log([f.high for f in fits])),
+                             diff_step=1e-2, xtol=1e-6, ftol=1e-8)
+    fitted = np.exp(solution.x)
+    J = solution.jac
+    try:
+        cov = np.linalg.inv(J.T @ J)
+        rel_unc = np.sqrt(np.clip(np.diag(cov), 0, None))
+    except np.linalg.LinAlgError:
+        rel_unc = np.full(len(fits), math.inf)
+    everything = list(range(len(entries)))
+    before = model(start, everything)
+    after = model(fitted, everything)
+    doc = tomllib.loads(text)
+    for f, v in zip(fits, fitted):
+        f.set(doc, float(v))
+    header = (f"# Calibrated by `gearcheck calibrate` from {source}: "
+              + ", ".join(f"{f.path} = {v:.6g}" for f, v in zip(fits, fitted))
+              + ".\n# The original file carries the comments that document every value.\n")
+    return Calibration([f.path for f in fits], start, fitted, rel_unc, entries, rpm, used, before, after,
+                       evaluations, header + tomli_w.dumps(doc))

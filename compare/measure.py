@@ -1,0 +1,50 @@
+"""The measurement chain: the number a test rig reports, computed from a solver's series.
+
+A measured amplitude is a statistic of the steady-state signal of one sensor: ``peak``
+(max |x|), ``rms`` or ``peak_to_peak``, after the sensor chain's band-pass when one is given
+(:func:`compare.align.sensor_filter`, zero phase, applied to the whole series before the
+window is cut so that the filter's start-up does not enter it).  The same function serves
+the cross-check's measured column and the calibration, so both read a solver the same way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .align import resample, sensor_filter, steady_start, uniform_grid
+from .quantities import extract
+
+STATISTICS = {
+    "peak": lambda x: float(np.max(np.abs(x))),
+    "rms": lambda x: float(np.sqrt(np.mean(x**2))),
+    "peak_to_peak": lambda x: float(np.ptp(x)),
+}
+
+
+def chain_statistic(x: np.ndarray, window: np.ndarray, fs: float, metric: str, band=None) -> float:
+    """``metric`` of ``x`` over the boolean ``window``, after the optional sensor ``band``."""
+    if band is not None:
+        x = sensor_filter(x, fs, tuple(band))
+    return STATISTICS[metric](x[window])
+
+
+def steady_window(grid: np.ndarray, forces: np.ndarray, cycle: float) -> tuple[np.ndarray, bool]:
+    """The steady window of a run from its mesh forces (time x meshes): from the detected start,
+    or the second half when no steady state is found."""
+    start = steady_start(grid, forces, cycle)
+    found = start is not None
+    return grid >= (start if found else 0.5 * grid[-1]), found
+
+
+def measure(spec, result, entries, cycle: float) -> list[float]:
+    """Each measurement entry's statistic from one solver's ``result`` (the calibration's model side)."""
+    quantities = extract(spec, result)
+    fs = (result.t.size - 1) / (result.t[-1] - result.t[0])
+    grid = uniform_grid(0.0, result.t[-1], fs)
+    forces = resample(result.t, result.mesh_force, grid)
+    window, _ = steady_window(grid, forces, cycle)
+    values = []
+    for entry in entries:
+        series = resample(result.t, quantities[entry["quantity"]][1], grid)
+        values.append(chain_statistic(series, window, fs, entry["metric"], entry.get("sensor_band_hz")))
+    return values

@@ -17,6 +17,7 @@ from lumped.errors import SolverError
 from .progress import ProgressBar
 
 SOLVERS = ("lumped", "mujoco")
+PUBLISHED_MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -68,7 +69,11 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file")
     s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
     s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
-    s.add_argument("--duration", type=float, default=0.1, metavar="S", help="simulated time (default 0.1 s)")
+    s.add_argument("--duration", type=float, metavar="S",
+                   help="simulated time (default 0.1 s; 0.02 s for a --model other than general)")
+    s.add_argument("--model", default="general", choices=("general",) + PUBLISHED_MODELS,
+                   help="lumped model checked against MuJoCo: gearcheck's general model (default) or a "
+                        "published 4-DOF model (double-planet: as-published, energy-derived, ...)")
     s.add_argument("--dt-lumped", type=float, metavar="S", help="lumped RK4 step (default: derived)")
     s.add_argument("--dt-mujoco", type=float, metavar="S", help="MuJoCo step (default: derived)")
     s.add_argument("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table")
@@ -312,6 +317,8 @@ def cmd_crosscheck(args) -> int:
 
     if args.all == (args.train is not None):
         raise GearcheckError("give a TRAIN or --all, not both")
+    if args.duration is None:
+        args.duration = 0.1 if args.model == "general" else 0.02
     if not (math.isfinite(args.duration) and args.duration > 0):
         raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
     if args.all:

@@ -35,8 +35,13 @@ def run_one(args, spec, out: Path) -> tuple[dict, list[str]]:
         stored = read_baseline(baseline)  # before the run: a mismatch is refused at once
         check_settings(stored, args.duration, spec.operating.input_speed * 60 / (2 * math.pi))
     bar = ProgressBar(f"crosscheck {spec.name}")
-    result = crosscheck(spec, duration=args.duration, tolerances=tolerances, dt_lumped=args.dt_lumped,
-                        dt_mujoco=args.dt_mujoco, sensor_band=args.sensor_band, progress=bar)
+    if args.model == "general":
+        result = crosscheck(spec, duration=args.duration, tolerances=tolerances, dt_lumped=args.dt_lumped,
+                            dt_mujoco=args.dt_mujoco, sensor_band=args.sensor_band, progress=bar)
+    else:
+        from .published import crosscheck_published
+
+        result = crosscheck_published(spec, model=args.model, duration=args.duration, tolerances=tolerances)
     bar.close()
     entries = list(spec.measurements)
     if args.measurements:

@@ -300,21 +300,6 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
     return sol.t, sol.y[:n].T, sol.y[n:].T, int(sol.nfev)
 
 
-def _to_pin_axes(model, bearings, force, q) -> None:
-    """Turn each planet's (radial, tangential) bearing force from the nominal carrier axes to the pin's
-    actual axes, which the carrier's vibration angle theta_c has turned (in place).  The radial
-    centripetal preload m Omega^2 r_c would otherwise show as a tangential force m Omega^2 r_c theta_c
-    on a wound-up carrier; MuJoCo's slides turn with the carrier and report the pin-axis force."""
-    index = {r.name: j for j, r in enumerate(bearings)}
-    for stage in model.spec.stages:
-        theta = q[:, model.dofs(stage.carrier, "theta")]
-        c, s = np.cos(theta), np.sin(theta)
-        for pid in stage.planets:
-            i, j = index[f"{pid}.bearing_radial"], index[f"{pid}.bearing_tangential"]
-            fr, ft = force[:, i].copy(), force[:, j].copy()
-            force[:, i], force[:, j] = c * fr + s * ft, -s * fr + c * ft
-
-
 def _result(model, sys, t, q, v, settle, info) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
     k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
@@ -340,7 +325,6 @@ def _result(model, sys, t, q, v, settle, info) -> TimeResult:
     if bearings:
         rows = np.array([r.a for r in bearings])
         bearing_force = (q @ rows.T) * [r.stiffness for r in bearings] + (v @ rows.T) * [r.damping for r in bearings]
-        _to_pin_axes(model, bearings, bearing_force, q)
     static = static_solution(model)
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})

@@ -33,6 +33,8 @@ from lumped.time_solver import simulate
 from .measure import measure
 
 SPEED_MATCH = 1e-6
+LOG_STEP = 0.05  # finite-difference step in ln p: a peak of a simulated signal is only piecewise smooth
+# in the parameters, so a 5 % step sees the trend, not the jitter of which sample is the largest
 
 
 @dataclass
@@ -168,7 +170,7 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
 
     solution = least_squares(residual, np.log(start), bounds=(np.log([f.low for f in fits]),
                                                               np.log([f.high for f in fits])),
-                             diff_step=1e-2, xtol=1e-6, ftol=1e-8)
+                             diff_step=LOG_STEP, x_scale=1.0, xtol=1e-4, ftol=1e-6)
     fitted = np.exp(solution.x)
     J = solution.jac
     try:

@@ -99,6 +99,11 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_calibrate)
 
+    s = sub.add_parser("stiffness", help="plot the mesh stiffness over the mesh cycle (PNG)")
+    _train_arg(s)
+    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)")
+    s.set_defaults(func=cmd_stiffness)
+
     s = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a train")
     _train_arg(s)
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)")
@@ -262,6 +267,17 @@ def cmd_run(args) -> int:
     return 0
 
 
+
+
+def cmd_stiffness(args) -> int:
+    from .plots import mesh_stiffness
+
+    spec = _load(args)
+    path = args.output or Path("out") / f"{spec.name}-stiffness.png"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    mesh_stiffness(spec, path)
+    print(f"wrote {path}")
+    return 0
 
 
 def cmd_mjcf(args) -> int:

@@ -65,6 +65,7 @@ class CrosscheckResult:
     series: dict  # quantity -> (a, b) on the grid
     wall_times: dict
     measurements: list[dict] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # findings stated in plain words in the report
 
     @property
     def failures(self) -> list[str]:
@@ -163,13 +164,7 @@ def crosscheck(spec, duration: float = 0.1, tolerances: Tolerances | None = None
         lines = [(name, f) for name, f in lines if f < 0.45 * fs]
         spectrum = spectral_metrics(xa, xb, fs, lines)
         tol = tolerances.lookup(n, q.kind, "nrmse")
-        negligible = max(metrics["reference"]["rms"], metrics["test"]["rms"]) < NEGLIGIBLE * scale[q.kind]
-        if negligible:
-            status = "negligible"
-        elif tol is None or (metrics["nrmse"] is not None and metrics["nrmse"] <= tol):
-            status = "pass"
-        else:
-            status = "fail"
+        status = verdict(metrics, tol, scale[q.kind])
         comparisons.append(QuantityComparison(n, q.kind, q.unit, q.description, status, metrics, spectrum, tol))
 
     settings = {
@@ -183,6 +178,15 @@ def crosscheck(spec, duration: float = 0.1, tolerances: Tolerances | None = None
     }
     return CrosscheckResult(spec, settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
                             comparisons, t0, found, (a, b), (lumped_modes, mujoco_modal), grid, series, wall)
+
+
+def verdict(metrics: dict, tolerance: float | None, scale: float) -> str:
+    """negligible (below NEGLIGIBLE x the largest of its kind in both solvers), pass or fail on NRMSE."""
+    if max(metrics["reference"]["rms"], metrics["test"]["rms"]) < NEGLIGIBLE * scale:
+        return "negligible"
+    if tolerance is None or (metrics["nrmse"] is not None and metrics["nrmse"] <= tolerance):
+        return "pass"
+    return "fail"
 
 
 def _radius(spec, member: str) -> float:

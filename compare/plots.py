@@ -134,3 +134,25 @@ FIGURES = {
     "natural_frequencies.png": natural_frequencies,
     "errors.png": error_bars,
 }
+
+
+def mesh_stiffness(spec, path, cycles: int = 2):
+    """k over ``cycles`` mesh cycles for the first planet's mesh with every central gear of every
+    stage (the model the train file names), with the number of tooth pairs in contact."""
+    from lumped.mesh_stiffness import stiffness_model
+
+    first = [m for m in spec.meshes if m.planet_index == 0]
+    fig, axes = plt.subplots(len(first), 1, figsize=(9, 2.0 * len(first)), sharex=True, squeeze=False)
+    xi = np.linspace(0.0, cycles, 2000 * cycles + 1)
+    for ax, mesh in zip(axes[:, 0], first):
+        model = stiffness_model(mesh)
+        ax.plot(xi, model(xi) / 1e9, color="tab:blue", lw=1.2, label="k(xi)")
+        ax.axhline(model.mean / 1e9, color="gray", ls="--", lw=0.8, label=f"mean {model.mean:.4g} N/m")
+        ax.set_ylabel("k [N/um]")
+        ax.set_title(f"{mesh.id} ({mesh.stiffness['model']}, contact ratio {mesh.geometry.contact_ratio:.4f})",
+                     fontsize=9)
+        ax.legend(loc="upper right", fontsize=7)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
+    fig.suptitle(f"{spec.name}: time-varying mesh stiffness", fontsize=9)
+    _save(fig, path)

@@ -89,6 +89,7 @@ def to_dict(result) -> dict:
         "modes_tolerance": _u(result.modal_tolerance, RATIO),
         "quantities": quantities,
         "measurements": result.measurements,
+        "notes": result.notes,
         "volatile": {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                      "wall_time": {k: _u(v, "s") for k, v in result.wall_times.items()}},
     }
@@ -210,6 +211,8 @@ def write_markdown(data, path: Path, figures: list[str]) -> None:
     lines = [f"# gearcheck cross-check: {data['train']['name']}", ""]
     lines += _summary_lines(data)
     lines += ["", _run_line(data), ""]
+    if data["notes"]:
+        lines += ["## Findings", ""] + [f"{note}\n" for note in data["notes"]]
     for title, header, rows in markdown_tables(data):
         lines += [f"## {title}", "", "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         lines += ["| " + " | ".join(r) + " |" for r in rows]
@@ -232,6 +235,8 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
     parts.append(f"<p>{esc(summary[0]).replace('**', '')}</p><ul>")
     parts += [f"<li>{esc(line[2:])}</li>" for line in summary[2:]]
     parts.append(f"</ul><p>{esc(_run_line(data))}</p>")
+    if data["notes"]:
+        parts.append("<h2>Findings</h2>" + "".join(f"<p>{esc(note)}</p>" for note in data["notes"]))
     for title, header, rows in markdown_tables(data):
         parts.append(f"<h2>{esc(title)}</h2><table><tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>")
         for r in rows:

@@ -285,6 +285,11 @@ def _sensors(spec: TrainSpec) -> list[str]:
     for stage in spec.stages:
         label = spec.members[stage.carrier].label
         lines.append(f'    <jointpos name="{label}_angle" joint="{label}_rz"/>')
+        lines.append(f'    <jointvel name="{label}_angle_rate" joint="{label}_rz"/>')
+    for mid, member in spec.members.items():
+        if not member.is_planet:
+            for axis in CENTRAL_AXES:
+                lines.append(f'    <jointpos name="{member.label}_{axis}_pos" joint="{member.label}_{axis}"/>')
     for mesh in spec.meshes:
         lines.append(f'    <tendonpos name="{mesh.label}_deflection" tendon="{mesh.label}"/>')
         lines.append(f'    <tendonvel name="{mesh.label}_rate" tendon="{mesh.label}"/>')
@@ -398,6 +403,9 @@ class MbdModel:
     rot_c0y: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rot_carrier_qadr: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
 
+    rot_tendon: np.ndarray = field(default_factory=lambda: np.zeros(0, int))  # per wrap, x wraps then y
+    rot_slide_qadr: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+
     def refresh(self, qpos: np.ndarray) -> None:
         """Rotate the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
         phi = qpos[self.rot_carrier_qadr]
@@ -405,6 +413,24 @@ class MbdModel:
         prm = self.model.wrap_prm
         prm[self.rot_wrap_x] = self.rot_c0x * c - self.rot_c0y * s
         prm[self.rot_wrap_y] = self.rot_c0x * s + self.rot_c0y * c
+
+    def coefficient_rate(self, phi, phidot, slide):
+        """The part of each mesh's deflection rate that a fixed tendon's J qvel misses: its world-frame
+        slide coefficients turn with the carrier, d/dt (c(phi) q) = c q' + (dc/dphi) phi' q.  Arguments
+        per rotating wrap (x wraps, then y wraps; time along axis 0 allowed): carrier angle, its rate,
+        the slide's position.  Returns one rate per mesh (m/s)."""
+        c0x = np.concatenate([self.rot_c0x, self.rot_c0x])
+        c0y = np.concatenate([self.rot_c0y, self.rot_c0y])
+        nx = len(self.rot_wrap_x)
+        sign = np.concatenate([np.zeros(nx), np.ones(nx)])  # x: c0x cos - c0y sin; y: c0x sin + c0y cos
+        s, c = np.sin(phi), np.cos(phi)
+        dc = np.where(sign == 0, -c0x * s - c0y * c, c0x * c - c0y * s)
+        terms = dc * phidot * slide
+        n_mesh = len(self.mesh_tendon)
+        out = np.zeros(np.shape(terms)[:-1] + (n_mesh,))
+        for t in range(n_mesh):
+            out[..., t] = terms[..., self.rot_tendon == t].sum(axis=-1)
+        return out
 
 
 def compile_train(spec: TrainSpec, stiffness="mean", _xml: str | None = None) -> MbdModel:
@@ -435,7 +461,7 @@ def compile_train(spec: TrainSpec, stiffness="mean", _xml: str | None = None) ->
                   model.tendon_damping[mesh_tendon].copy(), model.tendon_lengthspring[mesh_tendon, 1].copy(),
                   actuator, sensor)
     # world-frame slide pairs in every mesh tendon
-    wx, wy, cx, cy, ca = [], [], [], [], []
+    wx, wy, cx, cy, ca, tt, qx, qy = [], [], [], [], [], [], [], []
     for mesh, t in zip(spec.meshes, mesh_tendon):
         adr, n = model.tendon_adr[t], model.tendon_num[t]
         joint_at = {int(model.wrap_objid[adr + i]): adr + i for i in range(n)}
@@ -448,7 +474,12 @@ def compile_train(spec: TrainSpec, stiffness="mean", _xml: str | None = None) ->
             cx.append(model.wrap_prm[ix])
             cy.append(model.wrap_prm[iy])
             ca.append(qadr[stage.carrier][2])
+            tt.append(int(t))
+            qx.append(qadr[mid][0])
+            qy.append(qadr[mid][1])
     mb.rot_wrap_x, mb.rot_wrap_y = np.array(wx, int), np.array(wy, int)
     mb.rot_c0x, mb.rot_c0y = np.array(cx, float), np.array(cy, float)
     mb.rot_carrier_qadr = np.array(ca, int)
+    mb.rot_tendon = np.array(tt + tt, int)
+    mb.rot_slide_qadr = np.array(qx + qy, int)
     return mb

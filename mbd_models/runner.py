@@ -344,12 +344,30 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
     bodies = stiffness_clock == "bodies"
     fast = single and not has_te and not bodies and energy is None
     c_mesh = mb.mesh_damping
-    if has_te:
-        J = np.zeros((n_mesh, m.nv))
-        tadr, tnum, objid = m.tendon_adr, m.tendon_num, m.wrap_objid
-        w_rows = np.concatenate([np.full(tnum[i], i) for i in range(n_mesh)])
-        w_idx = np.concatenate([np.arange(tadr[i], tadr[i] + tnum[i]) for i in range(n_mesh)])
-        w_dofs = m.jnt_dofadr[objid[w_idx]]
+    # mesh damping on the true deflection rate: J qvel misses (dc/dphi) phi' q of the turning coefficients
+    J = np.zeros((n_mesh, m.nv))
+    tadr, tnum, objid = m.tendon_adr, m.tendon_num, m.wrap_objid
+    w_idx = np.concatenate([np.arange(tadr[i], tadr[i] + tnum[i]) for i in range(n_mesh)])
+    J[np.concatenate([np.full(tnum[i], i) for i in range(n_mesh)]), m.jnt_dofadr[objid[w_idx]]] = prm[w_idx]
+    rot_rows, rot_dofs = mb.rot_tendon, m.jnt_dofadr[objid[widx]]  # the entries that turn with the carrier
+    rot_q, rot_phi = mb.rot_slide_qadr, cadr2
+    rot_mesh = np.zeros((n_mesh, len(rot_q)))
+    rot_mesh[mb.rot_tendon, np.arange(len(rot_q))] = 1.0
+    dA = np.stack([A[:, 1], -A[:, 0]], axis=1)  # dc/dphi = dA @ (cos phi, sin phi)
+    applied = d.qfrc_applied
+
+    def damping_correction(de, cs=None):
+        """Generalized force c (de/dt - missing rate) J: the STE rate and the turning coefficients'
+        rate; ``cs`` = (cos, sin) of the single carrier angle when there is only one."""
+        J[rot_rows, rot_dofs] = prm[widx]
+        if cs is None:
+            phi = qpos[rot_phi]
+            dc = dA[:, 0] * np.cos(phi) + dA[:, 1] * np.sin(phi)
+        else:
+            dc = dA @ cs
+        missing = rot_mesh @ (dc * qvel[rot_phi] * qpos[rot_q])
+        rate = -missing if de is None else de - missing
+        applied[:] = (c_mesh * rate) @ J
     clock_info = _body_clock(mb) if bodies else None
     j = 0
     countdown = 0  # steps until the next sample
@@ -366,6 +384,7 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
                 prm[widx] = buf
                 stiff[:n_mesh] = k1[i]
                 ctrl[:] = u1[i]
+                damping_correction(None, cs)
                 forward(m, d)
                 if countdown == 0:
                     record[j] = sens
@@ -393,8 +412,7 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
                 ctrl[:] = u1[i]
                 if has_te:
                     lengthspring[:n_mesh] = e1[i][:, None] + lo_hi
-                    J[w_rows, w_dofs] = prm[w_idx]
-                    d.qfrc_applied[:] = (c_mesh * de1[i]) @ J
+                damping_correction(de1[i] if has_te else None)
                 forward(m, d)
                 if countdown == 0:
                     record[j] = sens
@@ -409,7 +427,7 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
                 ctrl[:] = u2[i]
                 if has_te:
                     lengthspring[:n_mesh] = e2[i][:, None] + lo_hi
-                    d.qfrc_applied[:] = (c_mesh * de2[i]) @ J
+                damping_correction(de2[i] if has_te else None)
                 rk(m, d, 4)
         t_now = stop * h
         if not (np.all(np.isfinite(qpos)) and np.all(np.isfinite(qvel))):
@@ -430,11 +448,10 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
         else:
             stiff[:n_mesh] = mb.excitation.stiffness(t_end)[0]
         ctrl[:] = drive.controls(t_end)[0]
+        e, de = mb.excitation.transmission_error(t_end)
         if has_te:
-            e, de = mb.excitation.transmission_error(t_end)
             lengthspring[:n_mesh] = e[0][:, None] + lo_hi
-            J[w_rows, w_dofs] = prm[w_idx]
-            d.qfrc_applied[:] = (c_mesh * de[0]) @ J
+        damping_correction(de[0] if has_te else None)
         forward(m, d)
         record[j] = sens
         if energy is not None:
@@ -493,6 +510,15 @@ def _result(mb: MbdModel, t, S, k_used, energy, static: StaticState, settle, inf
         angle[:, jm] = phi
     delta = np.column_stack([series(f"{m.label}_deflection")[:, 0] for m in spec.meshes])
     rate = np.column_stack([series(f"{m.label}_rate")[:, 0] for m in spec.meshes])
+    # the true deflection rate: J qvel plus the turning coefficients' part (see MbdModel.coefficient_rate)
+    wrap_carrier = np.concatenate([mb.rot_carrier_qadr, mb.rot_carrier_qadr])
+    carrier_label = {mb.qadr[s.carrier][2]: spec.members[s.carrier].label for s in spec.stages}
+    slide_label = {q: f"{spec.members[mid].label}_{axis}" for mid, qa in mb.qadr.items()
+                   if not spec.members[mid].is_planet for q, axis in zip(qa[:2], ("x", "y"))}
+    phi = np.column_stack([series(f"{carrier_label[q]}_angle")[:, 0] for q in wrap_carrier])
+    phidot = np.column_stack([series(f"{carrier_label[q]}_angle_rate")[:, 0] for q in wrap_carrier])
+    slide = np.column_stack([series(f"{slide_label[q]}_pos")[:, 0] for q in mb.rot_slide_qadr])
+    rate = rate + mb.coefficient_rate(phi, phidot, slide)
     t_drive = t + STAGE_OFFSETS[0] * info["dt_s"]  # the drive of the step starting at each sample
     k = exc.stiffness(t_drive) if k_used is None else k_used
     e, de = exc.transmission_error(t_drive)

@@ -46,7 +46,8 @@ class FitParameter:
 
     @classmethod
     def parse(cls, text: str) -> "FitParameter":
-        """``PATH`` or ``PATH=LOW:HIGH`` (bounds in the file's units; default 1/100 to 100 times the start)."""
+        """``PATH`` or ``PATH=LOW:HIGH`` (bounds in the file's units; default 1/100 to 100 times the file's
+        value, which is the start; a value outside the bounds starts at their geometric mean)."""
         path, _, bounds = text.partition("=")
         keys = []
         for part in path.split("."):
@@ -133,11 +134,11 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
     if not any(used):
         raise GearcheckError(f"no measurement at the fit speeds {fit_speeds} rpm (have {sorted(set(rpm))})")
     start = np.array([f.get(document) for f in fits])
-    for f, x0 in zip(fits, start):
+    for i, (f, x0) in enumerate(zip(fits, start)):
         if math.isnan(f.low):
             f.low, f.high = x0 / 100, x0 * 100
-        if not f.low <= x0 <= f.high:
-            raise GearcheckError(f"--fit {f.path}: start value {x0} outside its bounds {f.low}:{f.high}")
+        if not f.low <= x0 <= f.high:  # the file's value lies outside the bounds: start in their middle
+            start[i] = math.sqrt(f.low * f.high)
     evaluations = 0
 
     def model(values, which) -> list[float]:

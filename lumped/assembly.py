@@ -43,7 +43,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .contact import line_of_action, lever
-from .errors import GearcheckError
 from .excitation import Excitation
 from .kinematics import Kinematics, kinematics
 from .spec import TrainSpec
@@ -106,6 +105,7 @@ class LumpedModel:
     b_output: np.ndarray
     excitation: Excitation
     rotating_frame_terms: bool = True
+    turning: list = field(default_factory=list)  # TurningCoupling: radial couplings across frames
 
     @property
     def n(self) -> int:
@@ -136,6 +136,47 @@ class LumpedModel:
 
         zero = np.zeros_like(self.M)
         return replace(self, G=zero, K_frame=zero, F_static=np.zeros(self.n), rotating_frame_terms=False)
+
+
+@dataclass(frozen=True)
+class TurningCoupling:
+    """A radial coupling between members whose frames turn at different speeds (a ring shared by two
+    stages, a radial spline between stages): member b's frame turns by phi = (Omega_b - Omega_a) t
+    relative to a's, so the coupling's rows are periodic in time.  Its rows in ``rows`` are those of
+    t = 0, when every frame coincides (what the modal and static analyses use, like MuJoCo's
+    linearisation at its initial configuration); the time solver replaces them by
+    :meth:`forces` at every stage."""
+
+    a: tuple[int, int]  # (x, y) coordinates of member a
+    b: tuple[int, int]
+    omega_a: float
+    omega_b: float
+    stiffness: float
+    damping: float
+    rows: tuple[str, str]  # names of its t = 0 rows
+
+    def forces(self, t, q, v) -> np.ndarray:
+        """Generalized forces (time along axis 0 allowed) of the spring-damper between the two centres,
+        acting on world-frame displacement and velocity and resolved in each member's own axes."""
+        phi = (self.omega_b - self.omega_a) * np.asarray(t, dtype=float)
+        c, s = np.cos(phi), np.sin(phi)
+        ua = np.stack([q[..., self.a[0]], q[..., self.a[1]]], axis=-1)
+        ub = np.stack([q[..., self.b[0]], q[..., self.b[1]]], axis=-1)
+        # world velocities in own axes: u' + Omega k x u
+        va = np.stack([v[..., self.a[0]] - self.omega_a * ua[..., 1], v[..., self.a[1]] + self.omega_a * ua[..., 0]],
+                      axis=-1)
+        vb = np.stack([v[..., self.b[0]] - self.omega_b * ub[..., 1], v[..., self.b[1]] + self.omega_b * ub[..., 0]],
+                      axis=-1)
+        # b's vectors in a's axes: R(phi) x
+        rot = lambda x: np.stack([c * x[..., 0] - s * x[..., 1], s * x[..., 0] + c * x[..., 1]], axis=-1)  # noqa
+        pull = self.stiffness * (ua - rot(ub)) + self.damping * (va - rot(vb))  # force on b, in a's axes
+        on_b = np.stack([c * pull[..., 0] + s * pull[..., 1], -s * pull[..., 0] + c * pull[..., 1]], axis=-1)
+        out = np.zeros(np.shape(q))
+        out[..., self.a[0]] -= pull[..., 0]
+        out[..., self.a[1]] -= pull[..., 1]
+        out[..., self.b[0]] += on_b[..., 0]
+        out[..., self.b[1]] += on_b[..., 1]
+        return out
 
 
 def _sum_outer(rows, attr, n):
@@ -179,7 +220,8 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
             K_frame[iv, iu] += c * omega
             F[ith] -= member.support.torsional_damping * kin.speeds[mid]  # drag of a turning member
 
-    rows = _support_rows(spec, dofs) + _bearing_rows(spec, dofs) + _coupling_rows(spec, dofs, kin)
+    rows, turning = _coupling_rows(spec, dofs, kin)
+    rows = _support_rows(spec, dofs) + _bearing_rows(spec, dofs) + rows
     if spec.operating.input_shaft_stiffness is not None:
         a = np.zeros(n)
         a[dofs(spec.input, "theta")] = 1.0
@@ -194,7 +236,8 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     b_in[dofs(spec.input, "theta")] = 1.0
     b_out = np.zeros(n)
     b_out[dofs(spec.output, "theta")] = 1.0
-    model = LumpedModel(spec, kin, dofs, M, G, K_frame, rows, mesh_rows, damping, F, b_in, b_out, excitation)
+    model = LumpedModel(spec, kin, dofs, M, G, K_frame, rows, mesh_rows, damping, F, b_in, b_out, excitation,
+                        turning=turning)
     return model if rotating_frame_terms else model.without_rotating_frame_terms()
 
 
@@ -241,26 +284,25 @@ def _bearing_rows(spec, dofs) -> list[Row]:
     return rows
 
 
-def _coupling_rows(spec, dofs, kin) -> list[Row]:
+def _coupling_rows(spec, dofs, kin) -> tuple[list[Row], list[TurningCoupling]]:
     n = len(dofs)
-    rows = []
+    rows, turning = [], []
     for c in spec.couplings:
         rows.append(Row(f"{c.name}.torsion", "coupling",
                         _unit(n, (dofs(c.a, "theta"), 1.0), (dofs(c.b, "theta"), -1.0)),
                         c.torsional_stiffness, c.torsional_damping))
         if c.radial_stiffness or c.radial_damping:
-            wa = kin.speeds[f"{spec.members[c.a].stage}.carrier"]
-            wb = kin.speeds[f"{spec.members[c.b].stage}.carrier"]
-            if abs(wa - wb) > 1e-9 * max(abs(wa), abs(wb), 1.0):
-                raise GearcheckError(
-                    f"{spec.path}: couplings.{c.name}.radial_stiffness: the two members' stages turn at "
-                    f"different carrier speeds, so a radial coupling makes the rotating-frame model "
-                    f"time-periodic; not supported yet (set radial_stiffness = 0)")
             for axis in ("x", "y"):
                 rows.append(Row(f"{c.name}.{axis}", "coupling",
                                 _unit(n, (dofs(c.a, axis), 1.0), (dofs(c.b, axis), -1.0)),
                                 c.radial_stiffness, c.radial_damping))
-    return rows
+            wa = kin.speeds[f"{spec.members[c.a].stage}.carrier"]
+            wb = kin.speeds[f"{spec.members[c.b].stage}.carrier"]
+            if abs(wa - wb) > 1e-12 * max(abs(wa), abs(wb), 1.0):
+                turning.append(TurningCoupling((dofs(c.a, "x"), dofs(c.a, "y")), (dofs(c.b, "x"), dofs(c.b, "y")),
+                                               wa, wb, c.radial_stiffness, c.radial_damping,
+                                               (f"{c.name}.x", f"{c.name}.y")))
+    return rows, turning
 
 
 def _mesh_row(spec, dofs, kin, mesh) -> np.ndarray:

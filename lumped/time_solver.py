@@ -84,6 +84,12 @@ class _System:
         self.Minv = 1.0 / np.diag(model.M)
         self.D = model.C_b + model.G
         self.Kc = model.K_b + model.K_frame
+        self.turning = model.turning
+        for coupling in self.turning:  # their t = 0 rows give way to the time-periodic forces
+            for row in model.rows:
+                if row.name in coupling.rows:
+                    self.Kc = self.Kc - row.stiffness * np.outer(row.a, row.a)
+                    self.D = self.D - row.damping * np.outer(row.a, row.a)
         self.A = model.mesh_rows
         self.c = model.mesh_damping
         self.b = 0.5 * self.exc.backlash
@@ -104,16 +110,20 @@ class _System:
         elastic = deadzone(delta - e, self.b) if self.has_backlash else delta - e
         return delta, k * elastic + self.c * (rate - de)
 
-    def acceleration(self, q, v, k, e, de, t_in, t_out):
+    def acceleration(self, q, v, k, e, de, t_in, t_out, t=0.0):
         _, f = self.mesh_force(q, v, k, e, de)
         force = self.F0 + self.b_in * t_in + self.b_out * t_out - self.D @ v - self.Kc @ q - self.A.T @ f
+        for coupling in self.turning:
+            force = force + coupling.forces(t, q, v)
         return force * self.Minv
 
-    def accelerations(self, q, v, k, e, de, t_in, t_out):
+    def accelerations(self, q, v, k, e, de, t_in, t_out, t):
         """:meth:`acceleration` for many states at once (time along axis 0)."""
         _, f = self.mesh_force(q, v, k, e, de)
         force = (self.F0 + np.multiply.outer(t_in, self.b_in) + np.multiply.outer(t_out, self.b_out)
                  - v @ self.D.T - q @ self.Kc.T - f @ self.A)
+        for coupling in self.turning:
+            force = force + coupling.forces(t, q, v)
         return force * self.Minv
 
     def load(self, k, e, de, t_in, t_out):
@@ -227,7 +237,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
     v_out = np.empty((n_out, n))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     acc = sys.acceleration
-    linear = None if stage_by_stage else _LinearStep(sys, h)
+    linear = None if stage_by_stage or sys.turning else _LinearStep(sys, h)  # turning couplings: periodic
     stages = np.array(STAGE_OFFSETS)
     y = np.concatenate([q, v])
     j = 1
@@ -258,13 +268,14 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
                 d1 = (k[i, 0], e[i, 0], de[i, 0], tin[i, 0], tout[i, 0])
                 d2 = (k[i, 1], e[i, 1], de[i, 1], tin[i, 1], tout[i, 1])
                 d4 = (k[i, 2], e[i, 2], de[i, 2], tin[i, 2], tout[i, 2])
-                k1v = acc(q, v, *d1)
+                t0 = (start + i) * h
+                k1v = acc(q, v, *d1, t0)
                 q2, v2 = q + 0.5 * h * v, v + 0.5 * h * k1v
-                k2v = acc(q2, v2, *d2)
+                k2v = acc(q2, v2, *d2, t0 + 0.5 * h)
                 q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * k2v
-                k3v = acc(q3, v3, *d2)
+                k3v = acc(q3, v3, *d2, t0 + 0.5 * h)
                 q4, v4 = q + h * v3, v + h * k3v
-                k4v = acc(q4, v4, *d4)
+                k4v = acc(q4, v4, *d4, t0 + h)
                 y = np.concatenate([q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4),
                                     v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)])
             step = start + i + 1
@@ -290,7 +301,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
 
     def rhs(t, y):
         k, e, de, tin, tout = sys.drive(t)
-        return np.concatenate([y[n:], sys.acceleration(y[:n], y[n:], k, e, de, tin, tout)])
+        return np.concatenate([y[n:], sys.acceleration(y[:n], y[n:], k, e, de, tin, tout, t)])
 
     t_eval = h * np.arange(0, n_steps + 1, every)
     sol = solve_ivp(rhs, (0.0, n_steps * h), np.concatenate([q0, v0]), method=method, t_eval=t_eval,
@@ -303,7 +314,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
 def _result(model, sys, t, q, v, settle, info) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
     k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
-    qdd = sys.accelerations(q, v, k, e, de, tin, tout)
+    qdd = sys.accelerations(q, v, k, e, de, tin, tout, t)
     delta, force = sys.mesh_force(q, v, k, e, de)
     spec, dofs = model.spec, model.dofs
     members = list(spec.members)

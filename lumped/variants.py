@@ -30,6 +30,11 @@ def edited(preset: str, pairs, label: str = "edited") -> TrainSpec:
 def chained(n_stages: int, radial_stiffness: float = 0.0) -> TrainSpec:
     """n copies of demo-3p's stage in series, carrier k -> sun k+1 by a spline
     (torsional 2e6 N·m/rad, optionally radial)."""
+    return load_text(chained_text(n_stages, radial_stiffness), f"chain-{n_stages}")
+
+
+def chained_text(n_stages: int, radial_stiffness: float = 0.0) -> str:
+    """The train file of :func:`chained`."""
     text = preset_text("demo-3p")
     head, stage = text.split("[[stages]]", 1)
     head = head.replace('output = "stage1.carrier"', f'output = "stage{n_stages}.carrier"')
@@ -42,7 +47,7 @@ def chained(n_stages: int, radial_stiffness: float = 0.0) -> TrainSpec:
         parts.append(f'\n[[couplings]]\nname = "spline{i}"\nfrom = "stage{i}.carrier"\nto = "stage{i + 1}.sun"\n'
                      "torsional_stiffness = 2.0e6\ntorsional_damping = 5.0\n"
                      + (f"radial_stiffness = {radial_stiffness!r}\n" if radial_stiffness else ""))
-    return load_text("\n".join(parts), f"chain-{n_stages}")
+    return "\n".join(parts)
 
 
 def wide_stage(n_planets: int) -> TrainSpec:

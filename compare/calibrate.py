@@ -98,7 +98,24 @@ class Calibration:
     before: list[float]  # model statistics with the start values
     after: list[float]  # with the fitted values
     evaluations: int
-    text: str  # the calibrated train file
+    document: dict  # the calibrated train file, parsed
+    source: str  # where the original came from (its relative file references are resolved from there)
+    header: str
+
+    def text(self, directory=None) -> str:
+        """The calibrated train file; file references rewritten relative to ``directory`` if given."""
+        import copy
+        import os
+
+        from lumped.spec import beside
+
+        doc = copy.deepcopy(self.document)
+        if directory is not None:
+            for table, key in (("train", "measurements_file"), ("operating", "torque_csv")):
+                name = doc.get(table, {}).get(key)
+                if name is not None:
+                    doc[table][key] = os.path.relpath(beside(self.source, name), directory)
+        return self.header + tomli_w.dumps(doc)
 
     def rows(self) -> list[dict]:
         out = []
@@ -189,4 +206,4 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
               + ", ".join(f"{f.path} = {v:.6g}" for f, v in zip(fits, fitted))
               + ".\n# The original file carries the comments that document every value.\n")
     return Calibration([f.path for f in fits], start, fitted, rel_unc, entries, rpm, used, before, after,
-                       evaluations, header + tomli_w.dumps(doc))
+                       evaluations, doc, source, header)

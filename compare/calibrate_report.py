@@ -10,7 +10,7 @@ def write_calibration(result, name: str, out: Path) -> list[str]:
     """Write the files into ``out``; return the lines printed on the console (the Markdown tables)."""
     out.mkdir(parents=True, exist_ok=True)
     train = out / f"{name}-calibrated.toml"
-    train.write_text(result.text, encoding="utf-8")
+    train.write_text(result.text(out), encoding="utf-8")
     rows = result.rows()
     data = {
         "schema": "gearcheck.calibration", "schema_version": 1, "train": name, "runs": result.evaluations,

@@ -253,7 +253,7 @@ def _known(ref: str, members) -> str:
     return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
 
 
-def _beside(source: str, name: str):
+def beside(source: str, name: str):
     """A file named in a train file: relative to that file (presets and their edited variants: the presets
     folder)."""
     from pathlib import Path
@@ -271,7 +271,7 @@ def _measurements(data: dict, source: str, fail) -> list[dict]:
     entries = list(data["measurements"])
     name = data["train"]["measurements_file"]
     if name is not None:
-        path = _beside(source, name)
+        path = beside(source, name)
         try:
             document = tomllib.loads(path.read_text(encoding="utf-8"))
         except (OSError, tomllib.TOMLDecodeError) as exc:
@@ -288,7 +288,7 @@ def _torque_profile(name: str, source: str, fail):
     """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
     import numpy as np
 
-    path = _beside(source, name)
+    path = beside(source, name)
     try:
         data = np.loadtxt(path, delimiter=",", ndmin=2, skiprows=_header_rows(path))
     except (OSError, ValueError) as exc:

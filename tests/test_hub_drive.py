@@ -2,7 +2,6 @@
 
 import math
 
-import numpy as np
 import pytest
 
 from compare.calibrate import FitParameter, calibrate
@@ -86,7 +85,7 @@ def test_calibration_recovers_a_known_transmission_error():
     assert abs(fit.rows()[1]["error_after"]) < 0.01
     import tomllib
 
-    written = tomllib.loads(fit.text)["stages"][0]["mesh"]["ste"][0]["amplitude_um"]
+    written = tomllib.loads(fit.text())["stages"][0]["mesh"]["ste"][0]["amplitude_um"]
     assert written == pytest.approx(fit.fitted[0], rel=1e-12)
 
 

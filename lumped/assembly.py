@@ -327,7 +327,11 @@ def _mesh_row(spec, dofs, kin, mesh) -> np.ndarray:
 
 def _mesh_damping(spec, mesh, row, dofs, k_mean) -> float:
     """c = 2 zeta sqrt(k m_eq), m_eq = 1/(r_b1^2/I_1 + r_b2^2/I_2): the equivalent mass of the
-    gear pair's torsional motion along the line of action."""
+    gear pair's torsional motion along the line of action (the arms are the row's own levers).
+
+    Seed paper 000 prints c = 2 zeta sqrt(k / (1/m_s^2 + 1/m_p^2)), which is not even a damping
+    coefficient dimensionally (sqrt(N/m kg^2) = kg sqrt(N/m)); the critical damping of a spring k
+    between two inertias is 2 sqrt(k m_eq) with 1/m_eq = 1/m_s + 1/m_p, m = I/r_b^2."""
     if mesh.damping_coefficient is not None:
         return mesh.damping_coefficient
     if not mesh.damping_ratio:

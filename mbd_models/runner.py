@@ -350,24 +350,23 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
     w_idx = np.concatenate([np.arange(tadr[i], tadr[i] + tnum[i]) for i in range(n_mesh)])
     J[np.concatenate([np.full(tnum[i], i) for i in range(n_mesh)]), m.jnt_dofadr[objid[w_idx]]] = prm[w_idx]
     rot_rows, rot_dofs = mb.rot_tendon, m.jnt_dofadr[objid[widx]]  # the entries that turn with the carrier
-    rot_q, rot_phi = mb.rot_slide_qadr, cadr2
-    rot_mesh = np.zeros((n_mesh, len(rot_q)))
-    rot_mesh[mb.rot_tendon, np.arange(len(rot_q))] = 1.0
-    dA = np.stack([A[:, 1], -A[:, 0]], axis=1)  # dc/dphi = dA @ (cos phi, sin phi)
+    rot_q, rot_phi, nx = mb.rot_slide_qadr, cadr2, len(mb.rot_wrap_x)
+    c_rot = np.zeros((n_mesh, len(rot_q)))  # mesh damping per rotating wrap
+    c_rot[mb.rot_tendon, np.arange(len(rot_q))] = c_mesh[mb.rot_tendon]
     applied = d.qfrc_applied
+    swapped = np.empty(len(rot_q))
 
-    def damping_correction(de, cs=None):
-        """Generalized force c (de/dt - missing rate) J: the STE rate and the turning coefficients'
-        rate; ``cs`` = (cos, sin) of the single carrier angle when there is only one."""
-        J[rot_rows, rot_dofs] = prm[widx]
-        if cs is None:
-            phi = qpos[rot_phi]
-            dc = dA[:, 0] * np.cos(phi) + dA[:, 1] * np.sin(phi)
-        else:
-            dc = dA @ cs
-        missing = rot_mesh @ (dc * qvel[rot_phi] * qpos[rot_q])
-        rate = -missing if de is None else de - missing
-        applied[:] = (c_mesh * rate) @ J
+    def damping_correction(de):
+        """Generalized force c (de/dt - missing rate) J for the STE rate and the turning coefficients:
+        a pair c_x = a cos(phi) - b sin(phi), c_y = a sin(phi) + b cos(phi) turns as (-c_y, c_x) phi'."""
+        coef = prm[widx]
+        J[rot_rows, rot_dofs] = coef
+        swapped[:nx], swapped[nx:] = -coef[nx:], coef[:nx]
+        force = -(c_rot @ (swapped * qvel[rot_phi] * qpos[rot_q]))
+        if de is not None:
+            force += c_mesh * de
+        applied[:] = force @ J
+
     clock_info = _body_clock(mb) if bodies else None
     j = 0
     countdown = 0  # steps until the next sample
@@ -384,7 +383,7 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
                 prm[widx] = buf
                 stiff[:n_mesh] = k1[i]
                 ctrl[:] = u1[i]
-                damping_correction(None, cs)
+                damping_correction(None)
                 forward(m, d)
                 if countdown == 0:
                     record[j] = sens

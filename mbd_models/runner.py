@@ -355,6 +355,8 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
     c_rot[mb.rot_tendon, np.arange(len(rot_q))] = c_mesh[mb.rot_tendon]
     applied = d.qfrc_applied
     swapped = np.empty(len(rot_q))
+    A_turned = np.concatenate([-A[nx:], A[:nx]])  # single carrier: the turned pairs (-c_y, c_x) = A_turned @ cs
+    multiply = np.multiply
 
     def damping_correction(de):
         """Generalized force c (de/dt - missing rate) J for the STE rate and the turning coefficients:
@@ -374,16 +376,20 @@ def _loop(mb: MbdModel, d: mujoco.MjData, h: float, n_steps: int, every: int, pr
         stop = min(start + CHUNK, n_steps)
         (k1, k2), (u1, u2), (e1, e2), (de1, de2) = drive.arrays(h * np.arange(start, stop), h)
         if fast:
-            # the common case, kept lean: per step 3 array writes, 2 coefficient writes, 2 MuJoCo calls
+            # the common case, kept lean: per step 3 array writes, 2 coefficient writes, the damping
+            # correction of damping_correction() in its single-carrier form, 2 MuJoCo calls
             for i in range(stop - start):
                 phi = qpos[phi_adr]
                 cs[0] = cos(phi)
                 cs[1] = sin(phi)
                 dot(A, cs, out=buf)
                 prm[widx] = buf
+                J[rot_rows, rot_dofs] = buf
+                dot(A_turned, cs, out=swapped)
+                multiply(swapped, qpos[rot_q], out=swapped)
+                dot(dot(c_rot, swapped) * -qvel[phi_adr], J, out=applied)
                 stiff[:n_mesh] = k1[i]
                 ctrl[:] = u1[i]
-                damping_correction(None)
                 forward(m, d)
                 if countdown == 0:
                     record[j] = sens

@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import GearcheckError, SolverError
+from .time_solver import rk4_step
 
 MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")
 LABELS = ("y1", "theta_h", "theta_f", "theta_b")
@@ -306,18 +307,8 @@ def simulate(model: FourDofModel, duration: float, dt: float | None = None, load
     a = np.zeros((steps + 1, 4))
     qi, vi = np.zeros(4), np.zeros(4)
     for i in range(steps):
-        ti = t[i]
-        k1v = accel(ti, qi, vi)
-        a[i] = k1v
-        k1q = vi
-        k2q = vi + 0.5 * dt * k1v
-        k2v = accel(ti + 0.5 * dt, qi + 0.5 * dt * k1q, k2q)
-        k3q = vi + 0.5 * dt * k2v
-        k3v = accel(ti + 0.5 * dt, qi + 0.5 * dt * k2q, k3q)
-        k4q = vi + dt * k3v
-        k4v = accel(ti + dt, qi + dt * k3q, k4q)
-        qi = qi + dt / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
-        vi = vi + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        a[i] = accel(t[i], qi, vi)
+        qi, vi = rk4_step(lambda s, q_, v_, ti=t[i]: accel(ti + 0.5 * s * dt, q_, v_), qi, vi, dt)
         q[i + 1], v[i + 1] = qi, vi
     a[-1] = accel(t[-1], qi, vi)
     if not np.all(np.isfinite(q)):

@@ -264,20 +264,12 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
             if mapped is not None:
                 y = mapped
             else:  # stage by stage: a contact change, or a stiffness switch inside the step
-                q, v = y[:n], y[n:]
-                d1 = (k[i, 0], e[i, 0], de[i, 0], tin[i, 0], tout[i, 0])
-                d2 = (k[i, 1], e[i, 1], de[i, 1], tin[i, 1], tout[i, 1])
-                d4 = (k[i, 2], e[i, 2], de[i, 2], tin[i, 2], tout[i, 2])
                 t0 = (start + i) * h
-                k1v = acc(q, v, *d1, t0)
-                q2, v2 = q + 0.5 * h * v, v + 0.5 * h * k1v
-                k2v = acc(q2, v2, *d2, t0 + 0.5 * h)
-                q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * k2v
-                k3v = acc(q3, v3, *d2, t0 + 0.5 * h)
-                q4, v4 = q + h * v3, v + h * k3v
-                k4v = acc(q4, v4, *d4, t0 + h)
-                y = np.concatenate([q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4),
-                                    v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)])
+
+                def stage(s, q, v, i=i, t0=t0):
+                    return acc(q, v, k[i, s], e[i, s], de[i, s], tin[i, s], tout[i, s], t0 + 0.5 * s * h)
+
+                y = np.concatenate(rk4_step(stage, y[:n], y[n:], h))
             step = start + i + 1
             if step % every == 0:
                 t_out[j], q_out[j], v_out[j] = step * h, y[:n], y[n:]
@@ -287,6 +279,19 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
         if progress is not None:
             progress(stop / n_steps)
     return t_out[:j], q_out[:j], v_out[:j]
+
+
+def rk4_step(acceleration, q, v, h):
+    """One classical RK4 step of q'' = acceleration(s, q, v), s = 0, 1, 1, 2 the stage's time
+    t + s h/2 (the caller supplies the drive at those times); returns (q, v) at t + h."""
+    k1 = acceleration(0, q, v)
+    q2, v2 = q + 0.5 * h * v, v + 0.5 * h * k1
+    k2 = acceleration(1, q2, v2)
+    q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * k2
+    k3 = acceleration(1, q3, v3)
+    q4, v4 = q + h * v3, v + h * k3
+    k4 = acceleration(2, q4, v4)
+    return q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
 def _per_step(x: np.ndarray) -> np.ndarray:

@@ -28,9 +28,16 @@ def models_reference() -> str:
 BLOCKS = {"schema": markdown_reference, "models": models_reference}
 
 
-def block(text: str, name: str) -> str:
+def _split(text: str, name: str) -> tuple[str, str, str]:
+    """(everything up to and with the begin marker, the block, the end marker and the rest)."""
     begin, end = f"<!-- {name}:begin -->\n", f"<!-- {name}:end -->"
-    return text.split(begin, 1)[1].split(end, 1)[0]
+    head, rest = text.split(begin, 1)
+    inside, tail = rest.split(end, 1)
+    return head + begin, inside, end + tail
+
+
+def block(text: str, name: str) -> str:
+    return _split(text, name)[1]
 
 
 def update_readme(path) -> bool:
@@ -38,10 +45,8 @@ def update_readme(path) -> bool:
     path = Path(path)
     text = original = path.read_text(encoding="utf-8")
     for name, make in BLOCKS.items():
-        begin, end = f"<!-- {name}:begin -->\n", f"<!-- {name}:end -->"
-        head, rest = text.split(begin, 1)
-        _, tail = rest.split(end, 1)
-        text = head + begin + make() + end + tail
+        head, _, tail = _split(text, name)
+        text = head + make() + tail
     path.write_text(text, encoding="utf-8")
     return text != original
 

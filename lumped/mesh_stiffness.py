@@ -34,6 +34,21 @@ class MeshStiffness:
         raise NotImplementedError
 
     @property
+    def pairs_low(self) -> int:
+        """floor(eps): the tooth pairs in contact during the single-contact part of a cycle."""
+        return math.floor(self.contact_ratio)
+
+    @property
+    def multi_fraction(self) -> float:
+        """eps - floor(eps): the part of a cycle, from xi = 0, with one pair more in contact."""
+        return self.contact_ratio - self.pairs_low
+
+    def pairs(self, xi):
+        """Tooth pairs in contact at mesh position ``xi``, from the contact ratio."""
+        frac = np.mod(np.asarray(xi, dtype=float), 1.0)
+        return self.pairs_low + (frac < self.multi_fraction)
+
+    @property
     def maximum(self) -> float:
         """The largest stiffness over a cycle (what the time step must resolve); sampled unless a
         model knows it exactly."""
@@ -64,13 +79,7 @@ class RectangularStiffness(MeshStiffness):
 
     def __init__(self, params: dict, mesh):
         super().__init__(params, mesh)
-        self.pairs_low = math.floor(self.contact_ratio)
-        self.multi_fraction = self.contact_ratio - self.pairs_low
         self.pair_stiffness = self.mean / self.contact_ratio
-
-    def pairs(self, xi):
-        frac = np.mod(np.asarray(xi, dtype=float), 1.0)
-        return self.pairs_low + (frac < self.multi_fraction)
 
     def __call__(self, xi):
         return self.pair_stiffness * self.pairs(xi)
@@ -98,8 +107,6 @@ class EnergyMethodStiffness(MeshStiffness):
 
     def __init__(self, params: dict, mesh):
         self.contact_ratio = mesh.geometry.contact_ratio
-        self.pairs_low = math.floor(self.contact_ratio)
-        self.multi_fraction = self.contact_ratio - self.pairs_low
         pitch = mesh.geometry.base_pitch
         path = self.contact_ratio * pitch
         parts = [(0.0, self.multi_fraction, self.pairs_low + 1), (self.multi_fraction, 1.0, self.pairs_low)]
@@ -114,10 +121,6 @@ class EnergyMethodStiffness(MeshStiffness):
         self.values = [flat[:split].reshape(distances[0].shape).sum(axis=1),
                        flat[split:].reshape(distances[1].shape).sum(axis=1)]
         self.mean = float(sum(np.trapezoid(k, grid) for k, grid in zip(self.values, self.grids)))
-
-    def pairs(self, xi):
-        frac = np.mod(np.asarray(xi, dtype=float), 1.0)
-        return self.pairs_low + (frac < self.multi_fraction)
 
     def __call__(self, xi):
         frac = np.mod(np.asarray(xi, dtype=float), 1.0)

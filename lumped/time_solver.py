@@ -105,23 +105,15 @@ class _System:
         return k, e, de, t_in, t_out
 
     def mesh_force(self, q, v, k, e, de):
-        delta = self.A @ q if q.ndim == 1 else q @ self.A.T
-        rate = self.A @ v if v.ndim == 1 else v @ self.A.T
+        """Mesh deflections and forces for one state (1-D) or many (time along axis 0)."""
+        delta = q @ self.A.T
         elastic = deadzone(delta - e, self.b) if self.has_backlash else delta - e
-        return delta, k * elastic + self.c * (rate - de)
+        return delta, k * elastic + self.c * (v @ self.A.T - de)
 
     def acceleration(self, q, v, k, e, de, t_in, t_out, t=0.0):
+        """q'' for one state (1-D) or many (time along axis 0, the torques then as columns)."""
         _, f = self.mesh_force(q, v, k, e, de)
-        force = self.F0 + self.b_in * t_in + self.b_out * t_out - self.D @ v - self.Kc @ q - self.A.T @ f
-        for coupling in self.turning:
-            force = force + coupling.forces(t, q, v)
-        return force * self.Minv
-
-    def accelerations(self, q, v, k, e, de, t_in, t_out, t):
-        """:meth:`acceleration` for many states at once (time along axis 0)."""
-        _, f = self.mesh_force(q, v, k, e, de)
-        force = (self.F0 + np.multiply.outer(t_in, self.b_in) + np.multiply.outer(t_out, self.b_out)
-                 - v @ self.D.T - q @ self.Kc.T - f @ self.A)
+        force = self.F0 + self.b_in * t_in + self.b_out * t_out - v @ self.D.T - q @ self.Kc.T - f @ self.A
         for coupling in self.turning:
             force = force + coupling.forces(t, q, v)
         return force * self.Minv
@@ -319,7 +311,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
 def _result(model, sys, t, q, v, settle, info) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
     k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
-    qdd = sys.accelerations(q, v, k, e, de, tin, tout, t)
+    qdd = sys.acceleration(q, v, k, e, de, tin[:, None], tout[:, None], t)
     delta, force = sys.mesh_force(q, v, k, e, de)
     spec, dofs = model.spec, model.dofs
     members = list(spec.members)

@@ -113,7 +113,8 @@ def crosscheck(spec, duration: float = 0.1, tolerances: Tolerances | None = None
     if len(lumped_modes) != len(mujoco_modal):
         raise SolverError(f"the models have different numbers of modes ({len(lumped_modes)} lumped, "
                           f"{len(mujoco_modal)} MuJoCo)")
-    modal_rows = modal_metrics(lumped_modes, mujoco_modal)
+    modal_rows = modal_metrics(lumped_modes.frequencies, mujoco_modal.frequencies, lumped_modes.types,
+                               mujoco_modal.types, lumped_modes.multiplicity)
 
     report = (lambda f: progress(0.5 * f)) if progress else None
     a = simulate(model, duration, dt=dt_lumped, progress=report)

@@ -78,11 +78,12 @@ def spectral_metrics(a: np.ndarray, b: np.ndarray, fs: float, lines) -> list[dic
              "rel_error": _rel(float(y), float(x))} for (name, f), x, y in zip(lines, amp_a, amp_b)]
 
 
-def modal_metrics(reference, test) -> list[dict]:
-    """Frequency-by-frequency comparison of two ModalResults (same number of modes)."""
+def modal_metrics(fa, fb, types_a, types_b, multiplicity) -> list[dict]:
+    """Frequency-by-frequency comparison of reference (a) and test (b) natural frequencies (Hz),
+    with each side's mode types and the reference's multiplicities."""
     rows = []
-    for i, (fa, fb) in enumerate(zip(reference.frequencies, test.frequencies)):
-        rel = abs(fb - fa) / fa if fa > 0 else abs(fb - fa)
-        rows.append({"mode": i + 1, "reference_hz": float(fa), "test_hz": float(fb), "type": reference.types[i],
-                     "test_type": test.types[i], "multiplicity": reference.multiplicity[i], "rel_error": float(rel)})
+    for i, (a, b) in enumerate(zip(fa, fb)):
+        rel = abs(b - a) / a if a > 0 else abs(b - a)
+        rows.append({"mode": i + 1, "reference_hz": float(a), "test_hz": float(b), "type": types_a[i],
+                     "test_type": types_b[i], "multiplicity": multiplicity[i], "rel_error": float(rel)})
     return rows

@@ -27,11 +27,12 @@ import time
 
 import numpy as np
 
+from lumped.modal import multiplicities
 from lumped.published import LABELS, MODELS, PaperParameters, four_dof_model, natural_frequencies, simulate
 from mbd_models.published_twin import build_twin, simulate_twin, twin_modes
 
 from .crosscheck import CrosscheckResult, QuantityComparison, verdict
-from .metrics import spectral_metrics, waveform_metrics
+from .metrics import modal_metrics, spectral_metrics, waveform_metrics
 from .tolerances import Tolerances
 
 FINDING = (
@@ -61,15 +62,8 @@ DESCRIPTIONS = {"y1": "planet-set displacement y1 (Matejic et al. 2021)", "theta
                 "theta_f": "planet angle relative to the carrier", "theta_b": "ring b angle"}
 
 
-def _mode_rows(fa: np.ndarray, fb: np.ndarray) -> list[dict]:
-    rows = []
-    mult = lambda f, x: int(np.sum(np.isclose(f, x, rtol=1e-6, atol=1e-9)))  # noqa: E731
-    for i, (a, b) in enumerate(zip(fa, fb)):
-        rel = abs(b - a) / a if a > 0 else abs(b - a)
-        rows.append({"mode": i + 1, "reference_hz": float(a), "test_hz": float(b),
-                     "type": "rigid" if a == 0 else "elastic", "test_type": "rigid" if b == 0 else "elastic",
-                     "multiplicity": mult(fa, a), "rel_error": float(rel)})
-    return rows
+def _rigid_or_elastic(frequencies: np.ndarray) -> list[str]:
+    return ["rigid" if f == 0 else "elastic" for f in frequencies]
 
 
 def crosscheck_published(spec, model: str = "as-published", duration: float = 0.02, load: bool = True,
@@ -96,7 +90,8 @@ def crosscheck_published(spec, model: str = "as-published", duration: float = 0.
     started = time.perf_counter()
     twin_freq, twin_rigid = twin_modes(twin)
     wall["mujoco_modes_s"] = time.perf_counter() - started
-    modal_rows = _mode_rows(ref_modes.frequencies, twin_freq)
+    fa = ref_modes.frequencies
+    modal_rows = modal_metrics(fa, twin_freq, _rigid_or_elastic(fa), _rigid_or_elastic(twin_freq), multiplicities(fa))
 
     f_max = max(ref_modes.frequencies.max(), twin_freq.max())
     if dt is None:

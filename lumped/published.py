@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import GearcheckError, SolverError
+from .modal import generalized_modes
 from .time_solver import rk4_step
 
 MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")
@@ -252,15 +253,10 @@ class FourDofModes:
     rigid: int  # number of rigid-body (zero-frequency) modes
 
 
-def natural_frequencies(model: FourDofModel, rigid_tol: float = 1e-9) -> FourDofModes:
-    """Undamped modes: eigh of (C, M); eigenvalues below rigid_tol * max are rigid-body modes."""
-    from scipy.linalg import eigh
-
-    w2, shapes = eigh(model.C, model.M)
-    scale = max(abs(w2).max(), 1.0)
-    rigid = w2 < rigid_tol * scale
-    w2 = np.where(rigid, 0.0, w2)
-    return FourDofModes(model.name, np.sqrt(w2) / (2 * math.pi), shapes, int(rigid.sum()))
+def natural_frequencies(model: FourDofModel) -> FourDofModes:
+    """Undamped modes of (C, M) (:func:`lumped.modal.generalized_modes`: rigid-body modes as 0 Hz)."""
+    frequencies, shapes = generalized_modes(model.C, model.M)
+    return FourDofModes(model.name, frequencies, shapes, int(np.sum(frequencies == 0)))
 
 
 @dataclass

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from lumped.modal import generalized_modes
 from lumped.published import LABELS, PaperParameters
 
 FD_STEP = 1e-6
@@ -158,14 +159,11 @@ def linearise(twin: PublishedTwin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return M[sel], 0.5 * (K + K.T)[sel], 0.5 * (Cd + Cd.T)[sel]
 
 
-def twin_modes(twin: PublishedTwin, rigid_tol: float = 1e-9):
+def twin_modes(twin: PublishedTwin):
     """Natural frequencies (Hz, rigid-body modes as 0) of the linearised twin, and the rigid count."""
-    from scipy.linalg import eigh
-
     M, K, _ = linearise(twin)
-    w2 = eigh(K, M, eigvals_only=True)
-    rigid = w2 < rigid_tol * max(abs(w2).max(), 1.0)
-    return np.sqrt(np.where(rigid, 0.0, w2)) / (2 * math.pi), int(rigid.sum())
+    frequencies, _ = generalized_modes(K, M)
+    return frequencies, int(np.sum(frequencies == 0))
 
 
 @dataclass

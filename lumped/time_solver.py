@@ -8,11 +8,8 @@ Equation of motion (rotating frame, see :mod:`lumped.assembly`):
 f the backlash dead zone.  The start is the static deflection under the mean load
 (``ramp_s`` = 0) or the unloaded state with the load ramped in.
 
-Time step: RK4 is stable for omega_max h < 2.83 on undamped modes; the solver refuses a
-step above ``STABILITY_MARGIN`` times that limit and by default takes
-``POINTS_PER_PERIOD`` steps per period of the highest natural frequency (with the mesh
-stiffness at its cycle maximum) and ``POINTS_PER_MESH_CYCLE`` per mesh cycle, made a
-whole fraction of the slowest mesh period (:func:`lumped.excitation.commensurate_step`).
+Time step: :mod:`lumped.stepping` (the rule the MuJoCo runner follows too), from the highest
+natural frequency of this model with every mesh at its cycle-maximum stiffness.
 The drive is sampled at t + h (eps, 1/2, 1 - eps) (:data:`lumped.excitation.STAGE_OFFSETS`).
 By default (``drive="steps"``) RK4's first stage sees x(t + eps) and the other three
 (4 x(t + h/2) + x(t + h - eps))/5, exactly as the MuJoCo runner drives its model
@@ -32,13 +29,11 @@ import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
 from .errors import DivergenceError, SolverError
-from .excitation import STAGE_OFFSETS, STEP_WEIGHTS, commensurate_step
+from . import stepping
+from .excitation import STAGE_OFFSETS, STEP_WEIGHTS
 from .results import TimeResult
 from .static import deadzone, mean_load, static_solution
 
-STABILITY_MARGIN = 0.9
-POINTS_PER_PERIOD = 20
-POINTS_PER_MESH_CYCLE = 64
 CHUNK = 20000
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -51,28 +46,12 @@ def max_angular_frequency(model) -> float:
 
 
 def stable_step(model) -> float:
-    return STABILITY_MARGIN * 2.0 * math.sqrt(2.0) / max_angular_frequency(model)
+    return stepping.stable_step(max_angular_frequency(model))
 
 
 def default_step(model) -> float:
-    """``POINTS_PER_PERIOD`` steps per period of the highest natural frequency and at least
-    ``POINTS_PER_MESH_CYCLE`` per mesh cycle, rounded down to a whole fraction of the slowest
-    mesh period: the rectangular stiffness then switches at the same sub-step position in
-    every cycle, so the discrete steady response is periodic like the physical one."""
-    f_max = max_angular_frequency(model) / (2 * math.pi)
-    return commensurate_step(1.0 / (POINTS_PER_PERIOD * f_max), model.excitation.frequency, POINTS_PER_MESH_CYCLE)
-
-
-def check_step(model, dt: float) -> None:
-    limit = stable_step(model)
-    if not (dt > 0 and math.isfinite(dt)):
-        raise SolverError(f"time step must be a positive number, got {dt}")
-    if dt > limit:
-        f_max = max_angular_frequency(model) / (2 * math.pi)
-        raise SolverError(
-            f"time step {dt:.4g} s cannot resolve the highest natural frequency {f_max:.6g} Hz: RK4 is stable "
-            f"only for dt < 2.83/omega_max = {limit / STABILITY_MARGIN:.4g} s; use dt <= {default_step(model):.4g} s "
-            f"(the default) or at most {limit:.4g} s")
+    """:func:`lumped.stepping.default_step` for this model."""
+    return stepping.default_step(max_angular_frequency(model), model.excitation.frequency)
 
 
 class _System:
@@ -195,9 +174,10 @@ def simulate(model, duration: float, dt: float | None = None, method: str = "rk4
     """
     if not (duration > 0 and math.isfinite(duration)):
         raise SolverError(f"duration must be a positive number of seconds, got {duration}")
+    omega_max = max_angular_frequency(model)
     if dt is None:
-        dt = default_step(model)
-    check_step(model, dt)
+        dt = stepping.default_step(omega_max, model.excitation.frequency)
+    stepping.check_step(dt, omega_max, model.excitation.frequency, f"lumped model of {model.spec.name}")
     every = 1 if output_dt is None else max(1, round(output_dt / dt))
     n_steps = every * max(1, math.ceil(duration / (dt * every) - 1e-9))  # ends on an output sample
     q0, v0 = initial_state(model) if y0 is None else y0

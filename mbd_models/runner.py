@@ -25,9 +25,7 @@ exactly over the step.
 
 Time step: from the highest natural frequency of MuJoCo's own linearisation with every
 mesh at its cycle-maximum stiffness (:func:`mbd_models.linearise.max_angular_frequency`);
-by default ``POINTS_PER_PERIOD`` steps per period of that mode and
-``POINTS_PER_MESH_CYCLE`` per mesh cycle.  A requested step above ``STABILITY_MARGIN``
-times RK4's limit 2.83/omega_max is refused.
+the rule of :mod:`lumped.stepping`, the same as the lumped solver's.
 
 Start: the steady rotating state at the nominal operating point of the MuJoCo model
 itself (:func:`static_state`): a Newton solve on MuJoCo's forward dynamics for the
@@ -45,16 +43,13 @@ import mujoco
 import numpy as np
 
 from lumped.errors import DivergenceError, SolverError
-from lumped.excitation import STAGE_OFFSETS, STEP_WEIGHTS, commensurate_step
+from lumped import stepping
+from lumped.excitation import STAGE_OFFSETS, STEP_WEIGHTS
 from lumped.results import TimeResult
 
 from .linearise import max_angular_frequency
 from .mjcf_builder import MbdModel, compile_train
 
-STABILITY_MARGIN = 0.9
-RK4_LIMIT = 2.0 * math.sqrt(2.0)
-POINTS_PER_PERIOD = 20
-POINTS_PER_MESH_CYCLE = 64
 CHUNK = 10000
 DIVERGENCE_FACTOR = 1e3  # |delta| beyond this times the static scale counts as runaway
 
@@ -62,28 +57,10 @@ DIVERGENCE_FACTOR = 1e3  # |delta| beyond this times the static scale counts as 
 # --------------------------------------------------------------------------- time step
 
 
-def stable_step(mb: MbdModel, omega_max: float | None = None) -> float:
-    omega_max = max_angular_frequency(mb) if omega_max is None else omega_max
-    return STABILITY_MARGIN * RK4_LIMIT / omega_max
-
-
 def default_step(mb: MbdModel, omega_max: float | None = None) -> float:
+    """:func:`lumped.stepping.default_step` for this model (omega_max: if already known)."""
     omega_max = max_angular_frequency(mb) if omega_max is None else omega_max
-    h = 2.0 * math.pi / (POINTS_PER_PERIOD * omega_max)
-    return commensurate_step(h, mb.excitation.frequency, POINTS_PER_MESH_CYCLE)
-
-
-def check_step(mb: MbdModel, dt: float, omega_max: float | None = None) -> None:
-    if not (isinstance(dt, (int, float)) and dt > 0 and math.isfinite(dt)):
-        raise SolverError(f"time step must be a positive number of seconds, got {dt!r}")
-    omega_max = max_angular_frequency(mb) if omega_max is None else omega_max
-    limit = stable_step(mb, omega_max)
-    if dt > limit:
-        raise SolverError(
-            f"time step {dt:.4g} s is unstable for the MuJoCo model of {mb.spec.name}: its highest natural "
-            f"frequency is {omega_max / (2 * math.pi):.6g} Hz (meshes at maximum stiffness) and RK4 is stable only "
-            f"for dt < 2.83/omega_max = {RK4_LIMIT / omega_max:.4g} s; use dt <= {default_step(mb, omega_max):.4g} s "
-            f"(the default, {POINTS_PER_PERIOD} points per period) or at most {limit:.4g} s")
+    return stepping.default_step(omega_max, mb.excitation.frequency)
 
 
 # --------------------------------------------------------------------------- drive
@@ -267,7 +244,7 @@ def simulate_mujoco(spec, duration: float, dt: float | None = None, output_dt: f
     omega_max = max_angular_frequency(mb)
     if dt is None:
         dt = default_step(mb, omega_max)
-    check_step(mb, dt, omega_max)
+    stepping.check_step(dt, omega_max, mb.excitation.frequency, f"MuJoCo model of {spec.name}")
     if output_dt is not None and not (output_dt > 0 and math.isfinite(output_dt)):
         raise SolverError(f"output_dt must be a positive number of seconds, got {output_dt!r}")
     every = 1 if output_dt is None else max(1, round(output_dt / dt))
@@ -302,7 +279,7 @@ def simulate_mujoco(spec, duration: float, dt: float | None = None, output_dt: f
     t = dt * every * np.arange(sensordata.shape[0])
     settle = max(op.ramp, 0.5 * duration) if settle is None else settle
     info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
-            "omega_max_rad_s": omega_max, "stable_step_s": stable_step(mb, omega_max),
+            "omega_max_rad_s": omega_max, "stable_step_s": stepping.stable_step(omega_max),
             "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
             "static_newton_iterations": static.iterations, "static_residual": static.residual,
             "forward_evaluations": 4 * n_steps}

@@ -16,7 +16,8 @@ from lumped.time_solver import simulate
 from lumped.variants import edited
 from mbd_models import compile_train, simulate_mujoco, static_state
 from mbd_models.linearise import max_angular_frequency
-from mbd_models.runner import RK4_LIMIT, default_step
+from lumped.stepping import RK4_LIMIT
+from mbd_models.runner import default_step
 
 
 def variant(pairs, name="variant"):

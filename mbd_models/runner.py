@@ -46,6 +46,7 @@ from lumped.errors import DivergenceError, SolverError
 from lumped import stepping
 from lumped.excitation import STAGE_OFFSETS, STEP_WEIGHTS
 from lumped.results import TimeResult
+from lumped.static import deadzone
 
 from .linearise import max_angular_frequency
 from .mjcf_builder import MbdModel, compile_train
@@ -64,11 +65,6 @@ def default_step(mb: MbdModel, omega_max: float | None = None) -> float:
 
 
 # --------------------------------------------------------------------------- drive
-
-
-def deadband(x, half_backlash):
-    """x - b above b, 0 inside |x| <= b, x + b below -b (the tendon's two-valued spring length)."""
-    return np.where(x > half_backlash, x - half_backlash, np.where(x < -half_backlash, x + half_backlash, 0.0))
 
 
 class _Drive:
@@ -210,7 +206,7 @@ def static_state(mb: MbdModel, load_scale: float = 1.0, tol: float = 1e-13, max_
                                   f"(residual {res:.3g} m/s^2)")
         residual(q)
         delta = d.ten_length[t].copy()
-        force = mb.excitation.mean_stiffness * deadband(delta, mb.half_backlash)
+        force = mb.excitation.mean_stiffness * deadzone(delta, mb.half_backlash)
         qpos, qvel, _ = _nominal(mb, q)
         return StaticState(qpos, qvel, delta, force, iterations, res)
     finally:
@@ -504,7 +500,7 @@ def _result(mb: MbdModel, t, S, k_used, energy, static: StaticState, settle, inf
     t_drive = t + STAGE_OFFSETS[0] * info["dt_s"]  # the drive of the step starting at each sample
     k = exc.stiffness(t_drive) if k_used is None else k_used
     e, de = exc.transmission_error(t_drive)
-    force = k * deadband(delta - e, mb.half_backlash) + mb.mesh_damping * (rate - de)
+    force = k * deadzone(delta - e, mb.half_backlash) + mb.mesh_damping * (rate - de)
     names, bearing = [], []
     for mid, member in spec.members.items():
         if member.is_planet:

@@ -11,16 +11,18 @@ from __future__ import annotations
 
 import time
 
-from lumped import build_model, load_train
-from lumped.modal import modes
-from lumped.time_solver import simulate
-from lumped.variants import chained, wide_stage
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.modal import modes
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.lumped.variants import chained, wide_stage
+from gearcheck.shared.settings import RunSettings
 
 
 def timed_run(spec, duration):
     model = build_model(spec)
     started = time.perf_counter()
-    result = simulate(model, duration)
+    result = simulate(model, RunSettings(duration))
     total = time.perf_counter() - started
     return model, result.info, total
 

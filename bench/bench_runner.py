@@ -19,9 +19,13 @@ import time
 import mujoco
 import numpy as np
 
-from lumped.loader import load_train
-from mbd_models import compile_train, simulate_mujoco
-from lumped.variants import chained
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.lumped.variants import chained
+from gearcheck.mbd_models.runner import simulate_mujoco
+from gearcheck.mbd_models.twin import compile_train
+from gearcheck.shared.settings import RunSettings
 
 
 def bare_step_cost(mb, n_steps: int, dt: float) -> float:
@@ -38,8 +42,8 @@ def bare_step_cost(mb, n_steps: int, dt: float) -> float:
     return (time.perf_counter() - started) / n_steps
 
 
-def runner_step_cost(spec, mb, n_steps: int, dt: float) -> float:
-    res = simulate_mujoco(spec, n_steps * dt, dt=dt, mb=mb)
+def runner_step_cost(mb, n_steps: int, dt: float) -> float:
+    res = simulate_mujoco(mb, RunSettings(n_steps * dt, dt))
     return res.info["wall_time_s"] / res.info["steps"]
 
 
@@ -53,7 +57,7 @@ def cost_table(n_steps: int, repeats: int = 3):
         mb = compile_train(spec)
         dt = mb.model.opt.timestep  # the default step written into the MJCF
         bare = min(bare_step_cost(mb, n_steps, dt) for _ in range(repeats))
-        run = min(runner_step_cost(spec, mb, n_steps, dt) for _ in range(repeats))
+        run = min(runner_step_cost(mb, n_steps, dt) for _ in range(repeats))
         rows.append((n_stages, bare, run))
         label = f"{n_stages} stage" + ("s" if n_stages > 1 else "")
         print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>10.2f} "
@@ -62,9 +66,6 @@ def cost_table(n_steps: int, repeats: int = 3):
 
 
 def convergence_table(duration: float = 0.05, settle: float = 0.025):
-    from lumped.assembly import build_model
-    from lumped.time_solver import simulate
-
     spec = load_train("demo-3p")
     model = build_model(spec)
     mb = compile_train(spec)
@@ -79,18 +80,16 @@ def convergence_table(duration: float = 0.05, settle: float = 0.025):
           f"{'ring alpha':>11}")
     for f in (1, 2, 4):
         h = h0 / f
-        mj = simulate_mujoco(spec, duration, dt=h, settle=settle, mb=mb)
-        lp = simulate(model, duration, dt=h, settle=settle)
+        settings = RunSettings(duration, h, settle=settle)
+        mj, lp = simulate_mujoco(mb, settings), simulate(model, settings)
         w = mj.steady
-        n = len(spec.meshes)
-        force = max(nrms(mj.mesh_force[w, i], lp.mesh_force[w, i]) for i in range(n))
-        dyn = max(nrms(mj.mesh_force[w, i] - lp.static_mesh_force[i], lp.mesh_force[w, i] - lp.static_mesh_force[i])
-                  for i in range(n))
-        aw, bw = mj.acceleration("stage1.ring", "world"), lp.acceleration("stage1.ring", "world")
-        ac, bc = mj.acceleration("stage1.ring", "carrier"), lp.acceleration("stage1.ring", "carrier")
-        world = max(nrms(aw[c].to_numpy()[w], bw[c].to_numpy()[w]) for c in ("ax", "ay"))
-        carrier = max(nrms(ac[c].to_numpy()[w], bc[c].to_numpy()[w]) for c in ("ax", "ay"))
-        alpha = nrms(aw.alpha.to_numpy()[w], bw.alpha.to_numpy()[w])
+        forces = mj.names("mesh_force")
+        force = max(nrms(mj[n][w], lp[n][w]) for n in forces)
+        dyn = max(nrms(mj[n][w] - lp.static[n], lp[n][w] - lp.static[n]) for n in forces)
+        ring = "stage1.ring"
+        world = max(nrms(mj[f"{ring}.a{c}.world"][w], lp[f"{ring}.a{c}.world"][w]) for c in "xy")
+        carrier = max(nrms(mj[f"{ring}.a{c}.carrier"][w], lp[f"{ring}.a{c}.carrier"][w]) for c in "xy")
+        alpha = nrms(mj[f"{ring}.alpha"][w], lp[f"{ring}.alpha"][w])
         print(f"{h:>11.4e} {force:>11.3e} {dyn:>10.3e} {world:>11.3e} {carrier:>13.3e} {alpha:>11.3e}")
 
 

@@ -1,4 +1,4 @@
-"""Which excitation makes the hub-drive vibrate, and which makes it grow with speed (seed 000, Table 1).
+"""Which excitation makes the hub-drive vibrate, and which makes it grow with speed (Li et al. 2026, Table 1).
 
 Runs the lumped model of the `hub-drive` preset at the paper's two test speeds with one excitation
 source at a time and prints the Table 1 quantities (peak of the steady y acceleration of ring I and
@@ -14,13 +14,13 @@ Run:  python bench/hub_drive_excitation.py [--duration S]
 from __future__ import annotations
 
 import argparse
-import math
 import re
 
-from compare.measure import measure
-from lumped import build_model
-from lumped.loader import load_text, preset_text
-from lumped.time_solver import simulate
+from gearcheck.compare.measure import measure
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_text, load_train, preset_text
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.shared.settings import RunSettings
 
 CASES = {
     "everything": [],
@@ -40,10 +40,10 @@ def main():
             text = re.sub(old, new, text, flags=re.M)
         spec = load_text(text, f"preset:hub-drive ({name})")
         for rpm in (606.0, 1823.0):
-            run = spec.with_operating(input_speed=rpm * math.pi / 30)
+            run = load_train(spec, rpm)
             entries = [e for e in run.measurements if abs(e["speed"] - run.operating.input_speed) < 1e-6]
             model = build_model(run)
-            values = measure(run, simulate(model, args.duration), entries, 1 / model.excitation.frequency.min())
+            values = measure(simulate(model, RunSettings(args.duration)), entries, 1 / model.excitation.frequency.min())
             measured = "/".join(f"{e['value'] / 9.8:.2f}" for e in entries)
             print(f"{name:<26} {rpm:>6.0f} {values[0] / 9.8:>11.3f} {values[1] / 9.8:>15.3f}   ({measured})")
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from lumped.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError
 
 BASELINE_DIR = Path(__file__).parent / "baselines"
 VERSION = 1

@@ -3,7 +3,7 @@
 A parameter is addressed by its path in the train file, in the file's own units
 (``stages[0].mesh.ste[0].amplitude_um``, ``operating.output_torque``), with bounds.  The fit
 minimises sum_i ((ln y_i(p) - ln m_i)/s_i)^2 over ln p, y_i the lumped model's statistic of
-measurement i read through its measuring chain (:func:`compare.measure.measure`), m_i the
+measurement i read through its measuring chain (:func:`gearcheck.compare.measure.measure`), m_i the
 measured value and s_i its relative uncertainty (``uncertainty``, default 0.1): relative
 errors, and positive parameters by construction.  Parameter uncertainties come from the
 Jacobian at the optimum, cov(ln p) = (J^T J)^-1 with the residuals already divided by s_i;
@@ -16,7 +16,9 @@ The honest protocol for a paper's table: fit on the measurements at one speed
 
 from __future__ import annotations
 
+import copy
 import math
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -25,12 +27,14 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
-from lumped import build_model
-from lumped.errors import GearcheckError
-from lumped.loader import load_text
-from lumped.time_solver import simulate
-
-from .measure import measure
+from gearcheck.compare.measure import measure
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_text, load_train
+from gearcheck.lumped.spec import beside
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.units import rad_s_to_rpm
 
 SPEED_MATCH = 1e-6
 LOG_STEP = 0.05  # finite-difference step in ln p: a peak of a simulated signal is only piecewise smooth
@@ -104,11 +108,6 @@ class Calibration:
 
     def text(self, directory=None) -> str:
         """The calibrated train file; file references rewritten relative to ``directory`` if given."""
-        import copy
-        import os
-
-        from lumped.spec import beside
-
         doc = copy.deepcopy(self.document)
         if directory is not None:
             for table, key in (("train", "measurements_file"), ("operating", "torque_csv")):
@@ -133,8 +132,8 @@ class Calibration:
 def _speeds(entries, default_rpm):
     out = []
     for e in entries:
-        rpm = e.get("speed")
-        out.append(default_rpm if rpm is None else rpm * 60 / (2 * math.pi))
+        speed = e.get("speed")  # rad/s
+        out.append(default_rpm if speed is None else rad_s_to_rpm(speed))
     return out
 
 
@@ -145,7 +144,7 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
     if not entries:
         raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or --measurements")
     base_spec = load_text(text, source)
-    base_rpm = base_spec.operating.input_speed * 60 / (2 * math.pi)
+    base_rpm = rad_s_to_rpm(base_spec.operating.input_speed)
     rpm = _speeds(entries, base_rpm)
     used = [fit_speeds is None or any(abs(r - f) <= SPEED_MATCH * f for f in fit_speeds) for r in rpm]
     if not any(used):
@@ -166,12 +165,11 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
         spec = load_text(tomli_w.dumps(doc), source)
         out = [math.nan] * len(entries)
         for speed in sorted({rpm[i] for i in which}):
-            run = spec.with_operating(input_speed=speed * 2 * math.pi / 60)
-            lumped = build_model(run)
-            result = simulate(lumped, duration)
+            lumped = build_model(load_train(spec, speed))
+            result = simulate(lumped, RunSettings(duration))
             cycle = 1.0 / float(np.min(lumped.excitation.frequency))
             idx = [i for i in which if rpm[i] == speed]
-            for i, value in zip(idx, measure(run, result, [entries[i] for i in idx], cycle)):
+            for i, value in zip(idx, measure(result, [entries[i] for i in idx], cycle)):
                 out[i] = value
             evaluations += 1
             if progress is not None:

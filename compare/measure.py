@@ -2,7 +2,7 @@
 
 A measured amplitude is a statistic of the steady-state signal of one sensor: ``peak``
 (max |x|), ``rms`` or ``peak_to_peak``, after the sensor chain's band-pass when one is given
-(:func:`compare.align.sensor_filter`, zero phase, applied to the whole series before the
+(:func:`gearcheck.compare.align.sensor_filter`, zero phase, applied to the whole series before the
 window is cut so that the filter's start-up does not enter it).  The same function serves
 the cross-check's measured column and the calibration, so both read a solver the same way.
 """
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .align import resample, sensor_filter, steady_start, uniform_grid
-from .quantities import extract
+from gearcheck.compare.align import resample, sensor_filter, steady_start, uniform_grid
+from gearcheck.shared.errors import GearcheckError
 
 STATISTICS = {
     "peak": lambda x: float(np.max(np.abs(x))),
@@ -36,15 +36,17 @@ def steady_window(grid: np.ndarray, forces: np.ndarray, cycle: float) -> tuple[n
     return grid >= (start if found else 0.5 * grid[-1]), found
 
 
-def measure(spec, result, entries, cycle: float) -> list[float]:
+def measure(result, entries, cycle: float) -> list[float]:
     """Each measurement entry's statistic from one solver's ``result`` (the calibration's model side)."""
-    quantities = extract(spec, result)
     fs = (result.t.size - 1) / (result.t[-1] - result.t[0])
     grid = uniform_grid(0.0, result.t[-1], fs)
-    forces = resample(result.t, result.mesh_force, grid)
+    forces = resample(result.t, result.select("mesh_force"), grid)
     window, _ = steady_window(grid, forces, cycle)
     values = []
     for entry in entries:
-        series = resample(result.t, quantities[entry["quantity"]][1], grid)
+        if entry["quantity"] not in result:
+            raise GearcheckError(f"measurement of unknown quantity {entry['quantity']!r} (quantities: "
+                                 f"{', '.join(result.names(compared=True))[:400]}...)")
+        series = resample(result.t, result[entry["quantity"]], grid)
         values.append(chain_statistic(series, window, fs, entry["metric"], entry.get("sensor_band_hz")))
     return values

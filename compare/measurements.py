@@ -15,10 +15,9 @@ import math
 import tomllib
 from pathlib import Path
 
-from lumped.errors import GearcheckError, TrainFileError
-from lumped.schema import parse_measurements
-
-from .measure import chain_statistic
+from gearcheck.compare.measure import chain_statistic
+from gearcheck.lumped.schema import parse_measurements
+from gearcheck.shared.errors import GearcheckError, TrainFileError
 
 SPEED_MATCH = 1e-6  # relative
 
@@ -35,7 +34,7 @@ def load_measurements(path: str | Path) -> list[dict]:
 
 def attach(result, entries) -> None:
     """Add the measured column to ``result`` (a CrosscheckResult) for entries at its speed: both
-    solvers read through the entry's measuring chain (:func:`compare.measure.chain_statistic`)
+    solvers read through the entry's measuring chain (:func:`gearcheck.compare.measure.chain_statistic`)
     over the cross-check's steady window."""
     speed = result.spec.operating.input_speed
     by_name = {q.name: q for q in result.quantities}

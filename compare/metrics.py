@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .align import estimate_lag, shift_signal
+from gearcheck.compare.align import estimate_lag, shift_signal
 
 
 def _stats(x: np.ndarray) -> dict[str, float]:

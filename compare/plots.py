@@ -1,22 +1,28 @@
-"""Report figures (PNG, Agg backend, deterministic: no timestamps in the files)."""
+"""Report figures (PNG, deterministic: no timestamps in the files).
+
+Figures are drawn on :class:`matplotlib.figure.Figure` objects and saved through Agg without
+pyplot, so writing a report never touches the user's matplotlib backend.
+"""
 
 from __future__ import annotations
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from gearcheck.lumped.mesh_stiffness import stiffness_model
 
 LUMPED_STYLE = {"color": "tab:blue", "lw": 1.2, "label": "lumped"}
 MUJOCO_STYLE = {"color": "tab:orange", "lw": 1.0, "ls": "--", "label": "MuJoCo"}
 
 
+def _figure(rows: int = 1, cols: int = 1, figsize=(9, 5), **kwargs):
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(rows, cols, **kwargs)
+
+
 def _save(fig, path):
     fig.tight_layout()
     fig.savefig(path, dpi=110, metadata={"Software": None})
-    plt.close(fig)
 
 
 def headline_quantities(result) -> list[str]:
@@ -51,7 +57,7 @@ def time_histories(result, path, cycles: int = 4):
     t = result.grid
     t_end = t[-1]
     window = t >= t_end - cycles / f_cycle
-    fig, axes = plt.subplots(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
+    fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
         a, b = result.series[name]
         ax.plot(t[window] * 1e3, a[window], **LUMPED_STYLE)
@@ -71,7 +77,7 @@ def spectra(result, path):
     window = result.grid >= result.steady_start_s
     fs = result.settings["common_sample_rate_hz"]
     f_mesh = 1.0 / result.settings["steady_cycle_s"]
-    fig, axes = plt.subplots(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
+    fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
         for x, style in zip(result.series[name], (LUMPED_STYLE, MUJOCO_STYLE)):
             seg = x[window] - np.mean(x[window])
@@ -94,7 +100,7 @@ def spectra(result, path):
 def natural_frequencies(result, path):
     rows = result.modal
     idx = np.arange(1, len(rows) + 1)
-    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+    fig, (ax, ax2) = _figure(2, 1, figsize=(9, 5), sharex=True)
     ax.plot(idx, [r["reference_hz"] for r in rows], "o", color="tab:blue", label="lumped")
     ax.plot(idx, [r["test_hz"] for r in rows], "x", color="tab:orange", label="MuJoCo")
     ax.set_ylabel("natural frequency [Hz]")
@@ -113,7 +119,7 @@ def natural_frequencies(result, path):
 
 def error_bars(result, path):
     gated = [q for q in result.quantities if q.status != "negligible" and q.metrics["nrmse"] is not None]
-    fig, ax = plt.subplots(figsize=(9, max(3.0, 0.22 * len(gated) + 1.5)))
+    fig, ax = _figure(figsize=(9, max(3.0, 0.22 * len(gated) + 1.5)))
     y = np.arange(len(gated))
     values = [max(q.metrics["nrmse"], 1e-12) for q in gated]
     colors = ["tab:red" if q.status == "fail" else "tab:green" for q in gated]
@@ -139,10 +145,8 @@ FIGURES = {
 def mesh_stiffness(spec, path, cycles: int = 2):
     """k over ``cycles`` mesh cycles for the first planet's mesh with every central gear of every
     stage (the model the train file names), with the number of tooth pairs in contact."""
-    from lumped.mesh_stiffness import stiffness_model
-
     first = [m for m in spec.meshes if m.planet_index == 0]
-    fig, axes = plt.subplots(len(first), 1, figsize=(9, 2.0 * len(first)), sharex=True, squeeze=False)
+    fig, axes = _figure(len(first), 1, figsize=(9, 2.0 * len(first)), sharex=True, squeeze=False)
     xi = np.linspace(0.0, cycles, 2000 * cycles + 1)
     for ax, mesh in zip(axes[:, 0], first):
         model = stiffness_model(mesh)

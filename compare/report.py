@@ -22,7 +22,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from .plots import FIGURES
+from gearcheck.shared.citations import cite
 
 SCHEMA = "gearcheck.crosscheck"
 SCHEMA_VERSION = 1
@@ -80,7 +80,7 @@ def to_dict(result) -> dict:
         "train": {"name": spec.name, "description": spec.description, "source": spec.source},
         "provenance": provenance(result),
         "settings": _settings_with_units(result.settings),
-        "verdict": {"passed": result.passed, "failures": result.failures},
+        "verdict": {"passed": result.passed, "failures": result.failures, "moved_from_baseline": result.moved},
         "steady_state": {"start": _u(result.steady_start_s, "s"), "detected": result.steady_found},
         "modes": [{"mode": r["mode"], "type": r["type"], "multiplicity": r["multiplicity"],
                    "lumped": _u(r["reference_hz"], "Hz"), "mujoco": _u(r["test_hz"], "Hz"),
@@ -90,6 +90,7 @@ def to_dict(result) -> dict:
         "quantities": quantities,
         "measurements": result.measurements,
         "notes": result.notes,
+        "references": cite(result.references),
         "volatile": {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                      "wall_time": {k: _u(v, "s") for k, v in result.wall_times.items()}},
     }
@@ -188,7 +189,8 @@ def _settings_line(settings: dict) -> str:
 
 def _summary_lines(data) -> list[str]:
     s = data["settings"]
-    verdict = "PASS" if data["verdict"]["passed"] else "FAIL: " + ", ".join(data["verdict"]["failures"])
+    v = data["verdict"]
+    verdict = "PASS" if v["passed"] else "FAIL: " + ", ".join(v["failures"] + (v["moved_from_baseline"] or []))
     p = data["provenance"]
     return [
         f"Verdict: **{verdict}**",
@@ -218,6 +220,7 @@ def write_markdown(data, path: Path, figures: list[str]) -> None:
         lines += ["| " + " | ".join(r) + " |" for r in rows]
         lines.append("")
     lines += ["## Figures", ""] + [f"![{f}]({f})" for f in figures] + [""]
+    lines += ["## References", ""] + [f"- [{r['key']}] {r['citation']}" for r in data["references"]] + [""]
     path.write_text("\n".join(lines), encoding="utf-8")
 
 
@@ -248,12 +251,16 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
         encoded = base64.b64encode(fig.read_bytes()).decode("ascii")
         parts.append(f"<figure><img alt=\"{esc(fig.name)}\" src=\"data:image/png;base64,{encoded}\">"
                      f"<figcaption>{esc(fig.name)}</figcaption></figure>")
+    parts.append("<h2>References</h2><ul>" + "".join(f"<li>[{esc(r['key'])}] {esc(r['citation'])}</li>"
+                                                     for r in data["references"]) + "</ul>")
     parts.append("</body></html>\n")
     path.write_text("\n".join(parts), encoding="utf-8")
 
 
 def write_report(result, directory) -> dict:
     """Write report.json, report.md, report.html and the PNG figures; return the JSON dict."""
+    from gearcheck.compare.plots import FIGURES  # matplotlib only when a report is written
+
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     data = to_dict(result)

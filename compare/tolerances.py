@@ -5,14 +5,13 @@ Keys are ``KIND.METRIC`` (``mesh_force.nrmse``) or ``QUANTITY.METRIC``
 
 * ``frequency.rel_error`` 1e-6: both models linearise the same physics exactly, so
   natural frequencies must agree to round-off and finite-difference error;
-* ``mesh_force.nrmse`` and ``dte.nrmse`` 0.01: the two integrators at their default steps
-  (issue 3's acceptance level);
+* ``mesh_force.nrmse`` and ``dte.nrmse`` 0.01: the two integrators at their default steps;
 * ``acceleration.nrmse`` and ``angular_acceleration.nrmse`` 0.05: accelerations weight the
   high-frequency content where the two time discretisations differ most;
 * ``bearing_force.nrmse`` 0.02.
 
 Overrides come from the train file's ``[tolerances]`` table and then from a ``[tolerances]``
-table in a TOML file given with ``--tolerances`` (the file wins).
+table in a TOML file given with ``--tolerances`` (or a dict from Python; these win).
 """
 
 from __future__ import annotations
@@ -20,8 +19,8 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from lumped.errors import GearcheckError, TrainFileError
-from lumped.spec import flat_tolerances
+from gearcheck.lumped.spec import flat_tolerances
+from gearcheck.shared.errors import GearcheckError, TrainFileError
 
 DEFAULTS = {
     "frequency.rel_error": 1e-6,
@@ -42,11 +41,14 @@ class Tolerances:
         return self.values.get(f"{quantity}.{metric}", self.values.get(f"{kind}.{metric}"))
 
     @classmethod
-    def for_train(cls, spec, path: str | Path | None = None) -> "Tolerances":
-        """Defaults, then the train file's [tolerances], then those of ``path``."""
+    def for_train(cls, spec, extra=None) -> "Tolerances":
+        """Defaults, then the train file's [tolerances], then ``extra``: the path of a TOML file with a
+        [tolerances] table, or a dict of flat keys."""
         overrides = dict(spec.tolerances)
-        if path is not None:
-            overrides.update(read_tolerances(path))
+        if isinstance(extra, dict):
+            overrides.update(flat_tolerances(extra, lambda key, msg: GearcheckError(f"tolerances: {key}: {msg}")))
+        elif extra is not None:
+            overrides.update(read_tolerances(extra))
         return cls(overrides)
 
 

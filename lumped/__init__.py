@@ -1,12 +1,9 @@
-"""gearcheck's train description and reference lumped-parameter solver."""
+"""The train description and the reference lumped-parameter solver.
 
-from .assembly import LumpedModel, build_model
-from .errors import DivergenceError, GearcheckError, SolverError, TrainFileError
-from .kinematics import Kinematics, kinematics
-from .loader import load_text, load_train, preset_names
-from .spec import TrainSpec
+Description (what both models are built from; the MuJoCo twin may import these): ``schema``,
+``loader``, ``spec``, ``geometry``, ``line_of_action``, ``kinematics``, ``mesh_stiffness`` (with
+``tooth_stiffness`` and ``iso6336``), ``excitation``, ``published_parameters``, ``variants``.
 
-__all__ = [
-    "DivergenceError", "GearcheckError", "Kinematics", "LumpedModel", "SolverError", "TrainFileError",
-    "TrainSpec", "build_model", "kinematics", "load_text", "load_train", "preset_names",
-]
+Equations (the reference model; the twin never imports these): ``assembly``, ``modal``, ``static``,
+``time_solver``, ``harmonic``, ``published``, and ``side``, their face towards the cross-check.
+"""

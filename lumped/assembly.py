@@ -1,8 +1,8 @@
 """Assembly of the reference lumped-parameter model from a :class:`TrainSpec`.
 
 Formulation: translational-torsional, each stage in the frame that turns with its
-carrier's nominal speed Omega (Lin & Parker 1999, J. Sound Vib. 210; Kiracofe &
-Parker 2007 for several stages).  Coordinates are small vibrations about nominal
+carrier's nominal speed Omega (Lin & Parker 1999; Kiracofe & Parker 2007 for several
+stages).  Coordinates are small vibrations about nominal
 motion: central members (sun, ring, carrier) have x, y along the rotating frame's axes
 and theta; planets have radial, tangential (absolute displacement components along
 the carrier's radial and tangential directions at the planet) and theta.  All
@@ -42,10 +42,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .contact import line_of_action, lever
-from .excitation import Excitation
-from .kinematics import Kinematics, kinematics
-from .spec import TrainSpec
+from gearcheck.lumped.excitation import Excitation
+from gearcheck.lumped.kinematics import Kinematics, kinematics
+from gearcheck.lumped.line_of_action import lever, line_of_action
+from gearcheck.lumped.spec import TrainSpec
 
 CENTRAL_DOFS = ("x", "y", "theta")
 PLANET_DOFS = ("radial", "tangential", "theta")
@@ -329,7 +329,7 @@ def _mesh_damping(spec, mesh, row, dofs, k_mean) -> float:
     """c = 2 zeta sqrt(k m_eq), m_eq = 1/(r_b1^2/I_1 + r_b2^2/I_2): the equivalent mass of the
     gear pair's torsional motion along the line of action (the arms are the row's own levers).
 
-    Seed paper 000 prints c = 2 zeta sqrt(k / (1/m_s^2 + 1/m_p^2)), which is not even a damping
+    Li et al. (2026) print c = 2 zeta sqrt(k / (1/m_s^2 + 1/m_p^2)), which is not even a damping
     coefficient dimensionally (sqrt(N/m kg^2) = kg sqrt(N/m)); the critical damping of a spring k
     between two inertias is 2 sqrt(k m_eq) with 1/m_eq = 1/m_s + 1/m_p, m = I/r_b^2."""
     if mesh.damping_coefficient is not None:

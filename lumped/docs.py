@@ -1,8 +1,8 @@
 """The README's generated reference: train-file fields and mesh stiffness models.
 
-``python -m lumped.docs [README.md]`` rewrites the blocks between the README's
-``<!-- schema:begin -->``/``<!-- schema:end -->`` and ``<!-- models:begin -->``/
-``<!-- models:end -->`` markers; ``tests/test_readme.py`` fails when they are stale.
+``python -m gearcheck.lumped.docs [README.md]`` rewrites the blocks between the README's
+``<!-- NAME:begin -->``/``<!-- NAME:end -->`` markers (NAME: schema, models, references);
+``tests/test_readme.py`` fails when they are stale.
 """
 
 from __future__ import annotations
@@ -10,8 +10,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from .mesh_stiffness import MODELS
-from .schema import _row, markdown_reference
+from gearcheck.lumped.mesh_stiffness import MODELS
+from gearcheck.lumped.schema import _row, markdown_reference
+from gearcheck.shared.citations import REFERENCES
 
 
 def models_reference() -> str:
@@ -25,7 +26,14 @@ def models_reference() -> str:
     return "\n".join(rows) + "\n"
 
 
-BLOCKS = {"schema": markdown_reference, "models": models_reference}
+def references_table() -> str:
+    """The table of gearcheck's references, by key."""
+    rows = ["| key | reference |", "|---|---|"]
+    rows += [f"| `{key}` | {ref.citation} |" for key, ref in REFERENCES.items()]
+    return "\n".join(rows) + "\n"
+
+
+BLOCKS = {"schema": markdown_reference, "models": models_reference, "references": references_table}
 
 
 def _split(text: str, name: str) -> tuple[str, str, str]:

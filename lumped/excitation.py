@@ -1,9 +1,8 @@
 """What drives the train: torques, mesh stiffness variation and transmission error.
 
-All functions of time here follow the nominal kinematics (the "nominal clock" of
-DESIGN.md section 4), so the lumped solver and the MuJoCo runner evaluate exactly the
-same excitation.  Signs: a static transmission error e > 0 compresses the mesh, so the
-mesh force is k(t) f(delta - e) + c (d delta/dt - de/dt).
+All functions of time here follow the nominal kinematics (the "nominal clock"), so the lumped
+solver and the MuJoCo runner evaluate exactly the same excitation.  Signs: a static transmission
+error e > 0 compresses the mesh, so the mesh force is k(t) f(delta - e) + c (d delta/dt - de/dt).
 """
 
 from __future__ import annotations
@@ -13,37 +12,9 @@ import math
 
 import numpy as np
 
-from .contact import line_of_action
-from .kinematics import Kinematics
-from .mesh_stiffness import stiffness_model
-
-
-STAGE_OFFSETS = (1e-9, 0.5, 1.0 - 1e-9)
-"""Where a fixed-step solver samples the drive within a step [t, t + h]: just after t, at the
-midpoint, just before t + h.  A stiffness switch that falls on a step boundary is then seen
-on the same side by every mesh, whatever the round-off in its phase (planets with equal
-phases stay identical, so the symmetry that mesh phasing relies on survives)."""
-
-STEP_WEIGHTS = (4.0 / 5.0, 1.0 / 5.0)
-"""Per-step drive (MuJoCo holds model fields and controls constant over a step after its first
-RK4 stage): stage 1 sees x(t), stages 2-4 see (4 x(t + h/2) + x(t + h))/5.  With RK4's stage
-weights (2, 2, 1)/6 this integrates a drive linear in time over the step exactly; a stiffness
-switch inside a step is then seen as a weighted mean, the same in both solvers."""
-
-
-def commensurate_step(h_max: float, mesh_frequencies, points_per_cycle: int) -> float:
-    """The largest step <= h_max that divides the slowest mesh period into whole steps, with at
-    least ``points_per_cycle`` steps per period of the fastest mesh.  A rectangular stiffness
-    then switches at the same point of the step in every cycle and the discrete steady
-    response is periodic, like the physical one (an incommensurate step dithers the switching
-    instants from cycle to cycle)."""
-    f = np.asarray(mesh_frequencies, dtype=float)
-    f = f[f > 0]
-    if f.size == 0:
-        return h_max
-    h = min(h_max, 1.0 / (points_per_cycle * f.max()))
-    period = 1.0 / f.min()
-    return period / math.ceil(period / h - 1e-9)
+from gearcheck.lumped.kinematics import Kinematics
+from gearcheck.lumped.line_of_action import line_of_action
+from gearcheck.lumped.mesh_stiffness import stiffness_model
 
 
 def smooth_ramp(t, duration: float):
@@ -72,7 +43,8 @@ class Excitation:
         self._ste = [(i, h, a, p) for i, m in enumerate(meshes) for (h, a, p) in m.ste]
         self._eccentric = list(self._eccentric_terms(spec, kin))
         op = spec.operating
-        self._ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
+        # torque ripple harmonics: (member "input" | "output", amplitude, angular frequency rad/s, phase rad)
+        self.ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
         self._function = None
         self._profile = None if op.torque_profile is None else tuple(np.asarray(x) for x in op.torque_profile)
         if op.torque_function:
@@ -148,7 +120,7 @@ class Excitation:
         t_out_mean = self.kin.output_torque
         t_in = np.zeros_like(t) if op.input_shaft_stiffness is not None else t_in_mean * ramp
         t_out = t_out_mean * ramp
-        for member, amp, omega, phase in self._ripple:
+        for member, amp, omega, phase in self.ripple:
             wave = amp * np.cos(omega * t + phase) * ramp
             if member == "input":
                 t_in = t_in + t_in_mean * wave

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .static import stiffness_with_rotation
+from gearcheck.lumped.static import stiffness_with_rotation
 
 
 def harmonic_response(model, omega: float, force: np.ndarray) -> np.ndarray:

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact import line_of_action, lever
-from .errors import TrainFileError
-from .geometry import base_tooth_thickness
+from gearcheck.lumped.geometry import base_tooth_thickness
+from gearcheck.lumped.line_of_action import lever, line_of_action
+from gearcheck.shared.errors import TrainFileError
 
 
 @dataclass(frozen=True)
@@ -113,7 +113,7 @@ def _sun_ring_offset(spec, mesh) -> float:
     """Phase of a ring-planet mesh relative to the sun-planet mesh of the same simple planet.
 
     Parker & Lin 2004 (conference version DETC2003/PTG-48067, Eqs. 13-21), with the
-    mesh position counted from the start of contact as in :mod:`lumped.mesh_stiffness`
+    mesh position counted from the start of contact as in :mod:`gearcheck.lumped.mesh_stiffness`
     (sun mesh: contact starts at the planet tip; ring mesh: at the ring tip, the planet
     driving the ring in the carrier frame).  At the reference instant a sun-planet pair
     is at the pitch point P1, so the sun mesh is B1P1/p into its cycle; the ring contact

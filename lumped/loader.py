@@ -1,20 +1,23 @@
 """Reading train files and shipped presets.
 
-``TRAIN`` arguments are a preset name (``demo-3p``) or a path to a TOML file.
+``TRAIN`` arguments are a preset name (``demo-3p``) or a path to a TOML file.  Presets are package
+data: they install with gearcheck.
 """
 
 from __future__ import annotations
 
 import hashlib
+import math
 import tomllib
 from importlib import resources
 from pathlib import Path
 
-from . import schema
-from .errors import GearcheckError, TrainFileError
-from .spec import TrainSpec, build_spec
+from gearcheck.lumped import schema
+from gearcheck.lumped.spec import TrainSpec, build_spec
+from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.units import rpm_to_rad_s
 
-PRESET_PACKAGE = "lumped.presets"
+PRESET_PACKAGE = "gearcheck.lumped.presets"
 
 
 def preset_names() -> list[str]:
@@ -36,10 +39,15 @@ def load_text(text: str, source: str) -> TrainSpec:
     return build_spec(data, source, hashlib.sha256(text.encode("utf-8")).hexdigest())
 
 
-def load_train(train: str | Path) -> TrainSpec:
-    """A preset by name or a train file by path, validated."""
-    text, source = read_train_text(train)
-    return load_text(text, source)
+def load_train(train: str | Path | TrainSpec, speed: float | None = None) -> TrainSpec:
+    """A preset by name, a train file by path, or a TrainSpec as it is, validated; ``speed`` (rpm)
+    replaces the train's input speed."""
+    spec = train if isinstance(train, TrainSpec) else load_text(*read_train_text(train))
+    if speed is None:
+        return spec
+    if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not (math.isfinite(speed) and speed > 0):
+        raise GearcheckError(f"speed must be a positive number of rpm, got {speed!r}")
+    return spec.with_operating(input_speed=rpm_to_rad_s(speed))
 
 
 def read_train_text(train: str | Path) -> tuple[str, str]:

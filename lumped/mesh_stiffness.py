@@ -5,9 +5,9 @@ of travel along the line of action); xi = 0 is the instant a new tooth pair ente
 contact.  Every model is a class with a ``name``, a ``parameters`` table (the schema of
 its keys in the train file's ``stiffness`` table, checked and converted to SI like any
 other field), a ``mean`` and ``__call__(xi) -> k``; it is built from those parameters
-and the mesh (:class:`lumped.spec.MeshSpec`: both gears and the operating geometry).
+and the mesh (:class:`gearcheck.lumped.spec.MeshSpec`: both gears and the operating geometry).
 Both solvers call the same objects, so a new model is one new class registered in
-:data:`MODELS`.
+:data:`MODELS`; ``references`` names the works its formulas come from.
 """
 
 from __future__ import annotations
@@ -16,14 +16,15 @@ import math
 
 import numpy as np
 
-from . import tooth_stiffness
-from .schema import Context, Integer, Number, Positive, Table
+from gearcheck.lumped import tooth_stiffness
+from gearcheck.lumped.schema import Context, Integer, Number, Positive, Table
 
 
 class MeshStiffness:
     """Base class; subclasses set ``name``, ``parameters`` and implement ``__call__``."""
 
     name = ""
+    references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
     parameters = Table({"mean": Positive("mean mesh stiffness over a mesh cycle", "N/m")})
 
     def __init__(self, params: dict, mesh):
@@ -86,9 +87,9 @@ class RectangularStiffness(MeshStiffness):
 
 
 class EnergyMethodStiffness(MeshStiffness):
-    """Weber's energy method on the involute teeth (seed paper sec. 3.2): slices, Cornell foundation, Hertz.
+    """Weber's energy method on the involute teeth (Li et al. 2026, sec. 3.2): slices, Cornell foundation, Hertz.
 
-    The pair stiffness along the path of contact comes from :mod:`lumped.tooth_stiffness`;
+    The pair stiffness along the path of contact comes from :mod:`gearcheck.lumped.tooth_stiffness`;
     k(xi) sums the pairs at distances (frac(xi) + j) p_b from the start of contact.  It is
     tabulated separately on the multi-pair part of the cycle, frac(xi) in [0, eps - floor(eps)),
     and on the rest, so the jumps where a pair enters (frac = 0) and leaves are exact; between
@@ -96,6 +97,7 @@ class EnergyMethodStiffness(MeshStiffness):
     """
 
     name = "energy"
+    references = ("weber-1949", "cornell-1981", "li2026")
     parameters = Table({
         "youngs_modulus": Positive("Young's modulus of both gears", "Pa", 206e9),
         "poisson_ratio": Number("Poisson's ratio of both gears", "-", 0.3, 0.0, True, 0.5),
@@ -137,13 +139,13 @@ MODELS: dict[str, type[MeshStiffness]] = {
 
 
 def stiffness_model(mesh) -> MeshStiffness:
-    """The stiffness object of a :class:`~lumped.spec.MeshSpec` (parameters already checked, SI)."""
+    """The stiffness object of a :class:`~gearcheck.lumped.spec.MeshSpec` (parameters already checked, SI)."""
     return MODELS[mesh.stiffness["model"]](mesh.stiffness, mesh)
 
 
 def energy_stiffness_curve(mesh, points: int = 2001, **params):
     """(xi over one mesh cycle, k(xi) in N/m, pairs in contact) of the energy method for a
-    :class:`~lumped.spec.MeshSpec`, whatever model its train file names; ``params`` override
+    :class:`~gearcheck.lumped.spec.MeshSpec`, whatever model its train file names; ``params`` override
     the model's defaults (SI names: ``youngs_modulus``, ``poisson_ratio``, ``slices``, ...)."""
     checked = EnergyMethodStiffness.parameters.parse(params, "stiffness", Context("energy_stiffness_curve"))
     model = EnergyMethodStiffness(checked, mesh)

@@ -1,116 +1,17 @@
-"""Undamped natural frequencies and mode shapes, with Lin & Parker's mode types.
+"""Natural frequencies of the reference lumped model at mean mesh stiffness.
 
-K q = omega^2 M q with every mesh at its mean stiffness and without the rotating-frame
-terms (as in Lin & Parker 1999, section 3).  Mode types (Lin & Parker 1999, 2000):
-
-* rotational: the central members only rotate and all planets move alike;
-* translational: the central members only translate (degenerate pairs);
-* planet: the central members do not move (multiplicity N - 3);
-* rigid: zero frequency (a free rotation);
-* mixed: none of these (unequal spacing, couplings between stages ...).
-
-The classification reads the mode's kinetic-energy fractions in central translation,
-central rotation and the planets; a fraction below ``ENERGY_TOLERANCE`` counts as zero.
+K_mean q = omega^2 M q without the rotating-frame terms (as in Lin & Parker 1999, section 3),
+classified by the central members' coordinates (:func:`gearcheck.shared.modal.mode_types`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-import numpy as np
-import pandas as pd
-import scipy.linalg as sla
-
-ENERGY_TOLERANCE = 1e-8
-DEGENERACY_TOLERANCE = 1e-7  # relative frequency difference grouped as one multiple frequency
-RIGID_TOLERANCE = 1e-9  # omega^2 below this times the largest one is a rigid-body mode
-
-
-@dataclass
-class ModalResult:
-    """Natural frequencies (Hz), mass-normalised mode shapes and their types."""
-
-    train: str
-    frequencies: np.ndarray
-    shapes: np.ndarray  # (n_dof, n_modes)
-    types: list[str]
-    multiplicity: list[int]
-    dof_labels: list[str]
-    solver: str = "lumped"
-
-    def __len__(self) -> int:
-        return len(self.frequencies)
-
-    def to_dataframe(self) -> pd.DataFrame:
-        return pd.DataFrame({"mode": np.arange(1, len(self) + 1), "frequency_hz": self.frequencies,
-                             "type": self.types, "multiplicity": self.multiplicity})
-
-    def to_dict(self) -> dict:
-        return {
-            "train": self.train, "solver": self.solver, "unit": "Hz",
-            "modes": [{"mode": i + 1, "frequency_hz": float(f), "type": t, "multiplicity": m}
-                      for i, (f, t, m) in enumerate(zip(self.frequencies, self.types, self.multiplicity))],
-        }
-
-
-def generalized_modes(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Eigenpairs of K x = w^2 M x: (frequencies in Hz, ascending; mass-normalised shapes)."""
-    w2, shapes = sla.eigh(K, M)
-    w2[np.abs(w2) < RIGID_TOLERANCE * np.max(np.abs(w2))] = 0.0
-    return np.sqrt(np.clip(w2, 0.0, None)) / (2.0 * np.pi), shapes
-
-
-def multiplicities(frequencies: np.ndarray) -> list[int]:
-    groups: list[list[int]] = []
-    for i, f in enumerate(frequencies):
-        if groups and _same(frequencies[groups[-1][0]], f):
-            groups[-1].append(i)
-        else:
-            groups.append([i])
-    out = [0] * len(frequencies)
-    for g in groups:
-        for i in g:
-            out[i] = len(g)
-    return out
-
-
-def _same(a: float, b: float) -> bool:
-    return abs(a - b) <= DEGENERACY_TOLERANCE * max(abs(a), abs(b)) or (a == 0.0 and b == 0.0)
-
-
-def mode_types(M: np.ndarray, shapes: np.ndarray, frequencies: np.ndarray, translation, rotation) -> list[str]:
-    """Lin & Parker types from each mode's kinetic-energy fractions phi_g' M_gg phi_g / phi' M phi
-    in the central members' translations and rotations (index lists over the coordinates)."""
-    translation, rotation = list(translation), list(rotation)
-    types = []
-    for j, f in enumerate(frequencies):
-        if f == 0.0:
-            types.append("rigid")
-            continue
-        phi = shapes[:, j]
-        total = phi @ M @ phi
-        trans = phi[translation] @ M[np.ix_(translation, translation)] @ phi[translation] / total
-        rot = phi[rotation] @ M[np.ix_(rotation, rotation)] @ phi[rotation] / total
-        if trans < ENERGY_TOLERANCE and rot < ENERGY_TOLERANCE:
-            types.append("planet")
-        elif trans < ENERGY_TOLERANCE:
-            types.append("rotational")
-        elif rot < ENERGY_TOLERANCE:
-            types.append("translational")
-        else:
-            types.append("mixed")
-    return types
-
-
-def classify(model, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
-    central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
-               if not model.spec.members[member].is_planet]
-    return mode_types(model.M, shapes, frequencies, [i for i, d in central if d != "theta"],
-                      [i for i, d in central if d == "theta"])
+from gearcheck.shared.modal import ModalResult, modal_result
 
 
 def modes(model) -> ModalResult:
-    """Natural frequencies of a :class:`~lumped.assembly.LumpedModel` at mean mesh stiffness."""
-    frequencies, shapes = generalized_modes(model.K_mean, model.M)
-    return ModalResult(model.spec.name, frequencies, shapes, classify(model, shapes, frequencies),
-                       multiplicities(frequencies), model.dofs.labels())
+    """Natural frequencies of a :class:`~gearcheck.lumped.assembly.LumpedModel` at mean mesh stiffness."""
+    central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
+               if not model.spec.members[member].is_planet]
+    return modal_result(model.spec.name, "lumped", model.K_mean, model.M, model.dofs.labels(),
+                        [i for i, d in central if d != "theta"], [i for i, d in central if d == "theta"])

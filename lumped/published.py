@@ -8,7 +8,8 @@ planet set's displacement, theta_h the carrier angle, theta_f the planet's angle
 the carrier (its absolute angle is theta_h + theta_f, Eq. 3), theta_b the ring b angle.
 The paper writes c for stiffness and k for damping; so does this module.
 
-Models (``MODELS``), every one built from the same :class:`PaperParameters`:
+Models (``MODELS``), every one built from the same
+:class:`~gearcheck.lumped.published_parameters.PaperParameters`:
 
 * ``as-published`` -- M, B, C, D exactly as printed in Eqs. 10, 11, 12, 13.  Row and column 1
   of B and C carry only their diagonal (k1 + k2, c1 + c2): the y1-rotation coupling that
@@ -30,7 +31,7 @@ Models (``MODELS``), every one built from the same :class:`PaperParameters`:
   paper's own assumption for Eq. 4, "y1 collinear with the angular displacements but in the
   opposite direction"): the planet centre moves r_h th_h - y1 along the tangent, so
   M_12 = -m_p r_h; carrier mass on its axis.  This is the kinetic energy of rigid bodies on the
-  joints the potential energy describes (:mod:`mbd_models.published_twin`, y1 tangential).
+  joints the potential energy describes (:mod:`gearcheck.mbd_models.published_twin`, y1 tangential).
 
 ``planet_sets``: the paper's model has one planet although the reducer has three.  With
 ``planet_sets=1`` (default, literal) one planet's mass, inertia and mesh values enter; with
@@ -39,101 +40,32 @@ Models (``MODELS``), every one built from the same :class:`PaperParameters`:
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import GearcheckError, SolverError
-from .modal import generalized_modes
-from .time_solver import rk4_step
+from gearcheck.lumped.published_parameters import LABELS, PaperParameters, check_model, four_dof_result
+from gearcheck.lumped.time_solver import rk4_step
+from gearcheck.shared.errors import DivergenceError
+from gearcheck.shared.modal import ModalResult, modal_result
+from gearcheck.shared.results import TimeResult
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.stepping import transient_step
 
-MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")
-LABELS = ("y1", "theta_h", "theta_f", "theta_b")
-UNITS = ("m", "rad", "rad", "rad")
-
-
-@dataclass(frozen=True)
-class PaperParameters:
-    """Table 1 quantities of the paper, in SI, read from a :class:`~lumped.spec.TrainSpec`."""
-
-    m_h: float  # carrier mass
-    m_p: float  # planet body mass, m_f + m_g
-    J_ch: float  # carrier inertia about its axis
-    J_p: float  # planet inertia, J_cf + J_cg
-    J_cb: float  # ring b inertia
-    m_b: float  # ring b mass (not in the paper's model; the MuJoCo twin needs a positive mass)
-    r_h: float  # carrier radius ("mutual distance")
-    r_f: float  # pitch radius of planet gear f (meshes ring e)
-    r_g: float  # pitch radius of planet gear g (meshes ring b)
-    r_b: float  # pitch radius of ring b
-    c1: float  # mesh stiffness f-e
-    c2: float  # mesh stiffness g-b
-    k1: float  # mesh damping f-e
-    k2: float  # mesh damping g-b
-    input_torque: float  # mean M_h, N m (power balance with the output load)
-    output_torque: float  # load on ring b, N m, signed (opposes ring b's rotation)
-    input_speed: float  # rad/s (sets the ripple frequencies)
-    ripple: tuple = field(default=())  # (member, amplitude, omega rad/s, phase) of the spec's ripple
-    planet_sets: int = 1
-    source: str = ""
-
-    @classmethod
-    def from_spec(cls, spec, planet_sets: int = 1) -> "PaperParameters":
-        """Read the paper's parameters from a one-stage, two-ring, compound-planet train.
-
-        Ring e = the held ring, ring b = the output ring, carrier = the input; gears f and g are
-        the planet gears those rings mesh with.  Mesh stiffness is the stiffness model's mean,
-        mesh damping must be given as a coefficient (the paper's k1, k2).
-        """
-        from .kinematics import kinematics
-        from .mesh_stiffness import stiffness_model
-
-        if len(spec.stages) != 1:
-            raise GearcheckError(f"{spec.name}: the 4-DOF model of Matejic et al. needs one stage, "
-                                 f"got {len(spec.stages)}")
-        stage = spec.stages[0]
-        if spec.input != stage.carrier:
-            raise GearcheckError(f"{spec.name}: the 4-DOF model needs the carrier as input, got {spec.input}")
-        rings = [c for c in stage.centrals if spec.members[c].kind == "ring"]
-        held = [c for c in rings if c in spec.held]
-        if len(rings) != 2 or len(held) != 1 or spec.output not in rings or spec.output in held:
-            raise GearcheckError(f"{spec.name}: the 4-DOF model needs two rings, one held (e) and one the "
-                                 f"output (b); got rings {rings}, held {list(spec.held)}, output {spec.output}")
-        ring_e, ring_b = held[0], spec.output
-        mesh_e = next(m for m in spec.meshes if m.central == ring_e and m.planet_index == 0)
-        mesh_b = next(m for m in spec.meshes if m.central == ring_b and m.planet_index == 0)
-        for mesh in (mesh_e, mesh_b):
-            if mesh.damping_coefficient is None:
-                raise GearcheckError(f"{spec.name}: {mesh.central} mesh damping must be a coefficient "
-                                     "(the paper's k1, k2), not a ratio")
-        n = int(planet_sets)
-        if n < 1:
-            raise GearcheckError(f"planet_sets must be >= 1, got {planet_sets}")
-        carrier = spec.members[stage.carrier]
-        planet = spec.members[stage.planets[0]]
-        kin = kinematics(spec)
-        ripple = []
-        for r in spec.operating.ripple:
-            member = spec.input if r.member == "input" else spec.output
-            omega = 2 * math.pi * r.frequency if r.frequency is not None else r.order * abs(kin.speeds[member])
-            ripple.append((r.member, r.amplitude, omega, r.phase))
-        t_out = kin.output_torque
-        return cls(
-            m_h=carrier.mass, m_p=n * planet.mass, J_ch=carrier.inertia, J_p=n * planet.inertia,
-            J_cb=spec.members[ring_b].inertia, m_b=spec.members[ring_b].mass, r_h=stage.carrier_radius,
-            r_f=mesh_e.planet_gear.pitch_radius, r_g=mesh_b.planet_gear.pitch_radius,
-            r_b=mesh_b.central_gear.pitch_radius,
-            c1=n * stiffness_model(mesh_e).mean, c2=n * stiffness_model(mesh_b).mean,
-            k1=n * mesh_e.damping_coefficient, k2=n * mesh_b.damping_coefficient,
-            input_torque=-t_out / kin.ratio if t_out else 0.0, output_torque=t_out,
-            input_speed=spec.operating.input_speed, ripple=tuple(ripple), planet_sets=n, source=spec.name,
-        )
-
-    @property
-    def ratio(self) -> float:
-        """theta_h / theta_b of the rigid train (both meshes undeformed, y1 = 0)."""
-        return self.r_b * self.r_f / (self.r_h * (self.r_f - self.r_g))
+FINDING = (
+    "Matejic et al. (2021) write the potential energy as 1/2 c1 (y1 - u1)^2 + 1/2 c2 (y1 - u2)^2 (Eq. 4), "
+    "with u1, u2 the rotations' mesh displacements, and their equations of motion (Eqs. 6-9) keep the "
+    "coupling of y1 with the rotations; but the printed stiffness and damping matrices (Eqs. 11-12) have "
+    "zeros in row and column 1 off the diagonal. Taken literally, the as-published model hangs y1 on a "
+    "spring c1 + c2 to the ground that no torque can excite (its y1 acceleration is identically zero), "
+    "adds a spurious y1 mode and shifts the others. A MuJoCo twin built from the paper's own bodies and "
+    "joints, with the mesh coefficients taken from MuJoCo's Jacobians, agrees with the model derived from "
+    "Eqs. 3-5 with the coupling kept (energy-derived) to 1e-6 in every natural frequency, and with the "
+    "as-published matrices in none above the rigid-body mode. Smaller defects: Eq. 8 carries a stray "
+    "factor r_g in its k1 term, and Eq. 3 gives the carrier m_h r_h^2 on top of its CAD inertia J_ch "
+    "(46 % more carrier inertia; the 'energy-derived-axis' model and twin put the carrier's mass on its "
+    "axis)."
+)
 
 
 @dataclass(frozen=True)
@@ -150,17 +82,8 @@ class FourDofModel:
     def D(self, t, load: bool = True) -> np.ndarray:
         """Generalized forces, Eq. 13: (0, M_h(t), 0, 0); with ``load`` also the output torque on
         theta_b (the paper's D has none)."""
-        p = self.params
-        t = np.asarray(t, dtype=float)
-        m_h = np.full_like(t, p.input_torque)
-        t_b = np.full_like(t, p.output_torque if load else 0.0)
-        for member, amp, omega, phase in p.ripple:
-            wave = amp * np.cos(omega * t + phase)
-            if member == "input":
-                m_h = m_h + p.input_torque * wave
-            elif load:
-                t_b = t_b + p.output_torque * wave
-        out = np.zeros(t.shape + (4,))
+        m_h, t_b = self.params.torques(t, load)
+        out = np.zeros(np.shape(m_h) + (4,))
         out[..., 1] = m_h
         out[..., 3] = t_b
         return out
@@ -233,6 +156,7 @@ def energy_derived(p: PaperParameters, carrier_on_axis: bool = False, collinear:
 
 def four_dof_model(source, model: str = "as-published", planet_sets: int = 1) -> FourDofModel:
     """The chosen 4-DOF model (``MODELS``) of a TrainSpec or PaperParameters."""
+    check_model(model)
     p = source if isinstance(source, PaperParameters) else PaperParameters.from_spec(source, planet_sets)
     if model == "as-published":
         return as_published(p)
@@ -240,57 +164,25 @@ def four_dof_model(source, model: str = "as-published", planet_sets: int = 1) ->
         return energy_derived(p)
     if model == "energy-derived-axis":
         return energy_derived(p, carrier_on_axis=True)
-    if model == "consistent":
-        return energy_derived(p, carrier_on_axis=True, collinear=True)
-    raise GearcheckError(f"unknown 4-DOF model {model!r}; choose one of {', '.join(MODELS)}")
+    return energy_derived(p, carrier_on_axis=True, collinear=True)
 
 
-@dataclass(frozen=True)
-class FourDofModes:
-    model: str
-    frequencies: np.ndarray  # Hz, ascending, rigid-body modes as 0
-    shapes: np.ndarray  # columns, mass-normalised
-    rigid: int  # number of rigid-body (zero-frequency) modes
+def natural_frequencies(model: FourDofModel) -> ModalResult:
+    """Undamped modes of (C, M), rigid-body modes as 0 Hz, typed rigid or elastic."""
+    return modal_result(model.params.source, model.name, model.C, model.M, LABELS)
 
 
-def natural_frequencies(model: FourDofModel) -> FourDofModes:
-    """Undamped modes of (C, M) (:func:`lumped.modal.generalized_modes`: rigid-body modes as 0 Hz)."""
-    frequencies, shapes = generalized_modes(model.C, model.M)
-    return FourDofModes(model.name, frequencies, shapes, int(np.sum(frequencies == 0)))
-
-
-@dataclass
-class FourDofResponse:
-    model: str
-    t: np.ndarray
-    q: np.ndarray  # (n_t, 4)
-    v: np.ndarray
-    a: np.ndarray
-    info: dict
-
-    def acceleration(self, label: str) -> np.ndarray:
-        return self.a[:, LABELS.index(label)]
-
-
-def max_angular_frequency(model: FourDofModel) -> float:
-    return float(2 * math.pi * natural_frequencies(model).frequencies.max())
-
-
-def simulate(model: FourDofModel, duration: float, dt: float | None = None, load: bool = True,
-             points_per_period: float = 40.0) -> FourDofResponse:
+def simulate(model: FourDofModel, settings: RunSettings, load: bool = True) -> TimeResult:
     """Start-stop regime: from rest (q = q' = 0) under D(t), fixed-step classical RK4.
 
     load: apply the output torque on theta_b with the mean input torque M_h = T_out/i, so the
     train's rigid rotation only sees the ripple (the paper's Eq. 13 has no load: load=False,
     then the whole train accelerates under M_h).  Either way the rigid-body modes are kept: the
-    accelerations contain their (constant) part.  dt defaults to the shortest natural period
-    over ``points_per_period``.
+    accelerations contain their (constant) part.  The step defaults to
+    :func:`gearcheck.shared.stepping.transient_step` of the model's own frequencies.
     """
-    if duration <= 0:
-        raise SolverError(f"duration must be > 0, got {duration}")
-    if dt is None:
-        dt = 2 * math.pi / max_angular_frequency(model) / points_per_period
-    steps = int(math.ceil(duration / dt - 1e-9))
+    dt = transient_step(natural_frequencies(model).frequencies) if settings.dt is None else settings.dt
+    steps, _ = settings.grid(dt)
     Minv = np.linalg.inv(model.M)
     A_q, A_v = -Minv @ model.C, -Minv @ model.B
 
@@ -299,14 +191,15 @@ def simulate(model: FourDofModel, duration: float, dt: float | None = None, load
 
     t = np.arange(steps + 1) * dt
     q = np.zeros((steps + 1, 4))
-    v = np.zeros((steps + 1, 4))
     a = np.zeros((steps + 1, 4))
     qi, vi = np.zeros(4), np.zeros(4)
     for i in range(steps):
         a[i] = accel(t[i], qi, vi)
         qi, vi = rk4_step(lambda s, q_, v_, ti=t[i]: accel(ti + 0.5 * s * dt, q_, v_), qi, vi, dt)
-        q[i + 1], v[i + 1] = qi, vi
+        q[i + 1] = qi
     a[-1] = accel(t[-1], qi, vi)
     if not np.all(np.isfinite(q)):
-        raise SolverError(f"{model.name}: the RK4 integration diverged (dt = {dt:g} s)")
-    return FourDofResponse(model.name, t, q, v, a, {"method": "rk4", "dt_s": dt, "steps": steps, "load": load})
+        raise DivergenceError(float(t[np.argmax(~np.isfinite(q).all(axis=1))]),
+                              f"the {model.name} RK4 integration (dt = {dt:g} s)")
+    info = {"method": f"{model.name} 4-DOF, rk4", "dt_s": dt, "steps": steps, "load": load}
+    return four_dof_result(model.params.source, model.name, model.name, t, q, a, info)

@@ -16,14 +16,9 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from .errors import TrainFileError
-
-_UNIT_SUFFIXES = {
-    "_mm": ("mm", 1e-3),
-    "_um": ("µm", 1e-6),
-    "_deg": ("deg", math.pi / 180.0),
-    "_rpm": ("rpm", 2.0 * math.pi / 60.0),
-}
+from gearcheck.shared.citations import REFERENCES
+from gearcheck.shared.errors import TrainFileError
+from gearcheck.shared.units import SUFFIXES
 
 REQUIRED = object()
 
@@ -39,7 +34,7 @@ class Context:
 
 
 def _si_name(key: str) -> tuple[str, float]:
-    for suffix, (_, factor) in _UNIT_SUFFIXES.items():
+    for suffix, (_, factor) in SUFFIXES.items():
         if key.endswith(suffix):
             return key[: -len(suffix)], factor
     return key, 1.0
@@ -436,7 +431,10 @@ TRAIN_TABLE = Table(
     {
         "name": Text("train name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
         "description": Text("one-line description"),
-        "source": Text("where the train comes from (paper, design)", ""),
+        "source": Text("where the train comes from, in words (paper, design, table)", ""),
+        "references": ListOf(Text("key", REQUIRED, tuple(REFERENCES)),
+                             "the works the train comes from: keys of gearcheck's reference table (see README: "
+                             "references)", ()),
         "input": Text("input member, `STAGE.MEMBER`", REQUIRED),
         "output": Text("output member", REQUIRED),
         "held": ListOf(Text("member", REQUIRED),

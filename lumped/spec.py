@@ -13,8 +13,8 @@ import math
 from dataclasses import dataclass, field
 from math import gcd
 
-from .errors import TrainFileError
-from .geometry import Gear, MeshGeometry, mesh_geometry
+from gearcheck.lumped.geometry import Gear, MeshGeometry, mesh_geometry
+from gearcheck.shared.errors import TrainFileError
 
 MIN_TEETH = 6
 CENTRE_DISTANCE_TOLERANCE = 1e-6  # m: sun-planet and ring-planet operating centre distances must match
@@ -141,6 +141,7 @@ class TrainSpec:
     couplings: tuple[Coupling, ...]
     operating: Operating
     text_hash: str = ""
+    references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
     measurements: tuple[dict, ...] = ()  # measured reference values, SI (see schema.MEASUREMENT)
     tolerances: dict = field(default_factory=dict)  # cross-check tolerance overrides, flat keys
 
@@ -198,6 +199,9 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         for key in ("from", "to"):
             if c[key] not in members:
                 raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{_known(c[key], members)}")
+            if members[c[key]].is_planet:
+                raise fail(f"couplings[{j}].{key}", f"{c[key]} is a planet; a coupling joins central members "
+                                                    "(sun, ring, carrier)")
         if members[c["from"]].stage == members[c["to"]].stage:
             raise fail(f"couplings[{j}]", "a coupling joins members of different stages")
         couplings.append(Coupling(c["name"], c["kind"], c["from"], c["to"], c["torsional_stiffness"],
@@ -219,7 +223,8 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         name=train["name"], description=train["description"], source=train["source"], path=source,
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
         stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
-        text_hash=text_hash, measurements=tuple(_measurements(data, source, fail)),
+        text_hash=text_hash, references=tuple(train["references"]),
+        measurements=tuple(_measurements(data, source, fail)),
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
     )
 
@@ -266,7 +271,7 @@ def _measurements(data: dict, source: str, fail) -> list[dict]:
     """Inline [[measurements]] plus those of train.measurements_file, checked; bands sorted."""
     import tomllib
 
-    from .schema import parse_measurements
+    from gearcheck.lumped.schema import parse_measurements
 
     entries = list(data["measurements"])
     name = data["train"]["measurements_file"]
@@ -488,8 +493,8 @@ def _build_stage(st: dict, path: str, fail):
 
 def _check_stiffness(params: dict, path: str, fail):
     """Check a ``stiffness`` table against its model's parameter table; store SI values in place."""
-    from .mesh_stiffness import MODELS
-    from .schema import Context
+    from gearcheck.lumped.mesh_stiffness import MODELS
+    from gearcheck.lumped.schema import Context
 
     name = params["model"]
     if name not in MODELS:

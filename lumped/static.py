@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .errors import SolverError
+from gearcheck.shared.contact_laws import deadzone
+from gearcheck.shared.errors import SolverError
 
 
 @dataclass
@@ -72,8 +73,3 @@ def static_solution(model, load_scale: float = 1.0) -> StaticResult:
     return StaticResult(q, [m.id for m in model.spec.meshes], delta, force, contact,
                         [r.name for r in model.rows], row_forces)
 
-
-def deadzone(delta, half_backlash):
-    """f(delta) = delta - b above b, 0 inside |delta| <= b, delta + b below -b."""
-    return np.where(delta > half_backlash, delta - half_backlash,
-                    np.where(delta < -half_backlash, delta + half_backlash, 0.0))

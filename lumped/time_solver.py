@@ -1,6 +1,6 @@
 """Time response of the reference model: fixed-step RK4 and scipy's adaptive integrators.
 
-Equation of motion (rotating frame, see :mod:`lumped.assembly`):
+Equation of motion (rotating frame, see :mod:`gearcheck.lumped.assembly`):
 
     M q'' = F_static + b_in T_in(t) + b_out T_out(t) - (C_b + G) q' - (K_b + K_frame) q
             - sum_m a_m [k_m(t) f(a_m.q - e_m(t)) + c_m (a_m.q' - e_m'(t))],
@@ -8,12 +8,12 @@ Equation of motion (rotating frame, see :mod:`lumped.assembly`):
 f the backlash dead zone.  The start is the static deflection under the mean load
 (``ramp_s`` = 0) or the unloaded state with the load ramped in.
 
-Time step: :mod:`lumped.stepping` (the rule the MuJoCo runner follows too), from the highest
-natural frequency of this model with every mesh at its cycle-maximum stiffness.
-The drive is sampled at t + h (eps, 1/2, 1 - eps) (:data:`lumped.excitation.STAGE_OFFSETS`).
+Time step: :mod:`gearcheck.shared.stepping` (the rule the MuJoCo runner follows too), from the
+highest natural frequency of this model with every mesh at its cycle-maximum stiffness.
+The drive is sampled at t + h (eps, 1/2, 1 - eps) (:data:`~gearcheck.shared.stepping.STAGE_OFFSETS`).
 By default (``drive="steps"``) RK4's first stage sees x(t + eps) and the other three
 (4 x(t + h/2) + x(t + h - eps))/5, exactly as the MuJoCo runner drives its model
-(:data:`lumped.excitation.STEP_WEIGHTS`): exact for drives linear over a step, and a
+(:func:`~gearcheck.shared.stepping.per_step_drive`): exact for drives linear over a step, and a
 stiffness switch inside a step is treated alike by both solvers, so what the cross-check
 measures is the models, not two treatments of a discontinuity.  ``drive="stages"`` is the
 textbook RK4 with the drive at each stage's own time.
@@ -21,18 +21,19 @@ textbook RK4 with the drive at each stage's own time.
 
 from __future__ import annotations
 
-import math
 import time as clock
 
 import numpy as np
 import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
-from .errors import DivergenceError, SolverError
-from . import stepping
-from .excitation import STAGE_OFFSETS, STEP_WEIGHTS
-from .results import TimeResult
-from .static import deadzone, mean_load, static_solution
+from gearcheck.lumped.static import mean_load, static_solution
+from gearcheck.shared import stepping
+from gearcheck.shared.contact_laws import deadzone
+from gearcheck.shared.errors import DivergenceError, SolverError
+from gearcheck.shared.results import TimeResult, train_result
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
 
 CHUNK = 20000
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
@@ -50,7 +51,7 @@ def stable_step(model) -> float:
 
 
 def default_step(model) -> float:
-    """:func:`lumped.stepping.default_step` for this model."""
+    """:func:`gearcheck.shared.stepping.default_step` for this model."""
     return stepping.default_step(max_angular_frequency(model), model.excitation.frequency)
 
 
@@ -158,47 +159,38 @@ def mechanical_energy(model, q, v) -> np.ndarray:
     return 0.5 * np.einsum("ti,ij,tj->t", v, model.M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, K, q) - q @ F
 
 
-def simulate(model, duration: float, dt: float | None = None, method: str = "rk4", output_dt: float | None = None,
-             settle: float | None = None, rtol: float = 1e-8, atol: float = 1e-14, y0=None,
+def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e-8, atol: float = 1e-14, y0=None,
              progress=None, drive: str = "steps") -> TimeResult:
-    """Integrate ``model`` over ``duration`` seconds.
+    """Integrate ``model`` as ``settings`` ask.
 
     method: "rk4" (matrix form of each step where the model is linear over it), "rk4-stages" (the
     same RK4, stage by stage everywhere: the reference the matrix form is tested against) or
-    one of scipy's adaptive methods.
+    one of scipy's adaptive methods, whose largest step is then ``settings.dt``.
     drive: "steps" (default, like-for-like with the MuJoCo runner) or "stages" (see the module doc).
-    dt: RK4 step (default :func:`default_step`), checked against the stability limit;
-    also the largest step of the adaptive methods.  output_dt: sampling of the result
-    (default: every step).  settle: start of the steady-state window (default: the
-    larger of the load ramp and half the duration).  progress: callable(fraction).
+    The step defaults to :func:`default_step` and is checked against the stability limit.
+    y0: optional (q, v) instead of the static start.  progress: callable(fraction).
     """
-    if not (duration > 0 and math.isfinite(duration)):
-        raise SolverError(f"duration must be a positive number of seconds, got {duration}")
+    if method not in ("rk4", "rk4-stages") + ADAPTIVE_METHODS:
+        raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
+    if drive not in ("steps", "stages"):
+        raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
     omega_max = max_angular_frequency(model)
-    if dt is None:
-        dt = stepping.default_step(omega_max, model.excitation.frequency)
+    dt = stepping.default_step(omega_max, model.excitation.frequency) if settings.dt is None else settings.dt
     stepping.check_step(dt, omega_max, model.excitation.frequency, f"lumped model of {model.spec.name}")
-    every = 1 if output_dt is None else max(1, round(output_dt / dt))
-    n_steps = every * max(1, math.ceil(duration / (dt * every) - 1e-9))  # ends on an output sample
+    n_steps, every = settings.grid(dt)
     q0, v0 = initial_state(model) if y0 is None else y0
     sys = _System(model)
     started = clock.perf_counter()
-    if drive not in ("steps", "stages"):
-        raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
     if method in ("rk4", "rk4-stages"):
         t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, method == "rk4-stages", drive)
         evaluations = 4 * n_steps
-    elif method in ADAPTIVE_METHODS:
-        t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
     else:
-        raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
+        t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
     wall = clock.perf_counter() - started
-    op = model.spec.operating
-    settle = max(op.ramp, 0.5 * duration) if settle is None else settle
     info = {"method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
             "rhs_evaluations": evaluations, "wall_time_s": wall,
             "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms}
-    return _result(model, sys, t_out, q_out, v_out, settle, info)
+    return _result(model, sys, t_out, q_out, v_out, settings.settle_time(model.spec.operating.ramp), info)
 
 
 def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="steps"):
@@ -218,7 +210,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
         times = (np.arange(start, stop)[:, None] + stages[None, :]) * h
         k, e, de, tin, tout = sys.drive(times)
         if drive == "steps":  # stages 2-4 all see the step's weighted drive (as MuJoCo's model fields)
-            k, e, de, tin, tout = (_per_step(x) for x in (k, e, de, tin, tout))
+            k, e, de, tin, tout = (per_step_drive(x) for x in (k, e, de, tin, tout))
         if linear is not None:
             load = sys.load(k, e, de, tin, tout)
             smooth = np.all(k[:, 0, :] == k[:, 1, :], axis=1) & np.all(k[:, 1, :] == k[:, 2, :], axis=1)
@@ -266,13 +258,6 @@ def rk4_step(acceleration, q, v, h):
     return q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def _per_step(x: np.ndarray) -> np.ndarray:
-    """Drive samples (steps, 3 stage times, ...) -> stage 1 unchanged, stages 2-4 the weighted mean."""
-    out = x.copy()
-    out[:, 1] = out[:, 2] = STEP_WEIGHTS[0] * x[:, 1] + STEP_WEIGHTS[1] * x[:, 2]
-    return out
-
-
 def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
     n = q0.size
 
@@ -309,16 +294,9 @@ def _result(model, sys, t, q, v, settle, info) -> TimeResult:
         carrier = f"{member.stage}.carrier"
         angle[:, j] = model.kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
     bearings = [r for r in model.rows if r.kind == "bearing"]
-    bearing_force = None
-    if bearings:
-        rows = np.array([r.a for r in bearings])
-        bearing_force = (q @ rows.T) * [r.stiffness for r in bearings] + (v @ rows.T) * [r.damping for r in bearings]
-    static = static_solution(model)
+    rows = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)
+    bearing_force = (q @ rows.T) * [r.stiffness for r in bearings] + (v @ rows.T) * [r.damping for r in bearings]
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
-    return TimeResult(
-        train=spec.name, solver="lumped", t=t, members=members, acc_carrier=acc, carrier_angle=angle,
-        mesh_ids=[m.id for m in spec.meshes], mesh_deflection=delta, mesh_force=force, mesh_stiffness=k,
-        static_mesh_force=static.mesh_force, bearing_names=[r.name for r in bearings], bearing_force=bearing_force,
-        settle_time=settle, info=info, raw=raw,
-    )
+    return train_result(spec, "lumped", t, acc, angle, delta, force, k, static_solution(model).mesh_force,
+                        [r.name for r in bearings], bearing_force, settle, info, raw)

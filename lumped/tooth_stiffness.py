@@ -1,4 +1,4 @@
-"""Tooth-contact mesh stiffness by Weber's energy method (seed paper, section 3.2).
+"""Tooth-contact mesh stiffness by Weber's energy method (Li et al. 2026, section 3.2).
 
 The deflection of a tooth pair along the line of action at a contact point is the sum,
 for each tooth, of
@@ -25,7 +25,7 @@ radius rho_fP) tangent to the root circle and the flank.  The exact generated fi
 trochoid; the circle has the same tangents at both ends.  (Against Tian's straight tooth below
 the base circle the sliced compliance differs by under 2.5 %, see tests/test_mesh_stiffness.py.)
 
-Everything is SI.  Functions are pure in :class:`~lumped.geometry.Gear` and material constants.
+Everything is SI.  Functions are pure in :class:`~gearcheck.lumped.geometry.Gear` and material constants.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .geometry import Gear, involute
+from gearcheck.lumped.geometry import Gear, involute
 
 FILLET_RADIUS = 0.38  # root fillet radius / module: ISO 53 profile A rack tip radius rho_fP
 WIDE_TOOTH_RATIO = 5.0  # Cornell: face width / pitch tooth thickness above which plane strain holds

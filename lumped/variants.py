@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import re
 
-from .loader import load_text, preset_text
-from .spec import TrainSpec
+from gearcheck.lumped.loader import load_text, preset_text
+from gearcheck.lumped.spec import TrainSpec
 
 
 def edited_text(preset: str, pairs) -> str:

@@ -7,27 +7,25 @@ reference, carrier angle 0), at rest, with every mesh tendon at its mean stiffne
 As in the lumped modal analysis (Lin & Parker 1999, section 3) no rotation terms
 enter: the model is linearised at qvel = 0.
 
-Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions
-phi_S' M_SS phi_S / phi' M phi of the central members' slides (translation), the central
-members' hinges (rotation) and the planets' joints, classified by
-:func:`lumped.modal.mode_types` (a fraction below its tolerance counts as zero).  Zero amplitude of a group is a physical
-statement (the sun, ring and carrier do not translate / do not turn), so the types do
-not depend on MuJoCo's choice of coordinates (planet slides relative to the carrier).
+Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions of the central
+members' slides (translation) and hinges (rotation), classified by
+:func:`gearcheck.shared.modal.mode_types`; they do not depend on MuJoCo's choice of coordinates
+(planet slides relative to the carrier).
+
+Every function takes a compiled twin (:class:`gearcheck.mbd_models.twin.MbdModel`).
 """
 
 from __future__ import annotations
 
-import numpy as np
 import mujoco
+import numpy as np
 
-from lumped.modal import ModalResult, generalized_modes, mode_types, multiplicities
-
-from .mjcf_builder import MbdModel, compile_train
+from gearcheck.shared.modal import ModalResult, modal_result
 
 FD_STEP = 1e-6  # m or rad; the spring forces are linear in qpos, so the step only sets rounding
 
 
-def _set_rest(mb: MbdModel, data: mujoco.MjData, qpos: np.ndarray) -> None:
+def _set_rest(mb, data: mujoco.MjData, qpos: np.ndarray) -> None:
     data.qpos[:] = qpos
     data.qvel[:] = 0.0
     data.ctrl[:] = 0.0
@@ -35,7 +33,7 @@ def _set_rest(mb: MbdModel, data: mujoco.MjData, qpos: np.ndarray) -> None:
         data.ctrl[mb.actuator["input_shaft"]] = 0.0  # reference angle at the nominal configuration
 
 
-def mass_matrix(mb: MbdModel, qpos: np.ndarray | None = None) -> np.ndarray:
+def mass_matrix(mb, qpos: np.ndarray | None = None) -> np.ndarray:
     m = mb.model
     d = mujoco.MjData(m)
     _set_rest(mb, d, m.qpos0 if qpos is None else qpos)
@@ -45,7 +43,7 @@ def mass_matrix(mb: MbdModel, qpos: np.ndarray | None = None) -> np.ndarray:
     return M
 
 
-def stiffness_matrix(mb: MbdModel, tendon_stiffness: np.ndarray | None = None,
+def stiffness_matrix(mb, tendon_stiffness: np.ndarray | None = None,
                      qpos: np.ndarray | None = None) -> np.ndarray:
     """-d(qfrc_passive + qfrc_actuator)/dqpos by central differences, at rest.
 
@@ -79,7 +77,7 @@ def stiffness_matrix(mb: MbdModel, tendon_stiffness: np.ndarray | None = None,
     return 0.5 * (K + K.T)
 
 
-def max_angular_frequency(mb: MbdModel) -> float:
+def max_angular_frequency(mb) -> float:
     """Highest natural angular frequency of the MuJoCo model with every mesh at its cycle-maximum stiffness."""
     w2 = np.linalg.eigvalsh(_reduce(stiffness_matrix(mb, mb.excitation.max_stiffness), mass_matrix(mb)))
     return float(np.sqrt(max(w2.max(), 0.0)))
@@ -92,23 +90,13 @@ def _reduce(K, M):
     return 0.5 * (A + A.T)
 
 
-def joint_labels(mb: MbdModel) -> list[str]:
+def joint_labels(mb) -> list[str]:
     m = mb.model
     return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)]
 
 
-def classify(mb: MbdModel, M: np.ndarray, shapes: np.ndarray, frequencies: np.ndarray) -> list[str]:
-    """Lin & Parker mode types from kinetic-energy fractions over MuJoCo's own joints."""
+def modes(mb) -> ModalResult:
+    """Natural frequencies and mode types of the MuJoCo model at mean mesh stiffness (solver "mujoco")."""
     central = [mb.dadr[mid] for mid, member in mb.spec.members.items() if not member.is_planet]
-    return mode_types(M, shapes, frequencies, [i for x, y, _ in central for i in (x, y)],
-                      [rz for _, _, rz in central])
-
-
-def mujoco_modes(spec, mb: MbdModel | None = None) -> ModalResult:
-    """Natural frequencies and mode types of the MuJoCo model at mean mesh stiffness (solver="mujoco")."""
-    mb = compile_train(spec) if mb is None else mb
-    M = mass_matrix(mb)
-    K = stiffness_matrix(mb, mb.excitation.mean_stiffness)
-    frequencies, shapes = generalized_modes(K, M)
-    return ModalResult(spec.name, frequencies, shapes, classify(mb, M, shapes, frequencies),
-                       multiplicities(frequencies), joint_labels(mb), solver="mujoco")
+    return modal_result(mb.spec.name, "mujoco", stiffness_matrix(mb, mb.excitation.mean_stiffness), mass_matrix(mb),
+                        joint_labels(mb), [i for x, y, _ in central for i in (x, y)], [rz for _, _, rz in central])

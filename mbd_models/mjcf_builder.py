@@ -1,4 +1,4 @@
-"""MJCF generation: the train as rigid bodies on joints, meshes as fixed tendons.
+"""MJCF text of a train: rigid bodies on joints, meshes as fixed tendons.
 
 Bodies and joints (all planar, gravity off):
 
@@ -20,37 +20,21 @@ Bodies and joints (all planar, gravity off):
   w_in, so the shaft damping acts on the twist rate only;
   load and input torques are ``motor`` actuators with gear 1.
 
-Meshes: each mesh is a ``<fixed>`` tendon whose length is the mesh deflection
+Meshes: each mesh is a ``<fixed>`` tendon over the nine joints that move its pitch point (the
+central member's and the carrier's slides and hinges, the planet's slides and hinge), whose length
+is the mesh deflection.  The coefficients are not written from a formula here: they are given,
+taken by :func:`gearcheck.mbd_models.twin.compile_train` from MuJoCo's own Jacobians.  A backlash
+b = backlash/2 is the two-valued spring length "-b b" (a dead band).
 
-    delta = (u_central(p) - u_planet(p)) . d     (positive = teeth compressed),
-
-with p the pitch point and d the unit line-of-action direction from the train
-description (:func:`lumped.contact.line_of_action`, given in the carrier frame and
-rotated into the world by the carrier's angle).  The joint coefficients are NOT
-written from a formula: they are d . (Jp_central - Jp_planet), the translation
-Jacobians of MuJoCo's own bodies at p (``mujoco.mj_jac``) in a compiled skeleton of
-the same model.  A backlash b = backlash/2 is the two-valued spring length "-b b"
-(a dead band).  The coefficients of world-frame slides (central members and the
-carrier) depend on the carrier angle; :class:`MbdModel` keeps the indices and the
-angle-0 values so the runner can rotate them every step (see :meth:`MbdModel.refresh`).
-
-Mesh damping: c = 2 zeta sqrt(k_mean m_eq), m_eq = 1/(r_A^2/I_A + r_B^2/I_B) with
-r_A, r_B the tendon's own coefficients on the two gears' hinges and I the bodies' polar
-inertias in the compiled model.
+Every number is written with full precision (the shortest repr that round-trips), angles in
+radian, so the text is deterministic and lossless.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
-import mujoco
-import numpy as np
-
-from lumped.contact import line_of_action
-from lumped.excitation import Excitation
-from lumped.kinematics import Kinematics, kinematics
-from lumped.spec import TrainSpec
+from gearcheck.lumped.spec import TrainSpec
 
 STAGE_SPACING = 0.12  # m along z between stages (visual only: all motion is planar)
 RGBA = {
@@ -169,7 +153,7 @@ def _fixed(name: str, coefs: list[tuple[str, float]], stiffness: float, damping:
     return lines
 
 
-def _coupling_tendons(spec: TrainSpec) -> list[str]:
+def coupling_tendons(spec: TrainSpec) -> list[str]:
     lines = []
     for c in spec.couplings:
         a, b = spec.members[c.a].label, spec.members[c.b].label
@@ -182,75 +166,24 @@ def _coupling_tendons(spec: TrainSpec) -> list[str]:
     return lines
 
 
-def mesh_jacobian_row(spec: TrainSpec, kin: Kinematics, model: mujoco.MjModel, data: mujoco.MjData,
-                      mesh) -> np.ndarray:
-    """d . (Jp_central(p) - Jp_planet(p)) over all dofs, at ``data``'s current configuration.
-
-    ``data`` must have its kinematics computed (``mj_kinematics`` and ``mj_comPos``, or
-    ``mj_forward``).  p is the pitch point and d the line of action of the train
-    description, both given in the carrier frame and placed in the world with the
-    carrier body's current pose in ``data``.
-    """
-    stage = spec.stage_of(mesh.planet)
-    planet = spec.members[mesh.planet]
-    loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
-    carrier = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, spec.members[stage.carrier].label)
-    central = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, spec.members[mesh.central].label)
-    planet_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, planet.label)
-    R = data.xmat[carrier].reshape(3, 3)
-    # the stage axis: the carrier frame's origin less the carrier's own slide displacement
-    jx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, spec.members[stage.carrier].label + "_x")
-    jy = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, spec.members[stage.carrier].label + "_y")
-    origin = data.xpos[carrier] - np.array([data.qpos[model.jnt_qposadr[jx]], data.qpos[model.jnt_qposadr[jy]], 0.0])
-    point = origin + R @ np.array([loa.pitch_point[0], loa.pitch_point[1], 0.0])
-    direction = R @ np.array([loa.direction[0], loa.direction[1], 0.0])
-    jac_c = np.zeros((3, model.nv))
-    jac_p = np.zeros((3, model.nv))
-    mujoco.mj_jac(model, data, jac_c, None, point, central)
-    mujoco.mj_jac(model, data, jac_p, None, point, planet_body)
-    return direction @ (jac_c - jac_p)
-
-
-@dataclass
-class _MeshTendon:
-    name: str
-    coefs: list[tuple[str, float]]
-    damping: float
-    backlash: float
-
-
-def _mesh_tendons(spec: TrainSpec, kin: Kinematics, skeleton: mujoco.MjModel, stiffness: np.ndarray) -> list[_MeshTendon]:
-    """Mesh tendon coefficients from the skeleton model's own Jacobians at its reference configuration."""
-    data = mujoco.MjData(skeleton)
-    mujoco.mj_forward(skeleton, data)
-    names = [mujoco.mj_id2name(skeleton, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(skeleton.njnt)]
-    dof_joint = skeleton.dof_jntid
-    out = []
-    for mesh, k_mean in zip(spec.meshes, stiffness):
-        row = mesh_jacobian_row(spec, kin, skeleton, data, mesh)
-        keep = set(np.nonzero(row)[0])
-        # world-frame slides always come in (x, y) pairs: their coefficients rotate with the carrier
-        for mid in (mesh.central, spec.stage_of(mesh.planet).carrier):
-            for axis in CENTRAL_AXES:
-                keep.add(skeleton.jnt_dofadr[names.index(f"{spec.members[mid].label}_{axis}")])
-        coefs = [(names[dof_joint[i]], float(row[i])) for i in sorted(keep)]
-        damping = _mesh_damping(spec, mesh, skeleton, row, names, float(k_mean))
-        out.append(_MeshTendon(mesh.label, coefs, damping, 0.5 * mesh.backlash))
-    return out
-
-
-def _mesh_damping(spec, mesh, model, row, names, k_mean) -> float:
-    if mesh.damping_coefficient is not None:
-        return float(mesh.damping_coefficient)
-    if not mesh.damping_ratio:
-        return 0.0
-    inv = 0.0
-    for mid in (mesh.central, mesh.planet):
+def mesh_joints(spec: TrainSpec, mesh) -> list[str]:
+    """The joints whose motion moves ``mesh``'s pitch point on either gear: the central member's slides
+    and hinge, the carrier's (which carries the planet), the planet's slides and hinge."""
+    joints = []
+    for mid in (mesh.central, spec.stage_of(mesh.planet).carrier):
         label = spec.members[mid].label
-        arm = row[model.jnt_dofadr[names.index(label + "_rz")]]
-        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, label)
-        inv += arm**2 / model.body_inertia[body][2]
-    return 2.0 * mesh.damping_ratio * math.sqrt(k_mean / inv)
+        joints += [f"{label}_{axis}" for axis in CENTRAL_AXES + ("rz",)]
+    label = spec.members[mesh.planet].label
+    return joints + [f"{label}_{axis}" for axis in PLANET_AXES + ("rz",)]
+
+
+def mesh_tendons(spec: TrainSpec, coefficients, stiffness, damping) -> list[str]:
+    """One fixed tendon per mesh: ``coefficients[j]`` is a list of (joint, coefficient) in dof order."""
+    lines = []
+    for mesh, coefs, k, c in zip(spec.meshes, coefficients, stiffness, damping):
+        b = 0.5 * mesh.backlash
+        lines += _fixed(mesh.label, coefs, k, c, (-b, b))
+    return lines
 
 
 # --------------------------------------------------------------------------- actuators, sensors
@@ -305,181 +238,31 @@ def _sensors(spec: TrainSpec) -> list[str]:
 # --------------------------------------------------------------------------- document
 
 
-def _document(spec: TrainSpec, body: list[str], tendons: list[str], timestep: float, header: list[str],
-              sensors: bool = True) -> str:
+def document(spec: TrainSpec, tendons: list[str], timestep: float, header: list[str]) -> str:
+    """The whole MJCF text: ``header`` comment, compiler and option, bodies, ``tendons``, actuators, sensors."""
     lines = ["<!--"] + [f"  {h}" for h in header] + ["-->", f'<mujoco model="{spec.name}">',
              '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
              f'  <option timestep="{num(timestep)}" integrator="RK4" gravity="0 0 0">',
              '    <flag contact="disable"/>', "  </option>",
              '  <visual><map znear="0.001"/></visual>']
-    lines += body
+    lines += _worldbody(spec)
     if tendons:
         lines += ["  <tendon>"] + tendons + ["  </tendon>"]
-    lines += _actuators(spec) + (_sensors(spec) if sensors else []) + ["</mujoco>"]
+    lines += _actuators(spec) + _sensors(spec) + ["</mujoco>"]
     return "\n".join(lines) + "\n"
 
 
-def _stiffness_values(spec: TrainSpec, exc: Excitation, stiffness) -> np.ndarray:
-    if isinstance(stiffness, str):
-        if stiffness == "mean":
-            return exc.mean_stiffness.copy()
-        if stiffness == "max":
-            return exc.max_stiffness.copy()
-        raise ValueError(f"stiffness must be 'mean', 'max' or an array of N/m per mesh, not {stiffness!r}")
-    values = np.asarray(stiffness, dtype=float)
-    if values.shape != (len(spec.meshes),):
-        raise ValueError(f"stiffness needs one value per mesh ({len(spec.meshes)}), got shape {values.shape}")
-    return values
+HEADER = [
+    "gearcheck MuJoCo model of train {name!r} ({path}), generated by `gearcheck mjcf`.",
+    "Meshes are fixed tendons: length = mesh deflection along the line of action (positive = compressed).",
+    "Outside the gearcheck runner (gearcheck.mbd_models.runner) the meshes have their constant {stiffness} "
+    "stiffness,",
+    "the input reference and load torque are not driven, and the coefficients of the world-frame slides",
+    "in the mesh tendons are those of carrier angle 0 (the runner rotates them with the carrier every step).",
+    "Units SI; angles in radian; integrator RK4 at the model's default step.",
+]
 
 
-def build_mjcf(spec: TrainSpec, stiffness="mean", timestep: float | None = None) -> str:
-    """Deterministic MJCF text of ``spec`` (byte-identical for identical input).
-
-    stiffness: "mean" (default), "max" (cycle maximum) or one value per mesh (N/m),
-    written as the tendons' constant stiffness.  timestep: the ``<option timestep>``;
-    by default the runner's default step of this model (RK4, 20 points per period of
-    the highest natural frequency at maximum mesh stiffness), so the file runs stably
-    in MuJoCo's viewer.
-    """
-    kin = kinematics(spec)
-    exc = Excitation(spec, kin)
-    k = _stiffness_values(spec, exc, stiffness)
-    body = _worldbody(spec)
-    couplings = _coupling_tendons(spec)
-    skeleton = mujoco.MjModel.from_xml_string(_document(spec, body, couplings, 1e-5, [], sensors=False))
-    mesh_lines = []
-    for tendon, k_mesh in zip(_mesh_tendons(spec, kin, skeleton, exc.mean_stiffness), k):
-        b = tendon.backlash
-        mesh_lines += _fixed(tendon.name, tendon.coefs, k_mesh, tendon.damping, (-b, b))
-    tendons = mesh_lines + couplings
-    if timestep is None:
-        from .runner import default_step
-
-        timestep = default_step(compile_train(spec, _xml=_document(spec, body, tendons, 1e-5, [])))
-    header = [
-        f"gearcheck MuJoCo model of train {spec.name!r} ({spec.path}), generated by mbd_models.mjcf_builder.",
-        "Meshes are fixed tendons: length = mesh deflection along the line of action (positive = compressed).",
-        "Outside the gearcheck runner (mbd_models.runner) the meshes have their constant "
-        + ("mean" if isinstance(stiffness, str) and stiffness == "mean" else "given") + " stiffness,",
-        "the input reference and load torque are not driven, and the coefficients of the world-frame slides",
-        "in the mesh tendons are those of carrier angle 0 (the runner rotates them with the carrier every step).",
-        "Units SI; angles in radian; integrator RK4 at the model's default step.",
-    ]
-    return _document(spec, body, tendons, timestep, header)
-
-
-# --------------------------------------------------------------------------- compiled model
-
-
-def _id(model, kind, name: str) -> int:
-    i = mujoco.mj_name2id(model, kind, name)
-    if i < 0:
-        raise KeyError(f"no {kind} named {name!r} in the MuJoCo model")
-    return i
-
-
-@dataclass
-class MbdModel:
-    """A compiled MuJoCo model of a train and the named indices the runner needs."""
-
-    spec: TrainSpec
-    kin: Kinematics
-    excitation: Excitation
-    xml: str
-    model: mujoco.MjModel
-    body: dict[str, int]  # member id -> body id
-    qadr: dict[str, tuple[int, int, int]]  # member id -> qpos addresses (x|radial, y|tangential, rz)
-    dadr: dict[str, tuple[int, int, int]]  # member id -> dof addresses
-    mesh_tendon: np.ndarray  # tendon id per spec.meshes entry
-    mesh_damping: np.ndarray
-    half_backlash: np.ndarray
-    actuator: dict[str, int]
-    sensor: dict[str, tuple[int, int]]  # name -> (address, dimension)
-    # coefficient refresh of world-frame slides: wrap indices of x and y, angle-0 values,
-    # and the qpos address of the carrier angle that turns them
-    rot_wrap_x: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
-    rot_wrap_y: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
-    rot_c0x: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    rot_c0y: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    rot_carrier_qadr: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
-
-    rot_tendon: np.ndarray = field(default_factory=lambda: np.zeros(0, int))  # per wrap, x wraps then y
-    rot_slide_qadr: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
-
-    def refresh(self, qpos: np.ndarray) -> None:
-        """Rotate the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
-        phi = qpos[self.rot_carrier_qadr]
-        c, s = np.cos(phi), np.sin(phi)
-        prm = self.model.wrap_prm
-        prm[self.rot_wrap_x] = self.rot_c0x * c - self.rot_c0y * s
-        prm[self.rot_wrap_y] = self.rot_c0x * s + self.rot_c0y * c
-
-    def coefficient_rate(self, phi, phidot, slide):
-        """The part of each mesh's deflection rate that a fixed tendon's J qvel misses: its world-frame
-        slide coefficients turn with the carrier, d/dt (c(phi) q) = c q' + (dc/dphi) phi' q.  Arguments
-        per rotating wrap (x wraps, then y wraps; time along axis 0 allowed): carrier angle, its rate,
-        the slide's position.  Returns one rate per mesh (m/s)."""
-        c0x = np.concatenate([self.rot_c0x, self.rot_c0x])
-        c0y = np.concatenate([self.rot_c0y, self.rot_c0y])
-        nx = len(self.rot_wrap_x)
-        sign = np.concatenate([np.zeros(nx), np.ones(nx)])  # x: c0x cos - c0y sin; y: c0x sin + c0y cos
-        s, c = np.sin(phi), np.cos(phi)
-        dc = np.where(sign == 0, -c0x * s - c0y * c, c0x * c - c0y * s)
-        terms = dc * phidot * slide
-        n_mesh = len(self.mesh_tendon)
-        out = np.zeros(np.shape(terms)[:-1] + (n_mesh,))
-        for t in range(n_mesh):
-            out[..., t] = terms[..., self.rot_tendon == t].sum(axis=-1)
-        return out
-
-
-def compile_train(spec: TrainSpec, stiffness="mean", _xml: str | None = None) -> MbdModel:
-    """Compile :func:`build_mjcf`'s model and collect its named indices."""
-    xml = _xml if _xml is not None else build_mjcf(spec, stiffness)
-    model = mujoco.MjModel.from_xml_string(xml)
-    kin = kinematics(spec)
-    exc = Excitation(spec, kin)
-    J, B, T, A, S = (mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON,
-                     mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR)
-    body, qadr, dadr = {}, {}, {}
-    for mid, member in spec.members.items():
-        body[mid] = _id(model, B, member.label)
-        axes = PLANET_AXES if member.is_planet else CENTRAL_AXES
-        joints = [_id(model, J, f"{member.label}_{a}") for a in axes + ("rz",)]
-        qadr[mid] = tuple(int(model.jnt_qposadr[j]) for j in joints)
-        dadr[mid] = tuple(int(model.jnt_dofadr[j]) for j in joints)
-    mesh_tendon = np.array([_id(model, T, m.label) for m in spec.meshes], dtype=int)
-    actuator = {}
-    for name in ("input_shaft", "input_shaft_damper", "input_torque", "output_load"):
-        i = mujoco.mj_name2id(model, A, name)
-        if i >= 0:
-            actuator[name] = i
-    sensor = {}
-    for i in range(model.nsensor):
-        sensor[mujoco.mj_id2name(model, S, i)] = (int(model.sensor_adr[i]), int(model.sensor_dim[i]))
-    mb = MbdModel(spec, kin, exc, xml, model, body, qadr, dadr, mesh_tendon,
-                  model.tendon_damping[mesh_tendon].copy(), model.tendon_lengthspring[mesh_tendon, 1].copy(),
-                  actuator, sensor)
-    # world-frame slide pairs in every mesh tendon
-    wx, wy, cx, cy, ca, tt, qx, qy = [], [], [], [], [], [], [], []
-    for mesh, t in zip(spec.meshes, mesh_tendon):
-        adr, n = model.tendon_adr[t], model.tendon_num[t]
-        joint_at = {int(model.wrap_objid[adr + i]): adr + i for i in range(n)}
-        stage = spec.stage_of(mesh.planet)
-        for mid in (mesh.central, stage.carrier):
-            label = spec.members[mid].label
-            ix, iy = joint_at[_id(model, J, label + "_x")], joint_at[_id(model, J, label + "_y")]
-            wx.append(ix)
-            wy.append(iy)
-            cx.append(model.wrap_prm[ix])
-            cy.append(model.wrap_prm[iy])
-            ca.append(qadr[stage.carrier][2])
-            tt.append(int(t))
-            qx.append(qadr[mid][0])
-            qy.append(qadr[mid][1])
-    mb.rot_wrap_x, mb.rot_wrap_y = np.array(wx, int), np.array(wy, int)
-    mb.rot_c0x, mb.rot_c0y = np.array(cx, float), np.array(cy, float)
-    mb.rot_carrier_qadr = np.array(ca, int)
-    mb.rot_tendon = np.array(tt + tt, int)
-    mb.rot_slide_qadr = np.array(qx + qy, int)
-    return mb
+def header(spec: TrainSpec, stiffness: str) -> list[str]:
+    """The comment lines at the top of a generated file (``stiffness``: "mean" or "given")."""
+    return [line.format(name=spec.name, path=spec.path, stiffness=stiffness) for line in HEADER]

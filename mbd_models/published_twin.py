@@ -1,8 +1,7 @@
 """A MuJoCo twin of the 4-DOF idealisation of Matejic, Blagojevic & Matejic (2021).
 
-Built from bodies and joints, not from the paper's matrices (it uses the train description
-and the paper's parameter table, :class:`lumped.published.PaperParameters`, never
-:mod:`lumped.published`'s M, B, C):
+Built from bodies and joints, not from the paper's matrices (it uses the paper's parameter table,
+:class:`gearcheck.lumped.published_parameters.PaperParameters`, never the 4-DOF models' M, B, C):
 
 * ``carrier`` -- child of the world on the axis, hinge ``theta_h`` about z, then a slide
   ``y1`` (in the carrier's frame, so it turns with the carrier).  Mass m_h, polar inertia
@@ -28,20 +27,22 @@ displacements but in the opposite direction" in the potential energy (Eq. 4).  `
   counting y1 along the line of action with coefficient -1, which is what Eq. 4 does.  Not a
   physical mesh direction: the paper's assumption made explicit.
 
-Linearisation as in :mod:`mbd_models.linearise`: M from ``mj_fullM``, K from central differences
-of ``qfrc_passive``, both at q = 0, at rest.
+Linearisation as in :mod:`gearcheck.mbd_models.linearise`: M from ``mj_fullM``, K from central
+differences of ``qfrc_passive``, both at q = 0, at rest.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from lumped.modal import generalized_modes
-from lumped.published import LABELS, PaperParameters
+from gearcheck.lumped.published_parameters import LABELS, PaperParameters, four_dof_result
+from gearcheck.shared.errors import DivergenceError
+from gearcheck.shared.modal import ModalResult, modal_result
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.stepping import transient_step
 
 FD_STEP = 1e-6
 CONTACT_BODIES = {"e": ("planet", None), "b": ("planet", "ring_b")}
@@ -159,47 +160,40 @@ def linearise(twin: PublishedTwin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return M[sel], 0.5 * (K + K.T)[sel], 0.5 * (Cd + Cd.T)[sel]
 
 
-def twin_modes(twin: PublishedTwin):
-    """Natural frequencies (Hz, rigid-body modes as 0) of the linearised twin, and the rigid count."""
+def twin_modes(twin: PublishedTwin) -> ModalResult:
+    """Natural frequencies (Hz, rigid-body modes as 0) of the linearised twin, typed rigid or elastic."""
     M, K, _ = linearise(twin)
-    frequencies, _ = generalized_modes(K, M)
-    return frequencies, int(np.sum(frequencies == 0))
+    return modal_result(twin.params.source, "mujoco", K, M, LABELS)
 
 
-@dataclass
-class TwinResponse:
-    t: np.ndarray
-    q: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
-    info: dict
-
-
-def simulate_twin(twin: PublishedTwin, duration: float, dt: float, torques, load: bool = True) -> TwinResponse:
-    """From rest, MuJoCo's RK4 at step dt; ``torques(t) -> (M_h, T_b)`` applied as qfrc_applied on
-    theta_h and theta_b (held over each step).  Records qacc of every state (after mj_forward)."""
+def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: bool = True):
+    """From rest, MuJoCo's RK4 at the step ``settings.dt`` (default: the twin's own
+    :func:`~gearcheck.shared.stepping.transient_step`); the paper's torques (M_h, T_b)
+    (:meth:`~gearcheck.lumped.published_parameters.PaperParameters.torques`) applied as qfrc_applied on
+    theta_h and theta_b, held over each step.  Records qacc of every state (after mj_forward);
+    ``model`` names the 4-DOF model whose kinematics the twin has (for the signals' descriptions)."""
     m = twin.model
+    dt = transient_step(twin_modes(twin).frequencies) if settings.dt is None else settings.dt
     m.opt.timestep = dt
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     d = mujoco.MjData(m)
-    steps = int(math.ceil(duration / dt - 1e-9))
+    steps, _ = settings.grid(dt)
     idx = _order(twin)
     ih, ib = twin.dof["theta_h"], twin.dof["theta_b"]
     t = np.arange(steps + 1) * dt
+    m_h, t_b = twin.params.torques(t, load)
     q = np.zeros((steps + 1, 4))
-    v = np.zeros((steps + 1, 4))
     a = np.zeros((steps + 1, 4))
     for i in range(steps + 1):
-        m_h, t_b = torques(t[i])
         d.qfrc_applied[:] = 0.0
-        d.qfrc_applied[ih] = m_h
-        d.qfrc_applied[ib] = t_b if load else 0.0
+        d.qfrc_applied[ih] = m_h[i]
+        d.qfrc_applied[ib] = t_b[i]
         mujoco.mj_forward(m, d)
-        q[i], v[i], a[i] = d.qpos[idx], d.qvel[idx], d.qacc[idx]
+        q[i], a[i] = d.qpos[idx], d.qacc[idx]
         if i < steps:
             mujoco.mj_step(m, d)
     if not np.all(np.isfinite(q)):
-        raise FloatingPointError("the MuJoCo 4-DOF twin diverged")
-    return TwinResponse(t, q, v, a, {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": steps,
-                                     "y1": twin.y1, "carrier_mass": twin.carrier_mass,
-                                     "mujoco_version": mujoco.__version__})
+        raise DivergenceError(float(t[np.argmax(~np.isfinite(q).all(axis=1))]), "the MuJoCo 4-DOF twin")
+    info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": steps, "y1": twin.y1,
+            "carrier_mass": twin.carrier_mass, "mujoco_version": mujoco.__version__}
+    return four_dof_result(twin.params.source, "mujoco", model, t, q, a, info)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from lumped.loader import preset_names
+from gearcheck.lumped.loader import preset_names
 
 
 @pytest.fixture(params=preset_names())

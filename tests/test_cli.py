@@ -5,7 +5,7 @@ import json
 import pandas as pd
 import pytest
 
-from compare.cli import main
+from gearcheck.cli import main
 
 
 def test_presets_lists_every_preset_with_its_source(capsys):
@@ -34,7 +34,7 @@ def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
     assert main(["run", "demo-3p", "--solver", "lumped", "--duration", "0.01", "--speed", "1000",
                  "--output-dt", "2e-5", "--out", str(tmp_path)]) == 0
     df = pd.read_csv(tmp_path / "timeseries.csv")
-    assert {"t", "stage1.ring.ay", "stage1.planet1.sun.force", "stage1.planet1.sun.dte"} <= set(df.columns)
+    assert {"t", "stage1.ring.ay.world", "stage1.planet1.sun.force", "stage1.planet1.sun.dte"} <= set(df.columns)
     assert df["t"].iloc[-1] == pytest.approx(0.01, rel=1e-3)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["solver"] == "lumped" and summary["info"]["method"] == "rk4"
@@ -42,8 +42,8 @@ def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv, message", [
     (["show", "no-such-train"], "no such train file or preset"),
-    (["run", "demo-3p", "--duration", "-1"], "--duration must be a positive number"),
-    (["run", "demo-3p", "--speed", "nan"], "--speed must be a positive number"),
+    (["run", "demo-3p", "--duration", "-1"], "duration must be a positive number"),
+    (["run", "demo-3p", "--speed", "nan"], "speed must be a positive number"),
     (["run", "demo-3p", "--dt", "1e-3", "--duration", "0.001"], "cannot resolve the highest natural frequency"),
 ])
 def test_bad_requests_exit_2_with_one_line(argv, message, capsys, tmp_path):

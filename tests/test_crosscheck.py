@@ -7,17 +7,24 @@ from pathlib import Path
 
 import pytest
 
-from compare.cli import main
-from compare.crosscheck import crosscheck
-from lumped import load_train
-from lumped.loader import preset_names
+from gearcheck import crosscheck
+from gearcheck.cli import main
+from gearcheck.compare.baseline import BASELINE_DIR
+from gearcheck.compare.engine import compare
+from gearcheck.compare.plan import TrainPlan
+from gearcheck.compare.tolerances import Tolerances
+from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.lumped.side import LumpedSide
+from gearcheck.lumped.time_solver import max_angular_frequency
+from gearcheck.mbd_models.side import MujocoSide
+from gearcheck.shared.settings import RunSettings
 
 DURATION = "0.05"
 
 
 def test_demo_presets_pass_with_default_tolerances():
     for name in ("demo-3p", "demo-4p"):
-        result = crosscheck(load_train(name), duration=0.05)
+        result = crosscheck(name, duration=0.05)
         assert result.passed, result.failures
         assert result.steady_found
         gated = [q for q in result.quantities if q.status == "pass"]
@@ -29,13 +36,14 @@ def test_demo_presets_pass_with_default_tolerances():
 
 
 def test_a_twin_with_a_wrong_planet_inertia_fails_by_name():
-    """A test hook changes the planets' inertia in the MuJoCo model only (x 1.3)."""
-    def heavier_planets(spec):
-        members = {k: dataclasses.replace(m, inertia=1.3 * m.inertia) if m.is_planet else m
-                   for k, m in spec.members.items()}
-        return dataclasses.replace(spec, members=members)
-
-    result = crosscheck(load_train("demo-3p"), duration=0.05, mujoco_hook=heavier_planets)
+    """The engine given a MuJoCo side whose planets are 1.3 times too heavy in rotation."""
+    spec = load_train("demo-3p")
+    members = {k: dataclasses.replace(m, inertia=1.3 * m.inertia) if m.is_planet else m
+               for k, m in spec.members.items()}
+    reference = LumpedSide(spec)
+    plan = TrainPlan.of(spec, reference.model.kin, max_angular_frequency(reference.model), 0.05)
+    result = compare(spec, reference, MujocoSide(dataclasses.replace(spec, members=members)), plan,
+                     (RunSettings(0.05),) * 2, Tolerances())
     assert not result.passed
     failures = set(result.failures)
     assert any(f.startswith("mode ") for f in failures)  # the natural frequencies moved
@@ -70,7 +78,8 @@ def test_reports_identical_across_runs(tmp_path, capsys):
 
 
 def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
-    """CI's regression dashboard: every preset cross-checked, nothing moved from compare/baselines/."""
+    """CI's regression dashboard: every preset cross-checked, nothing moved from the shipped baselines
+    (package data: this also fails when the installed package lacks them)."""
     assert main(["crosscheck", "--all", "--duration", DURATION, "--baseline", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert {r["train"] for r in summary["presets"]} == set(preset_names())
@@ -79,7 +88,7 @@ def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
 
 
 def test_a_moved_metric_is_flagged(tmp_path, capsys):
-    baseline = json.loads((Path(__file__).parent.parent / "compare" / "baselines" / "demo-3p.json").read_text())
+    baseline = json.loads((BASELINE_DIR / "demo-3p.json").read_text())
     baseline["quantities"]["stage1.ring.ay.world"]["lumped_rms"] *= 1.2
     baseline["modes"][0]["mujoco_hz"] *= 1.001
     path = tmp_path / "moved.json"
@@ -106,7 +115,7 @@ def test_measured_values_appear_as_a_third_column(tmp_path, capsys):
 @pytest.mark.parametrize("argv, message", [
     (["crosscheck"], "give a TRAIN or --all"),
     (["crosscheck", "demo-3p", "--tolerances", "missing.toml"], "cannot read tolerances"),
-    (["crosscheck", "demo-3p", "--duration", "0"], "--duration must be a positive number"),
+    (["crosscheck", "demo-3p", "--duration", "0"], "duration must be a positive number"),
 ])
 def test_crosscheck_bad_input_exits_2(argv, message, capsys, tmp_path):
     assert main(argv + ["--out", str(tmp_path)]) == 2
@@ -115,7 +124,7 @@ def test_crosscheck_bad_input_exits_2(argv, message, capsys, tmp_path):
 
 def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
     """Tightening the mesh-force tolerance below the measured error must fail the run, by name."""
-    from lumped.variants import edited
+    from gearcheck.lumped.variants import edited
 
     strict = edited("demo-3p", [(r"^\[\[stages\]\]", "[tolerances]\nmesh_force.nrmse = 1e-9\n\n[[stages]]")])
     assert strict.tolerances == {"mesh_force.nrmse": 1e-9}
@@ -123,7 +132,7 @@ def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
     assert "stage1.planet1.sun.force" in result.failures and "stage1.ring.ay.world" not in result.failures
     loose = tmp_path / "tol.toml"
     loose.write_text("[tolerances]\n\"stage1.planet1.sun.force.nrmse\" = 0.5\n")
-    from compare.tolerances import Tolerances
+    from gearcheck.compare.tolerances import Tolerances
 
     tol = Tolerances.for_train(strict, loose)
     assert tol.lookup("stage1.planet1.sun.force", "mesh_force", "nrmse") == 0.5
@@ -133,12 +142,10 @@ def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
 def test_sensor_band_filters_both_solvers_alike():
     """A 100-1000 Hz accelerometer chain keeps the 406 Hz mesh line and removes the 2 kHz resonance
     content: the filtered ring acceleration is smaller and the solvers still agree."""
-    plain = crosscheck(load_train("demo-3p"), duration=0.05)
-    band = crosscheck(load_train("demo-3p"), duration=0.05, sensor_band=(100.0, 1000.0))
-    q0 = next(q for q in plain.quantities if q.name == "stage1.ring.ay.world")
-    q1 = next(q for q in band.quantities if q.name == "stage1.ring.ay.world")
+    plain = crosscheck("demo-3p", duration=0.05)
+    band = crosscheck("demo-3p", duration=0.05, sensor_band=(100.0, 1000.0))
+    q0, q1 = plain["stage1.ring.ay.world"], band["stage1.ring.ay.world"]
     assert q1.metrics["reference"]["rms"] < 0.5 * q0.metrics["reference"]["rms"]
     assert band.passed and q1.metrics["nrmse"] < 0.01
-    force0 = next(q for q in plain.quantities if q.name == "stage1.planet1.sun.force")
-    force1 = next(q for q in band.quantities if q.name == "stage1.planet1.sun.force")
+    force0, force1 = plain["stage1.planet1.sun.force"], band["stage1.planet1.sun.force"]
     assert force1.metrics["reference"]["rms"] == force0.metrics["reference"]["rms"]  # forces unfiltered

@@ -3,10 +3,12 @@
 import numpy as np
 import pytest
 
-from compare.crosscheck import crosscheck
-from lumped import build_model, load_train
-from lumped.time_solver import simulate
-from lumped.variants import edited
+from gearcheck import crosscheck
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.lumped.variants import edited
+from gearcheck.shared.settings import RunSettings
 
 EXCITED = [
     (r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nste = [{ harmonic = 1, amplitude_um = 4.0 }, "
@@ -21,8 +23,7 @@ def test_transmission_error_eccentricity_and_ripple_agree_between_solvers():
     spec = edited("demo-3p", EXCITED, "excited")
     result = crosscheck(spec, duration=0.05)
     assert result.passed, result.failures
-    force = next(q for q in result.quantities if q.name == "stage1.planet1.sun.force")
-    assert force.metrics["nrmse"] < 2e-3
+    assert result["stage1.planet1.sun.force"].metrics["nrmse"] < 2e-3
 
 
 def test_transmission_error_drives_the_mesh_frequency_line():
@@ -36,8 +37,8 @@ def test_transmission_error_drives_the_mesh_frequency_line():
         pairs = [(r"^damping = \{ ratio = 0.05 \}",
                   f"damping = {{ ratio = 0.05 }}\nste = [{{ harmonic = 1, amplitude_um = {amplitude_um} }}]")]
         model = build_model(edited("demo-3p", pairs))
-        r = simulate(model, 0.06, settle=0.03)
-        x = r.mesh_force[r.steady, 0]
+        r = simulate(model, RunSettings(0.06, settle=0.03))
+        x = r["stage1.planet1.sun.force"][r.steady]
         t = r.t[r.steady]
         w = np.hanning(x.size)
         return 2 * np.sum(w * (x - x.mean()) * np.exp(-2j * np.pi * f_mesh * t)) / np.sum(w)
@@ -50,16 +51,16 @@ def test_transmission_error_drives_the_mesh_frequency_line():
 def test_load_ramp_settles_to_the_state_reached_from_the_static_start():
     ramped = build_model(edited("demo-3p", [(r"^input_shaft_damping = .*", "input_shaft_damping = 2.0\nramp_s = 0.01")]))
     static = build_model(load_train("demo-3p"))
-    a, b = simulate(ramped, 0.08), simulate(static, 0.08)
-    assert a.mesh_force[0, 0] < 0.05 * b.mesh_force[0, 0]  # the ramped run starts unloaded
+    a, b = simulate(ramped, RunSettings(0.08)), simulate(static, RunSettings(0.08))
+    fa, fb, name = a.select("mesh_force"), b.select("mesh_force"), "stage1.planet1.sun.force"
+    assert fa[0, 0] < 0.05 * fb[0, 0]  # the ramped run starts unloaded
     tail = a.t > 0.07
-    np.testing.assert_allclose(a.mesh_force[tail], b.mesh_force[tail], rtol=0, atol=2e-3 * b.static_mesh_force[0])
+    np.testing.assert_allclose(fa[tail], fb[tail], rtol=0, atol=2e-3 * b.static[name])
 
 
 def test_torque_profile_from_a_csv_file(tmp_path):
     """A periodic torque profile (time, torque) next to the train file adds to the input torque."""
-    from lumped.loader import load_train
-    from lumped.variants import edited_text
+    from gearcheck.lumped.variants import edited_text
 
     (tmp_path / "pulse.csv").write_text("time_s,torque_nm\n0.0,0.0\n0.005,40.0\n0.01,0.0\n")
     path = tmp_path / "pulsed.toml"

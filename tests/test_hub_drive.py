@@ -1,15 +1,17 @@
-"""Seed 000, the two-stage hub reducer: the preset, its Table 1 data and the calibration machinery."""
+"""The two-stage hub reducer of Li et al. (2026): the preset, its Table 1 data and the calibration machinery."""
 
 import math
 
 import pytest
 
-from compare.calibrate import FitParameter, calibrate
-from compare.crosscheck import crosscheck
-from compare.measure import measure
-from lumped import build_model, kinematics, load_train
-from lumped.loader import preset_text
-from lumped.time_solver import simulate
+from gearcheck import crosscheck
+from gearcheck.compare.calibrate import FitParameter, calibrate
+from gearcheck.compare.measure import measure
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.kinematics import kinematics
+from gearcheck.lumped.loader import load_train, preset_text
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.shared.settings import RunSettings
 
 G = 9.8  # the paper's g
 
@@ -58,8 +60,7 @@ def test_table1_data_and_the_papers_error_column():
 
 @pytest.mark.parametrize("rpm", [606.0, 1823.0])
 def test_crosscheck_passes_at_both_test_speeds(rpm):
-    spec = load_train("hub-drive").with_operating(input_speed=rpm * math.pi / 30)
-    result = crosscheck(spec, duration=0.15)
+    result = crosscheck("hub-drive", speed=rpm, duration=0.15)
     assert result.passed, result.failures
 
 
@@ -72,11 +73,10 @@ def test_calibration_recovers_a_known_transmission_error():
     truth = load_train_text(base.replace("amplitude_um = 1.0", "amplitude_um = 2.5"))
     entries = []
     for rpm in (1500.0, 1200.0):
-        spec = truth.with_operating(input_speed=rpm * math.pi / 30)
-        model = build_model(spec)
+        model = build_model(load_train(truth, rpm))
         probe = [{"quantity": "stage1.ring.ay.world", "metric": "rms", "value": 1.0, "speed": rpm * math.pi / 30,
                   "uncertainty": 0.1, "sensor_band_hz": None}]
-        value = measure(spec, simulate(model, 0.04), probe, 1 / model.excitation.frequency.min())[0]
+        value = measure(simulate(model, RunSettings(0.04)), probe, 1 / model.excitation.frequency.min())[0]
         entries.append({**probe[0], "value": value})
     fit = calibrate(base, "synthetic", entries, [FitParameter.parse("stages[0].mesh.ste[0].amplitude_um=0.1:10")],
                     0.04, fit_speeds=[1500.0])
@@ -90,6 +90,6 @@ def test_calibration_recovers_a_known_transmission_error():
 
 
 def load_train_text(text):
-    from lumped.loader import load_text
+    from gearcheck.lumped.loader import load_text
 
     return load_text(text, "synthetic")

@@ -17,7 +17,7 @@ def test_corpus_is_large_enough():
 @pytest.mark.parametrize("path", INVALID, ids=[p.stem for p in INVALID])
 def test_invalid_train_file(path):
     expected = path.read_text().splitlines()[0].removeprefix("# expect: ")
-    run = subprocess.run([sys.executable, "-m", "compare.cli", "show", str(path)], capture_output=True, text=True)
+    run = subprocess.run([sys.executable, "-m", "gearcheck", "show", str(path)], capture_output=True, text=True)
     assert run.returncode == 2
     assert run.stdout == ""
     lines = run.stderr.strip().splitlines()

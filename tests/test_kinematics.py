@@ -5,8 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from lumped.variants import edited
-from lumped import kinematics, load_train
+from gearcheck.lumped.kinematics import kinematics
+from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.variants import edited
 
 
 def test_willis_for_every_stage_of_every_preset(preset):

@@ -13,12 +13,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from lumped.assembly import build_model
-from lumped.loader import load_train, preset_names
-from lumped.modal import modes
-from lumped.variants import chained, edited
-from mbd_models import build_mjcf, compile_train, mujoco_modes
-from mbd_models.mjcf_builder import mesh_jacobian_row
+import gearcheck
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.lumped.modal import modes
+from gearcheck.lumped.variants import chained, edited
+from gearcheck.mbd_models.twin import compile_train, mesh_jacobian_row
 
 RELATIVE_TOLERANCE = 1e-6
 RIGID_HZ = 1e-3  # below this a frequency is a rigid-body mode (0 in both)
@@ -26,7 +26,7 @@ RIGID_HZ = 1e-3  # below this a frequency is a rigid-body mode (0 in both)
 
 def _compare(spec):
     lumped_modes = modes(build_model(spec))
-    mj = mujoco_modes(spec)
+    mj = gearcheck.modes(spec, "mujoco")
     assert mj.solver == "mujoco"
     assert len(mj) == len(lumped_modes)
     rows = []
@@ -57,15 +57,15 @@ def test_two_stage_chain_matches_lumped():
 def test_free_input_has_one_rigid_mode():
     """Without an input shaft the train turns freely: exactly one zero frequency in MuJoCo's linearisation."""
     spec = edited("demo-3p", [(r"^input_shaft_(stiffness|damping).*$", "")], "free-input")
-    mj = mujoco_modes(spec)
+    mj = gearcheck.modes(spec, "mujoco")
     assert mj.types.count("rigid") == 1 and mj.frequencies[0] == 0.0
     _compare(spec)
 
 
 def test_mjcf_is_deterministic_and_named():
     spec = load_train("demo-3p")
-    xml = build_mjcf(spec)
-    assert xml == build_mjcf(load_train("demo-3p"))
+    xml = gearcheck.mjcf(spec)
+    assert xml == gearcheck.mjcf(load_train("demo-3p"))
     assert xml.startswith("<!--") and "constant mean stiffness" in xml.split("-->")[0]
     assert '<compiler angle="radian"' in xml and 'gravity="0 0 0"' in xml
     for name in ("stage1_sun", "stage1_carrier", "stage1_planet2", "stage1_planet2_sun_mesh",
@@ -123,7 +123,7 @@ def test_mesh_damping_from_tendon_geometry():
 
 def test_backlash_mesh_linearised_on_its_flank():
     """A dead band is closed for the linearisation: the same frequencies as without backlash."""
-    with_backlash = mujoco_modes(edited("demo-3p", [(r"^\[stages.mesh\]$", "[stages.mesh]\nbacklash_um = 30.0")],
+    with_backlash = gearcheck.modes(edited("demo-3p", [(r"^\[stages.mesh\]$", "[stages.mesh]\nbacklash_um = 30.0")],
                                         "backlash"))
-    np.testing.assert_allclose(with_backlash.frequencies, mujoco_modes(load_train("demo-3p")).frequencies,
+    np.testing.assert_allclose(with_backlash.frequencies, gearcheck.modes(load_train("demo-3p"), "mujoco").frequencies,
                                rtol=1e-12)

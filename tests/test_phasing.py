@@ -9,9 +9,10 @@ projected on the modes; the modal amplitudes of the excluded types must vanish.
 import numpy as np
 import pytest
 
-from lumped import build_model, load_train
-from lumped.harmonic import harmonic_response, transmission_error_force
-from lumped.modal import modes
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.harmonic import harmonic_response, transmission_error_force
+from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.modal import modes
 
 
 def modal_amplitudes(preset, harmonic, central):

@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
-from lumped.variants import edited
-from lumped import build_model, load_train
-from lumped.static import static_solution
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.static import static_solution
+from gearcheck.lumped.variants import edited
 
 
 def input_torque_through_meshes(spec, static):

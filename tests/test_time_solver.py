@@ -5,11 +5,13 @@ import re
 import numpy as np
 import pytest
 
-from lumped.variants import edited
-from lumped import SolverError, build_model, load_train
-from lumped.loader import load_text, preset_text
-from lumped.static import static_solution
-from lumped.time_solver import default_step, mechanical_energy, simulate, stable_step
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.loader import load_text, load_train, preset_text
+from gearcheck.lumped.static import static_solution
+from gearcheck.lumped.time_solver import default_step, mechanical_energy, simulate, stable_step
+from gearcheck.lumped.variants import edited
+from gearcheck.shared.errors import SolverError
+from gearcheck.shared.settings import RunSettings
 
 
 def conservative_demo():
@@ -26,7 +28,7 @@ def energy_drift(model, dt, duration=0.05):
     """Relative energy change over ``duration`` after the full load is applied suddenly at rest,
     normalised by the vibration energy E(0) - E(static)."""
     zero = np.zeros(model.n)
-    r = simulate(model, duration, dt=dt, y0=(zero, zero))
+    r = simulate(model, RunSettings(duration, dt), y0=(zero, zero))
     labels = model.dofs.labels()
     q = np.array([r.raw[lab] for lab in labels]).T
     v = np.array([r.raw[lab + "_dot"] for lab in labels]).T
@@ -54,7 +56,7 @@ def test_unstable_step_is_refused_with_a_suggestion():
     model = build_model(load_train("demo-3p"))
     limit = stable_step(model)
     with pytest.raises(SolverError, match=r"use dt <= .* s \(the default\)"):
-        simulate(model, 0.001, dt=1.5 * limit)
+        simulate(model, RunSettings(0.001, 1.5 * limit))
 
 
 def test_rk4_converges_at_fourth_order_to_dop853():
@@ -65,14 +67,15 @@ def test_rk4_converges_at_fourth_order_to_dop853():
     zero = np.zeros(model.n)
     h = default_step(model)
     duration = 0.004
-    reference = simulate(model, duration, dt=h, method="DOP853", rtol=1e-10, atol=1e-16, y0=(zero, zero))
-    peak = np.max(np.abs(reference.mesh_force[:, 0]))
+    reference = simulate(model, RunSettings(duration, h), method="DOP853", rtol=1e-10, atol=1e-16, y0=(zero, zero))
+    name = reference.names("mesh_force")[0]
+    peak = np.max(np.abs(reference[name]))
 
     def error(dt):
-        r = simulate(model, duration, dt=dt, output_dt=h, y0=(zero, zero))
+        r = simulate(model, RunSettings(duration, dt, output_dt=h), y0=(zero, zero))
         n = min(r.t.size, reference.t.size)
         np.testing.assert_allclose(r.t[:n], reference.t[:n], rtol=1e-12)
-        return np.max(np.abs(r.mesh_force[:n, 0] - reference.mesh_force[:n, 0])) / peak
+        return np.max(np.abs(r[name][:n] - reference[name][:n])) / peak
 
     coarse, fine = error(h), error(h / 2)
     assert coarse < 1e-4
@@ -83,11 +86,11 @@ def test_steady_state_mesh_force_mean_equals_static_load():
     """With damping the response settles; the mean mesh force over whole mesh cycles is the static force
     to within the parametric (stiffness-variation) contribution, a few per cent."""
     model = build_model(load_train("demo-3p"))
-    r = simulate(model, 0.06, settle=0.03)
-    force = r.mesh_force[r.steady]
-    np.testing.assert_allclose(force.mean(axis=0), r.static_mesh_force, rtol=0.03)
+    r = simulate(model, RunSettings(0.06, settle=0.03))
+    forces = r.names("mesh_force")
+    np.testing.assert_allclose([r[n][r.steady].mean() for n in forces], [r.static[n] for n in forces], rtol=0.03)
     # the rectangular stiffness makes it vibrate: Kv departs from 1
-    assert np.ptp(r.dynamic_factor[r.steady][:, 0]) > 0.05
+    assert np.ptp(r.select("dynamic_factor")[r.steady][:, 0]) > 0.05
 
 
 def test_matrix_step_equals_stage_by_stage_rk4():
@@ -99,8 +102,9 @@ def test_matrix_step_equals_stage_by_stage_rk4():
                                      "ste = [{ harmonic = 1, amplitude_um = 5.0 }]"),
                                     (r"^output_torque = .*", "output_torque = 30.0")])):
         model = build_model(spec)
-        a = simulate(model, 0.01)
-        b = simulate(model, 0.01, method="rk4-stages")
-        np.testing.assert_allclose(a.mesh_force, b.mesh_force, rtol=1e-9, atol=1e-9 * np.abs(b.mesh_force).max())
+        a = simulate(model, RunSettings(0.01))
+        b = simulate(model, RunSettings(0.01), method="rk4-stages")
+        fa, fb = a.select("mesh_force"), b.select("mesh_force")
+        np.testing.assert_allclose(fa, fb, rtol=1e-9, atol=1e-9 * np.abs(fb).max())
     e, _ = model.excitation.transmission_error(b.t)
-    assert np.any(b.mesh_deflection - e < 20e-6)  # the light-load case did leave the drive flanks
+    assert np.any(b.select("dte") - e < 20e-6)  # the light-load case did leave the drive flanks

@@ -5,9 +5,9 @@ from pathlib import Path
 import mujoco
 import pytest
 
-from compare.cli import main
-from lumped import load_train, preset_names
-from mbd_models import build_mjcf
+import gearcheck
+from gearcheck.cli import main
+from gearcheck.lumped.loader import load_train, preset_names
 
 XML = Path(__file__).resolve().parent.parent / "xml"
 
@@ -19,7 +19,7 @@ def test_every_preset_has_a_file_and_nothing_else_is_there():
 @pytest.mark.parametrize("name", preset_names())
 def test_xml_is_up_to_date_and_loads(name, tmp_path):
     path = XML / f"{name}.xml"
-    expected = build_mjcf(load_train(name))
+    expected = gearcheck.mjcf(load_train(name))
     assert path.read_text(encoding="utf-8") == expected, (
         f"xml/{name}.xml is stale: regenerate it with `gearcheck mjcf {name} -o xml/{name}.xml`")
     model = mujoco.MjModel.from_xml_path(str(path))  # what `python -m mujoco.viewer --mjcf=...` loads

@@ -12,7 +12,7 @@ GEAR when the teeth are compressed, so the mesh deflection is
 u_X(p) the small displacement of body X's material at the pitch point p.  The radial
 component of ``direction`` separates the gears (outward from the sun, inward from
 the ring); its tangential component is flank * cos(alpha'), the loaded flank
-(+1 or -1) being chosen from the nominal torque (:mod:`lumped.kinematics`).
+(+1 or -1) being chosen from the nominal torque (:mod:`gearcheck.lumped.kinematics`).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The ``gearcheck`` command line.
+"""The ``gearcheck`` command line: parses arguments, calls the front door, prints.
 
 Every GearcheckError becomes one line on stderr and exit status 2; no traceback.
 """
@@ -7,22 +7,21 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from pathlib import Path
 
-from lumped import GearcheckError, build_model, load_train, preset_names
-from lumped.errors import SolverError
-
-from .progress import ProgressBar
-
-SOLVERS = ("lumped", "mujoco")
-PUBLISHED_MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")
+import gearcheck
+from gearcheck.compare.crosscheck import MODELS
+from gearcheck.compare.progress import ProgressBar
+from gearcheck.compare.report import write_report
+from gearcheck.compare.summary import summary_row, write_summary
+from gearcheck.lumped.describe import describe
+from gearcheck.shared.citations import REFERENCES
+from gearcheck.shared.errors import GearcheckError
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = _parser()
-    args = parser.parse_args(argv)
+    args = _parser().parse_args(argv)
     try:
         return args.func(args)
     except GearcheckError as exc:
@@ -36,6 +35,7 @@ def main(argv: list[str] | None = None) -> int:
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gearcheck", description="Cross-verify lumped-parameter planetary gear "
                                                               "models against MuJoCo multibody twins.")
+    p.add_argument("--version", action="version", version=f"gearcheck {gearcheck.__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("presets", help="list the shipped train presets")
@@ -48,13 +48,13 @@ def _parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("modes", help="natural frequencies and mode types")
     _train_arg(s)
-    s.add_argument("--solver", choices=SOLVERS + ("both",), default="lumped")
+    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="lumped")
     s.add_argument("--json", action="store_true", help="machine-readable output")
     s.set_defaults(func=cmd_modes)
 
     s = sub.add_parser("run", help="time response at the operating point")
     _train_arg(s)
-    s.add_argument("--solver", choices=SOLVERS, default="lumped")
+    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS), default="lumped")
     s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
     s.add_argument("--duration", type=float, default=0.2, metavar="S", help="simulated time (default 0.2 s)")
     s.add_argument("--dt", type=float, metavar="S", help="time step (default: from the highest natural frequency)")
@@ -65,13 +65,13 @@ def _parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_run)
 
     s = sub.add_parser("crosscheck", help="run both solvers, compare them, write a report; exit 1 when a "
-                                          "tolerance is exceeded")
+                                          "tolerance is exceeded or a baseline metric moved")
     s.add_argument("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file")
     s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
     s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
     s.add_argument("--duration", type=float, metavar="S",
                    help="simulated time (default 0.1 s; 0.02 s for a --model other than general)")
-    s.add_argument("--model", default="general", choices=("general",) + PUBLISHED_MODELS,
+    s.add_argument("--model", default="general", choices=MODELS,
                    help="lumped model checked against MuJoCo: gearcheck's general model (default) or a "
                         "published 4-DOF model (double-planet: as-published, energy-derived, ...)")
     s.add_argument("--dt-lumped", type=float, metavar="S", help="lumped RK4 step (default: derived)")
@@ -80,9 +80,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--sensor-band", type=float, nargs=2, metavar=("LOW", "HIGH"),
                    help="accelerometer chain: band-pass both solvers' accelerations to LOW-HIGH Hz")
     s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]")
-    s.add_argument("--baseline", type=Path, metavar="FILE", help="compare with a stored baseline (with --all: "
-                                                                 "the shipped baselines)", nargs="?",
-                   const="shipped")
+    s.add_argument("--baseline", type=str, metavar="FILE", nargs="?", const="shipped",
+                   help="compare with a stored baseline (without FILE: the shipped one of the preset)")
     s.add_argument("--update-baseline", action="store_true", help="rewrite the baseline instead of checking it")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_crosscheck)
@@ -115,77 +114,28 @@ def _train_arg(s):
     s.add_argument("train", metavar="TRAIN", help="preset name or path to a train TOML file")
 
 
-def _load(args):
-    spec = load_train(args.train)
-    speed = getattr(args, "speed", None)
-    if speed is not None:
-        if not (math.isfinite(speed) and speed > 0):
-            raise GearcheckError(f"--speed must be a positive number of rpm, got {speed}")
-        spec = spec.with_operating(input_speed=speed * 2 * math.pi / 60)
-    return spec
-
-
 # ----------------------------------------------------------------------------- commands
 def cmd_presets(args) -> int:
     rows = []
-    for name in preset_names():
-        spec = load_train(name)
-        rows.append((name, spec.description, spec.source))
+    for name in gearcheck.presets():
+        spec = gearcheck.load(name)
+        cited = "; ".join(f"{REFERENCES[key].authors} {REFERENCES[key].year}" for key in spec.references)
+        rows.append((name, spec.description, cited or spec.source))
     width = max(len(r[0]) for r in rows)
     for name, description, source in rows:
         print(f"{name:<{width}}  {description}  [{source}]")
     return 0
 
 
-def describe(spec) -> dict:
-    """Derived quantities of a train (``gearcheck show``)."""
-    model = build_model(spec)
-    kin = model.kin
-    rpm = 60 / (2 * math.pi)
-    out = {
-        "train": spec.name, "description": spec.description, "source": spec.source, "file": spec.path,
-        "input": spec.input, "output": spec.output, "held": list(spec.held),
-        "ratio": kin.ratio, "input_speed_rpm": spec.operating.input_speed * rpm,
-        "input_torque_nm": kin.input_torque, "output_torque_nm": kin.output_torque,
-        "speeds_rpm": {m: w * rpm for m, w in kin.speeds.items()},
-        "stages": [], "meshes": [],
-    }
-    for stage in spec.stages:
-        out["stages"].append({
-            "name": stage.name, "planets": len(stage.planets), "carrier_radius_m": stage.carrier_radius,
-            "planet_angles_deg": [math.degrees(a) for a in stage.planet_angles],
-            "gears": {_gear_label(spec.members[mid], g): {
-                "teeth": g.teeth, "pitch_radius_m": g.pitch_radius, "base_radius_m": g.base_radius,
-                "tip_radius_m": g.tip_radius, "profile_shift": g.profile_shift}
-                for mid in stage.centrals + stage.planets[:1] for g in spec.members[mid].gears.values()},
-        })
-    for j, mesh in enumerate(spec.meshes):
-        g = mesh.geometry
-        out["meshes"].append({
-            "mesh": mesh.id, "contact_ratio": g.contact_ratio, "operating_pressure_angle_deg":
-                math.degrees(g.pressure_angle), "mesh_frequency_hz": kin.mesh_frequency[mesh.id],
-            "phase_cycles": kin.mesh_phase[mesh.id], "loaded_flank": kin.flanks[mesh.id],
-            "mean_stiffness_n_per_m": float(model.excitation.mean_stiffness[j]),
-            "damping_n_s_per_m": float(model.mesh_damping[j]), "backlash_m": mesh.backlash,
-            "stiffness_model": mesh.stiffness["model"],
-        })
-    return out
-
-
-def _gear_label(member, gear) -> str:
-    if member.is_planet:
-        return "planet" if gear.name == "planet" else f"planet.{gear.name}"
-    return gear.name
-
-
 def cmd_show(args) -> int:
-    spec = _load(args)
-    info = describe(spec)
+    info = describe(gearcheck.load(args.train))
     if args.json:
         print(json.dumps(info, indent=2))
         return 0
     print(f"{info['train']}: {info['description']}")
     print(f"  source: {info['source']}    file: {info['file']}")
+    if info["references"]:
+        print("  references: " + ", ".join(info["references"]))
     print(f"  input {info['input']} at {info['input_speed_rpm']:.6g} rpm, {info['input_torque_nm']:.6g} N·m; "
           f"output {info['output']}, {info['output_torque_nm']:.6g} N·m; held {', '.join(info['held']) or '-'}")
     print(f"  ratio input/output = {info['ratio']:.10g}")
@@ -205,22 +155,10 @@ def cmd_show(args) -> int:
     return 0
 
 
-def modal_results(spec, solver: str) -> list:
-    from lumped.modal import modes
-
-    results = []
-    if solver in ("lumped", "both"):
-        results.append(modes(build_model(spec)))
-    if solver in ("mujoco", "both"):
-        from mbd_models import mujoco_modes
-
-        results.append(mujoco_modes(spec))
-    return results
-
-
 def cmd_modes(args) -> int:
-    spec = _load(args)
-    results = modal_results(spec, args.solver)
+    spec = gearcheck.load(args.train)
+    solvers = list(gearcheck.SOLVERS) if args.solver == "both" else [args.solver]
+    results = [gearcheck.modes(spec, solver) for solver in solvers]
     if args.json:
         print(json.dumps({"train": spec.name, "unit": "Hz", "solvers": [r.to_dict() for r in results]}, indent=2))
         return 0
@@ -239,27 +177,13 @@ def cmd_modes(args) -> int:
     return 0
 
 
-def run_solver(spec, solver: str, duration: float, dt=None, output_dt=None, method="rk4", progress=None):
-    if solver == "lumped":
-        from lumped.time_solver import simulate
-
-        return simulate(build_model(spec), duration, dt=dt, method=method, output_dt=output_dt, progress=progress)
-    from mbd_models import simulate_mujoco
-
-    if method != "rk4":
-        raise SolverError("--method applies to the lumped solver only")
-    return simulate_mujoco(spec, duration, dt=dt, output_dt=output_dt, progress=progress)
-
-
 def cmd_run(args) -> int:
-    spec = _load(args)
-    if not (math.isfinite(args.duration) and args.duration > 0):
-        raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
+    spec = gearcheck.load(args.train, args.speed)
     bar = ProgressBar(f"{args.solver} {spec.name}")
-    result = run_solver(spec, args.solver, args.duration, args.dt, args.output_dt, args.method, bar)
+    result = gearcheck.simulate(spec, args.solver, args.duration, dt=args.dt, output_dt=args.output_dt,
+                                method=args.method, progress=bar)
     bar.close()
-    out = args.out
-    written = result.write(out)
+    written = result.write(args.out)
     print(f"{spec.name} ({args.solver}): {result.t.size} samples over {result.t[-1]:.6g} s, "
           f"dt = {result.info['dt_s']:.4g} s, wall {result.info['wall_time_s']:.3g} s")
     for path in written:
@@ -267,12 +191,10 @@ def cmd_run(args) -> int:
     return 0
 
 
-
-
 def cmd_stiffness(args) -> int:
-    from .plots import mesh_stiffness
+    from gearcheck.compare.plots import mesh_stiffness
 
-    spec = _load(args)
+    spec = gearcheck.load(args.train)
     path = args.output or Path("out") / f"{spec.name}-stiffness.png"
     path.parent.mkdir(parents=True, exist_ok=True)
     mesh_stiffness(spec, path)
@@ -281,9 +203,7 @@ def cmd_stiffness(args) -> int:
 
 
 def cmd_mjcf(args) -> int:
-    from mbd_models import build_mjcf
-
-    text = build_mjcf(_load(args))
+    text = gearcheck.mjcf(args.train)
     if args.output is None:
         sys.stdout.write(text)
         return 0
@@ -301,22 +221,17 @@ def _write_atomic(path: Path, text: str) -> None:
 
 
 def cmd_calibrate(args) -> int:
-    from lumped.loader import read_train_text
+    from gearcheck.compare.calibrate import FitParameter, calibrate
+    from gearcheck.compare.calibrate_report import write_calibration
+    from gearcheck.compare.measurements import load_measurements
+    from gearcheck.lumped.loader import read_train_text
 
-    from .calibrate import FitParameter, calibrate
-    from .calibrate_report import write_calibration
-    from .measurements import load_measurements
-
-    if not (math.isfinite(args.duration) and args.duration > 0):
-        raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
     text, source = read_train_text(args.train)
-    spec = load_train(args.train)
+    spec = gearcheck.load(args.train)
     entries = load_measurements(args.measurements) if args.measurements else list(spec.measurements)
     fits = [FitParameter.parse(f) for f in args.fit]
-    done = [0]
 
     def progress(runs):
-        done[0] = runs
         if sys.stderr.isatty():
             print(f"\rcalibrate {spec.name}: {runs} runs", end="", file=sys.stderr, flush=True)
 
@@ -329,17 +244,36 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_crosscheck(args) -> int:
-    from .crosscheck_cli import crosscheck_all, crosscheck_one
-
     if args.all == (args.train is not None):
         raise GearcheckError("give a TRAIN or --all, not both")
-    if args.duration is None:
-        args.duration = 0.1 if args.model == "general" else 0.02
-    if not (math.isfinite(args.duration) and args.duration > 0):
-        raise GearcheckError(f"--duration must be a positive number of seconds, got {args.duration}")
+    if args.all and args.speed is not None:
+        raise GearcheckError("--speed applies to one train; --all runs each preset at its own speed")
+    names = gearcheck.presets() if args.all else [args.train]
+    rows = []
+    for name in names:
+        out = args.out / name if args.all else args.out
+        bar = ProgressBar(f"crosscheck {name}")
+        result = gearcheck.crosscheck(
+            name, speed=args.speed, duration=args.duration, model=args.model, dt_lumped=args.dt_lumped,
+            dt_mujoco=args.dt_mujoco, tolerances=args.tolerances, measurements=args.measurements,
+            sensor_band=args.sensor_band, baseline=args.baseline, update_baseline=args.update_baseline, progress=bar)
+        bar.close()
+        data = write_report(result, out)
+        print(_verdict_line(result, out))
+        rows.append(summary_row(data))
     if args.all:
-        return crosscheck_all(args)
-    return crosscheck_one(args, _load(args), args.out)
+        write_summary(args.out, rows)
+        print(f"summary: {args.out / 'summary.md'}")
+    return 0 if all(r["status"] == "PASS" for r in rows) else 1
+
+
+def _verdict_line(result, out: Path) -> str:
+    detail = ""
+    if result.failures:
+        detail += f"; beyond tolerance: {', '.join(result.failures)}"
+    if result.moved:
+        detail += f"; moved from baseline: {'; '.join(result.moved)}"
+    return f"{result.spec.name}: {result.verdict}{detail} (report: {out / 'report.md'})"
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,117 @@
+"""How the cross-check reads the reference's signals: what a comparison plan says.
+
+A plan answers, for one pair of runs: are the two put on one grid by anti-aliased resampling or
+compared sample by sample on the grid they share; is there a steady state to detect and with which
+cycle; how far to search for a lag and which spectral lines to measure in each signal; what sets the
+negligibility scale of each kind; below which floor a solver cannot resolve a kind; and which
+operating-point settings the report states.
+
+* :class:`TrainPlan` -- a gear train in steady operation: resampled onto the lower of the two
+  output rates, steady window from the mesh-cycle detector on the mesh forces, lags within half a
+  mesh period, mesh harmonics and carrier sidebands, translational scale also from r alpha of every
+  central member, and MuJoCo's round-off floor of absolute angles (:func:`round_off_floor`);
+* :class:`TransientPlan` -- a start-stop transient on one shared step grid (the 4-DOF models of
+  Matejic et al. 2021 and their twin): the whole record, lags within one step, lines at the natural
+  frequencies.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gearcheck.compare.metrics import spectral_lines
+from gearcheck.shared.units import rad_s_to_rpm
+
+
+@dataclass(frozen=True)
+class TrainPlan:
+    spec: object
+    mesh_frequency: dict[str, float]  # mesh id -> Hz
+    stage_frequencies: dict[str, tuple[float, float]]  # stage -> (slowest mesh frequency, carrier frequency) Hz
+    floors: dict[str, float]  # kind -> the smallest amplitude a solver resolves
+    resample: bool = True
+    detect_steady: bool = True
+
+    @classmethod
+    def of(cls, spec, kin, omega_max: float, duration: float) -> "TrainPlan":
+        """The plan of ``spec`` (kinematics ``kin``) for runs of ``duration`` s; ``omega_max`` the
+        reference model's highest natural angular frequency."""
+        stages = {}
+        for stage in spec.stages:
+            f_mesh = min(kin.mesh_frequency[m.id] for m in spec.meshes if m.stage == stage.name)
+            stages[stage.name] = (f_mesh, abs(kin.speeds[stage.carrier]) / (2 * math.pi))
+        return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, omega_max, duration))
+
+    @property
+    def cycle(self) -> float:
+        """The period of the slowest mesh: the cycle of the steady-state test and of the plots."""
+        return 1.0 / min(f for f, _ in self.stage_frequencies.values())
+
+    @property
+    def operating(self) -> dict:
+        return {"input_speed_rpm": rad_s_to_rpm(self.spec.operating.input_speed),
+                "output_torque_nm": self.spec.operating.output_torque}
+
+    def _frequencies(self, name: str) -> tuple[float, float]:
+        f_mesh, f_carrier = self.stage_frequencies.get(name.split(".")[0], next(iter(self.stage_frequencies.values())))
+        mesh = name.rsplit(".", 1)[0]
+        return self.mesh_frequency.get(mesh, f_mesh), f_carrier
+
+    def max_lag(self, name: str) -> float:
+        return 0.5 / self._frequencies(name)[0]
+
+    def lines(self, name: str, duration: float) -> list[tuple[str, float]]:
+        return spectral_lines(*self._frequencies(name), duration)
+
+    def scale_from(self, name: str) -> list[tuple[str, float]]:
+        """An angular acceleration alpha of a central member sets the translational scale r alpha."""
+        member = name.rsplit(".", 1)[0]
+        if name.endswith(".alpha") and not self.spec.members[member].is_planet:
+            return [("acceleration", central_radius(self.spec, member))]
+        return []
+
+
+@dataclass(frozen=True)
+class TransientPlan:
+    frequencies: np.ndarray  # the reference's natural frequencies, Hz
+    dt: float  # the shared step
+    operating: dict = field(default_factory=dict)
+    floors: dict = field(default_factory=dict)
+    resample: bool = False
+    detect_steady: bool = False
+
+    @property
+    def cycle(self) -> float:
+        elastic = self.frequencies[self.frequencies > 0]
+        return 1.0 / float(elastic.min())
+
+    def max_lag(self, name: str) -> float:
+        return self.dt
+
+    def lines(self, name: str, duration: float) -> list[tuple[str, float]]:
+        return [(f"mode {i + 1}", float(f)) for i, f in enumerate(self.frequencies) if f > 0]
+
+    def scale_from(self, name: str) -> list[tuple[str, float]]:
+        return []
+
+
+def central_radius(spec, member: str) -> float:
+    """Pitch radius of a central gear, carrier radius of a carrier."""
+    m = spec.members[member]
+    if m.kind == "carrier":
+        return spec.stage_of(member).carrier_radius
+    return next(iter(m.gears.values())).pitch_radius
+
+
+def round_off_floor(spec, kin, omega_max: float, duration: float) -> dict[str, float]:
+    """Accelerations below which a solver integrating absolute angles (MuJoCo: the carrier turns by
+    Omega t radians) cannot resolve anything: a position known to eps Omega t r, seen through the
+    stiffest mode, is an acceleration of omega_max^2 eps Omega t r (and omega_max^2 eps Omega t for
+    angles).  The lumped model integrates small vibrations about nominal motion and has no such floor."""
+    turn = max(abs(w) for w in kin.speeds.values()) * duration
+    radius = max(central_radius(spec, mid) for mid, m in spec.members.items() if not m.is_planet)
+    angular = omega_max ** 2 * np.finfo(float).eps * turn
+    return {"angular_acceleration": angular, "acceleration": angular * radius}

@@ -1,0 +1,67 @@
+"""The MuJoCo models as the cross-check sees them (:class:`gearcheck.shared.side.Side`).
+
+* :class:`MujocoSide` -- the twin of a train: bodies on joints, meshes as driven tendons;
+* :class:`PublishedTwinSide` -- the twin of the 4-DOF idealisation of Matejic et al. (2021), built
+  with the kinematics the chosen 4-DOF model claims.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+from gearcheck.lumped.published_parameters import KINEMATICS, PaperParameters, check_model
+from gearcheck.mbd_models import linearise
+from gearcheck.mbd_models.published_twin import PublishedTwin, build_twin, simulate_twin, twin_modes
+from gearcheck.mbd_models.runner import simulate_mujoco
+from gearcheck.mbd_models.twin import MbdModel, compile_train
+from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.results import TimeResult
+from gearcheck.shared.settings import RunSettings
+
+
+class MujocoSide:
+    """The MuJoCo twin of a train (``stiffness_clock``: see
+    :func:`gearcheck.mbd_models.runner.simulate_mujoco`)."""
+
+    solver = "mujoco"
+    references = ("todorov-2012",)
+
+    def __init__(self, spec, stiffness_clock: str = "nominal"):
+        self.spec = spec
+        self.stiffness_clock = stiffness_clock
+
+    @cached_property
+    def model(self) -> MbdModel:
+        return compile_train(self.spec)
+
+    def modes(self) -> ModalResult:
+        return linearise.modes(self.model)
+
+    def run(self, settings: RunSettings, progress=None) -> TimeResult:
+        return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock)
+
+
+class PublishedTwinSide:
+    """The MuJoCo twin of the 4-DOF model ``name`` of Matejic et al. (2021); ``y1`` and ``carrier_mass``
+    override the kinematics that model claims (:data:`~gearcheck.lumped.published_parameters.KINEMATICS`).
+    A run needs its step: the 4-DOF models and their twin are compared on one time grid."""
+
+    solver = "mujoco"
+    references = ("todorov-2012", "matejic2021")
+
+    def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1, y1: str | None = None,
+                 carrier_mass: str | None = None):
+        check_model(name)
+        self.spec, self.name, self.load, self.planet_sets = spec, name, load, planet_sets
+        default_y1, default_mass = KINEMATICS[name]
+        self.y1, self.carrier_mass = y1 or default_y1, carrier_mass or default_mass
+
+    @cached_property
+    def model(self) -> PublishedTwin:
+        return build_twin(PaperParameters.from_spec(self.spec, self.planet_sets), self.y1, self.carrier_mass)
+
+    def modes(self) -> ModalResult:
+        return twin_modes(self.model)
+
+    def run(self, settings: RunSettings, progress=None) -> TimeResult:
+        return simulate_twin(self.model, settings, self.name, self.load)

@@ -1,0 +1,268 @@
+"""The compiled MuJoCo twin of a train: one compile, MuJoCo's own mesh coefficients, named indices.
+
+:func:`compile_train` writes the MJCF (:mod:`gearcheck.mbd_models.mjcf_builder`) with every mesh
+tendon over its nine joints and compiles it once.  The tendon coefficients are then taken from
+MuJoCo itself, d . (Jp_central(p) - Jp_planet(p)): the translation Jacobians (``mujoco.mj_jac``)
+of the two bodies at the pitch point p, projected on the line of action d of the train
+description (:func:`gearcheck.lumped.line_of_action.line_of_action`, given in the carrier frame and
+placed in the world with the carrier body's pose), and written into the compiled model's
+``wrap_prm`` and into the text.  The mesh damping c = 2 zeta sqrt(k_mean m_eq),
+m_eq = 1/(r_A^2/I_A + r_B^2/I_B), takes r_A, r_B from those coefficients on the two gears' hinges
+and I from the compiled bodies.  Last, the default step comes from MuJoCo's own linearisation
+(:mod:`gearcheck.mbd_models.linearise`) and is written into the model and the text, so the file
+runs stably in MuJoCo's viewer.
+
+The coefficients of the world-frame slides (central members and the carrier) depend on the
+carrier's angle; :class:`TurningCoefficients` keeps their angle-0 values so that the runner can turn
+them every step.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from gearcheck.lumped.excitation import Excitation
+from gearcheck.lumped.kinematics import Kinematics, kinematics
+from gearcheck.lumped.line_of_action import line_of_action
+from gearcheck.lumped.spec import TrainSpec
+from gearcheck.mbd_models import linearise
+from gearcheck.mbd_models.mjcf_builder import (
+    CENTRAL_AXES,
+    PLANET_AXES,
+    coupling_tendons,
+    document,
+    header,
+    mesh_joints,
+    mesh_tendons,
+)
+from gearcheck.shared import stepping
+
+PLACEHOLDER_STEP = 1e-5  # s, the compiled model's step until its own default is known
+
+
+@dataclass(frozen=True)
+class TurningCoefficients:
+    """The mesh tendons' world-frame slide coefficients, which turn with their carrier.
+
+    Per wrap (x wraps of every mesh, then their y wraps): ``wraps`` the index into ``wrap_prm``;
+    ``base`` (2n, 2) such that the coefficient is base @ (cos phi, sin phi), phi the angle of the
+    carrier at qpos address ``carrier_qadr``; ``tendon`` the mesh it belongs to; ``slide_qadr`` and
+    ``slide_dof`` the slide it multiplies.  ``single``: the qpos address of the one carrier all wraps
+    turn with, or None (several stages)."""
+
+    wraps: np.ndarray
+    base: np.ndarray
+    carrier_qadr: np.ndarray
+    tendon: np.ndarray
+    slide_qadr: np.ndarray
+    slide_dof: np.ndarray
+    single: int | None
+
+    def values(self, phi) -> np.ndarray:
+        """The coefficients at carrier angles ``phi`` (one per wrap, or one scalar for all)."""
+        return self.base[:, 0] * np.cos(phi) + self.base[:, 1] * np.sin(phi)
+
+    def derivatives(self, phi) -> np.ndarray:
+        """d(coefficient)/d(phi): an (x, y) pair a cos - b sin, a sin + b cos turns as (-y, x)."""
+        return self.base[:, 1] * np.cos(phi) - self.base[:, 0] * np.sin(phi)
+
+    def missing_rate(self, phi, phidot, slide, n_mesh: int) -> np.ndarray:
+        """The part of each mesh's deflection rate that a fixed tendon's J qvel misses: its turning
+        coefficients give d/dt (c(phi) q) = c q' + (dc/dphi) phi' q.  Arguments per wrap (time along
+        axis 0 allowed): carrier angle, its rate, the slide's position.  Returns one rate per mesh."""
+        terms = self.derivatives(phi) * phidot * slide
+        out = np.zeros(np.shape(terms)[:-1] + (n_mesh,))
+        for t in range(n_mesh):
+            out[..., t] = terms[..., self.tendon == t].sum(axis=-1)
+        return out
+
+
+@dataclass
+class MbdModel:
+    """A compiled MuJoCo model of a train and the named indices the runner needs."""
+
+    spec: TrainSpec
+    kin: Kinematics
+    excitation: Excitation
+    xml: str
+    model: mujoco.MjModel
+    omega_max: float  # highest natural angular frequency, every mesh at its cycle-maximum stiffness
+    body: dict[str, int]  # member id -> body id
+    qadr: dict[str, tuple[int, int, int]]  # member id -> qpos addresses (x|radial, y|tangential, rz)
+    dadr: dict[str, tuple[int, int, int]]  # member id -> dof addresses
+    mesh_tendon: np.ndarray  # tendon id per spec.meshes entry (the first tendons of the model)
+    mesh_damping: np.ndarray
+    half_backlash: np.ndarray
+    actuator: dict[str, int]
+    sensor: dict[str, tuple[int, int]]  # name -> (address, dimension)
+    turning: TurningCoefficients
+
+    @property
+    def default_step(self) -> float:
+        return stepping.default_step(self.omega_max, self.excitation.frequency)
+
+    def refresh(self, qpos: np.ndarray) -> None:
+        """Turn the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
+        self.model.wrap_prm[self.turning.wraps] = self.turning.values(qpos[self.turning.carrier_qadr])
+
+    def mesh_jacobian(self) -> np.ndarray:
+        """(n_mesh, nv) coefficients of every mesh tendon as the model holds them now."""
+        m = self.model
+        J = np.zeros((len(self.mesh_tendon), m.nv))
+        for j, t in enumerate(self.mesh_tendon):
+            wraps = np.arange(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t])
+            J[j, m.jnt_dofadr[m.wrap_objid[wraps]]] = m.wrap_prm[wraps]
+        return J
+
+
+def _id(model, kind, name: str) -> int:
+    i = mujoco.mj_name2id(model, kind, name)
+    if i < 0:
+        raise KeyError(f"no {kind} named {name!r} in the MuJoCo model")
+    return i
+
+
+def mesh_jacobian_row(spec: TrainSpec, kin: Kinematics, model: mujoco.MjModel, data: mujoco.MjData,
+                      mesh) -> np.ndarray:
+    """d . (Jp_central(p) - Jp_planet(p)) over all dofs, at ``data``'s current configuration.
+
+    ``data`` must have its kinematics computed (``mj_kinematics`` and ``mj_comPos``, or
+    ``mj_forward``).  p is the pitch point and d the line of action of the train
+    description, both given in the carrier frame and placed in the world with the
+    carrier body's current pose in ``data``.
+    """
+    stage = spec.stage_of(mesh.planet)
+    planet = spec.members[mesh.planet]
+    loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
+    carrier_label = spec.members[stage.carrier].label
+    carrier = _id(model, mujoco.mjtObj.mjOBJ_BODY, carrier_label)
+    central = _id(model, mujoco.mjtObj.mjOBJ_BODY, spec.members[mesh.central].label)
+    planet_body = _id(model, mujoco.mjtObj.mjOBJ_BODY, planet.label)
+    R = data.xmat[carrier].reshape(3, 3)
+    # the stage axis: the carrier frame's origin less the carrier's own slide displacement
+    jx = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_x")
+    jy = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_y")
+    origin = data.xpos[carrier] - np.array([data.qpos[model.jnt_qposadr[jx]], data.qpos[model.jnt_qposadr[jy]], 0.0])
+    point = origin + R @ np.array([loa.pitch_point[0], loa.pitch_point[1], 0.0])
+    direction = R @ np.array([loa.direction[0], loa.direction[1], 0.0])
+    jac_c = np.zeros((3, model.nv))
+    jac_p = np.zeros((3, model.nv))
+    mujoco.mj_jac(model, data, jac_c, None, point, central)
+    mujoco.mj_jac(model, data, jac_p, None, point, planet_body)
+    return direction @ (jac_c - jac_p)
+
+
+def _mesh_damping(spec, mesh, model, row, k_mean) -> float:
+    if mesh.damping_coefficient is not None:
+        return float(mesh.damping_coefficient)
+    if not mesh.damping_ratio:
+        return 0.0
+    inv = 0.0
+    for mid in (mesh.central, mesh.planet):
+        label = spec.members[mid].label
+        arm = row[model.jnt_dofadr[_id(model, mujoco.mjtObj.mjOBJ_JOINT, label + "_rz")]]
+        inv += arm**2 / model.body_inertia[_id(model, mujoco.mjtObj.mjOBJ_BODY, label)][2]
+    return 2.0 * mesh.damping_ratio * math.sqrt(k_mean / inv)
+
+
+def _stiffness_values(spec: TrainSpec, exc: Excitation, stiffness) -> np.ndarray:
+    if isinstance(stiffness, str):
+        if stiffness == "mean":
+            return exc.mean_stiffness.copy()
+        if stiffness == "max":
+            return exc.max_stiffness.copy()
+        raise ValueError(f"stiffness must be 'mean', 'max' or an array of N/m per mesh, not {stiffness!r}")
+    values = np.asarray(stiffness, dtype=float)
+    if values.shape != (len(spec.meshes),):
+        raise ValueError(f"stiffness needs one value per mesh ({len(spec.meshes)}), got shape {values.shape}")
+    return values
+
+
+def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
+    """Compile the MuJoCo twin of ``spec`` (once), with its mesh coefficients from MuJoCo's Jacobians.
+
+    stiffness: "mean" (default), "max" (cycle maximum) or one value per mesh (N/m): the tendons'
+    constant stiffness in the file (the runner drives k(t) every step whatever it is).
+    """
+    kin = kinematics(spec)
+    exc = Excitation(spec, kin)
+    k = _stiffness_values(spec, exc, stiffness)
+    joints = [mesh_joints(spec, mesh) for mesh in spec.meshes]
+    placeholder = [[(j, 0.0) for j in names] for names in joints]
+    zeros = np.zeros(len(spec.meshes))
+    couplings = coupling_tendons(spec)
+    model = mujoco.MjModel.from_xml_string(
+        document(spec, mesh_tendons(spec, placeholder, k, zeros) + couplings, PLACEHOLDER_STEP, []))
+
+    # MuJoCo's own coefficients at the reference configuration, into the compiled model
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    coefficients, damping = [], []
+    for t, (mesh, names, k_mean) in enumerate(zip(spec.meshes, joints, exc.mean_stiffness)):
+        row = mesh_jacobian_row(spec, kin, model, data, mesh)
+        dofs = {name: int(model.jnt_dofadr[_id(model, mujoco.mjtObj.mjOBJ_JOINT, name)]) for name in names}
+        coefs = sorted(((name, float(row[dofs[name]])) for name in names), key=lambda c: dofs[c[0]])
+        adr = model.tendon_adr[t]
+        for i, (name, value) in enumerate(coefs):
+            assert model.wrap_objid[adr + i] == _id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+            model.wrap_prm[adr + i] = value
+        coefficients.append(coefs)
+        damping.append(_mesh_damping(spec, mesh, model, row, float(k_mean)))
+    model.tendon_damping[:len(spec.meshes)] = damping
+
+    mb = _indices(spec, kin, exc, model)
+    mb.omega_max = linearise.max_angular_frequency(mb)
+    model.opt.timestep = mb.default_step
+    stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
+    mb.xml = document(spec, mesh_tendons(spec, coefficients, k, damping) + couplings, model.opt.timestep,
+                      header(spec, stiffness_label))
+    return mb
+
+
+def _indices(spec, kin, exc, model) -> MbdModel:
+    """Named indices of the compiled model (its xml and omega_max are filled in by the caller)."""
+    J, B, T, A, S = (mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON,
+                     mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR)
+    body, qadr, dadr = {}, {}, {}
+    for mid, member in spec.members.items():
+        body[mid] = _id(model, B, member.label)
+        axes = PLANET_AXES if member.is_planet else CENTRAL_AXES
+        joints = [_id(model, J, f"{member.label}_{a}") for a in axes + ("rz",)]
+        qadr[mid] = tuple(int(model.jnt_qposadr[j]) for j in joints)
+        dadr[mid] = tuple(int(model.jnt_dofadr[j]) for j in joints)
+    mesh_tendon = np.array([_id(model, T, m.label) for m in spec.meshes], dtype=int)
+    assert np.array_equal(mesh_tendon, np.arange(len(spec.meshes))), "mesh tendons must come first"
+    actuator = {name: i for name in ("input_shaft", "input_shaft_damper", "input_torque", "output_load")
+                if (i := mujoco.mj_name2id(model, A, name)) >= 0}
+    sensor = {mujoco.mj_id2name(model, S, i): (int(model.sensor_adr[i]), int(model.sensor_dim[i]))
+              for i in range(model.nsensor)}
+    # world-frame slide pairs in every mesh tendon: x wraps, then y wraps
+    x_wraps, y_wraps, carrier, tendon, slide_x, slide_y = [], [], [], [], [], []
+    for t, mesh in enumerate(spec.meshes):
+        adr, n = model.tendon_adr[t], model.tendon_num[t]
+        wrap_of = {int(model.wrap_objid[adr + i]): adr + i for i in range(n)}
+        stage = spec.stage_of(mesh.planet)
+        for mid in (mesh.central, stage.carrier):
+            label = spec.members[mid].label
+            x_wraps.append(wrap_of[_id(model, J, label + "_x")])
+            y_wraps.append(wrap_of[_id(model, J, label + "_y")])
+            carrier.append(qadr[stage.carrier][2])
+            tendon.append(t)
+            slide_x.append(mid)
+            slide_y.append(mid)
+    wraps = np.array(x_wraps + y_wraps, dtype=int)
+    c0x, c0y = model.wrap_prm[x_wraps].copy(), model.wrap_prm[y_wraps].copy()
+    base = np.stack([np.concatenate([c0x, c0y]), np.concatenate([-c0y, c0x])], axis=1)
+    slide_qadr = np.array([qadr[mid][0] for mid in slide_x] + [qadr[mid][1] for mid in slide_y], dtype=int)
+    slide_dof = np.array([dadr[mid][0] for mid in slide_x] + [dadr[mid][1] for mid in slide_y], dtype=int)
+    carrier_qadr = np.array(carrier + carrier, dtype=int)
+    single = int(carrier_qadr[0]) if len(set(carrier_qadr.tolist())) == 1 else None
+    turning = TurningCoefficients(wraps, base, carrier_qadr, np.array(tendon + tendon, dtype=int), slide_qadr,
+                                  slide_dof, single)
+    return MbdModel(spec, kin, exc, "", model, 0.0, body, qadr, dadr, mesh_tendon,
+                    model.tendon_damping[mesh_tendon].copy(), model.tendon_lengthspring[mesh_tendon, 1].copy(),
+                    actuator, sensor, turning)

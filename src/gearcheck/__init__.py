@@ -1,0 +1,35 @@
+"""gearcheck: cross-verify lumped-parameter gear-train models against MuJoCo multibody twins.
+
+>>> import gearcheck
+>>> result = gearcheck.crosscheck("demo-3p", duration=0.05)
+>>> result.verdict
+'PASS'
+
+The front door:
+
+* :func:`load` -- a train (preset name, train file, or TrainSpec), validated;
+* :func:`modes` -- natural frequencies and mode types, either solver;
+* :func:`simulate` -- a time run, either solver: a :class:`TimeResult` with named signals;
+* :func:`mjcf` -- the MuJoCo model of a train;
+* :func:`crosscheck` -- both solvers compared, with measurements, tolerances and baselines;
+* :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check.
+
+Packages: :mod:`gearcheck.lumped` (train description and reference solver),
+:mod:`gearcheck.mbd_models` (the MuJoCo twin), :mod:`gearcheck.compare` (the cross-check),
+:mod:`gearcheck.shared` (what both solvers share).
+"""
+
+from importlib import metadata
+
+from gearcheck.api import SOLVERS, crosscheck, load, mjcf, modes, presets, simulate, write_report
+from gearcheck.compare.engine import CrosscheckResult
+from gearcheck.lumped.spec import TrainSpec
+from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
+from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.results import TimeResult
+
+__version__ = metadata.version("gearcheck")
+
+__all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "ModalResult", "SolverError",
+           "TimeResult", "TrainFileError", "TrainSpec", "__version__", "crosscheck", "load", "mjcf", "modes",
+           "presets", "simulate", "write_report"]

@@ -1,0 +1,7 @@
+"""``python -m gearcheck``: the command line."""
+
+import sys
+
+from gearcheck.cli import main
+
+sys.exit(main())

@@ -1,0 +1,121 @@
+"""The front door: load a train, its modes, a time run of either solver, its MuJoCo model, a cross-check.
+
+Every function takes a train as a preset name (``"hub-drive"``), the path of a train file, or a
+loaded :class:`~gearcheck.lumped.spec.TrainSpec`.  Bad input raises a
+:class:`~gearcheck.shared.errors.GearcheckError` whose message names the file, field or argument.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from gearcheck.compare.crosscheck import crosscheck
+from gearcheck.compare.report import write_report
+from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.lumped.side import LumpedSide
+from gearcheck.lumped.spec import TrainSpec
+from gearcheck.mbd_models.side import MujocoSide
+from gearcheck.mbd_models.twin import compile_train
+from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.results import TimeResult
+from gearcheck.shared.settings import RunSettings
+
+__all__ = ["SOLVERS", "crosscheck", "load", "mjcf", "modes", "presets", "simulate", "write_report"]
+
+SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
+
+
+def presets() -> list[str]:
+    """The names of the shipped trains."""
+    return preset_names()
+
+
+def load(train: str | Path | TrainSpec, speed: float | None = None) -> TrainSpec:
+    """A validated train.
+
+    Parameters
+    ----------
+    train : str, path or TrainSpec
+        A preset name, the path of a train file (TOML), or a train already loaded.
+    speed : float, optional
+        Input speed in rpm, replacing the train's.
+
+    Returns
+    -------
+    TrainSpec
+        The train in SI units: members, stages, meshes, couplings, operating point, measurements.
+    """
+    return load_train(train, speed)
+
+
+def _side(solver: str, spec: TrainSpec, method: str = "rk4"):
+    if solver not in SOLVERS:
+        raise GearcheckError(f"unknown solver {solver!r}; choose one of {', '.join(SOLVERS)}")
+    if solver == "lumped":
+        return LumpedSide(spec, method)
+    if method != "rk4":
+        raise GearcheckError(f"method {method!r} applies to the lumped solver only")
+    return MujocoSide(spec)
+
+
+def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalResult:
+    """Natural frequencies, mode shapes and Lin & Parker mode types at mean mesh stiffness.
+
+    Parameters
+    ----------
+    train : str, path or TrainSpec
+        The train.
+    solver : {"lumped", "mujoco"}
+        The reference lumped model, or MuJoCo's linearisation of the twin.
+    speed : float, optional
+        Input speed in rpm.
+
+    Returns
+    -------
+    ModalResult
+        ``frequencies`` (Hz), ``shapes``, ``types``, ``multiplicity``; ``to_dataframe()``.
+    """
+    return _side(solver, load(train, speed)).modes()
+
+
+def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: float | None = None,
+             dt: float | None = None, output_dt: float | None = None, settle: float | None = None,
+             method: str = "rk4", progress=None) -> TimeResult:
+    """A time run of the train at its operating point.
+
+    Parameters
+    ----------
+    train : str, path or TrainSpec
+        The train.
+    solver : {"lumped", "mujoco"}
+        The reference lumped model (RK4 in the rotating carrier frame) or the MuJoCo twin.
+    duration : float
+        Simulated time in s.
+    speed : float, optional
+        Input speed in rpm.
+    dt : float, optional
+        Fixed step in s (default: 20 steps per period of the highest natural frequency, a whole
+        fraction of the mesh period); a step RK4 cannot run stably is refused.
+    output_dt : float, optional
+        Sampling of the result in s (default: every step).
+    settle : float, optional
+        Start of the steady window in s (default: half the duration, or the load ramp).
+    method : str
+        The lumped solver's integrator: "rk4" (default), "rk4-stages", or scipy's "RK45", "DOP853",
+        "Radau", "BDF", "LSODA" (then ``dt`` is their largest step).
+    progress : callable, optional
+        Called with the fraction done.
+
+    Returns
+    -------
+    TimeResult
+        Named signals, ``result["stage1.ring.ay.world"]``; ``to_dataframe()``, ``summary()``,
+        ``write(directory)``.
+    """
+    return _side(solver, load(train, speed), method).run(RunSettings(duration, dt, output_dt, settle), progress)
+
+
+def mjcf(train, speed: float | None = None) -> str:
+    """The MuJoCo model (MJCF text) of the train, deterministic, loadable in MuJoCo's viewer."""
+    return compile_train(load(train, speed)).xml

@@ -1,0 +1,146 @@
+"""The time-response result every model returns: one object, named signals, pandas export.
+
+A :class:`TimeResult` holds the sample times and a set of named signals, each with a kind, a unit
+and a description: ``result["stage1.ring.ay.world"]`` is an array over ``result.t``.  Whether the
+cross-check gates a signal is part of the signal (``compared``).
+
+A gear train's signals (:func:`train_result`, the same for the lumped solver and the MuJoCo twin):
+
+* ``MEMBER.ax.world``, ``MEMBER.ay.world``: acceleration of the member's centre along the fixed
+  x, y axes, as a housing-mounted accelerometer sees it (m/s^2);
+* ``MEMBER.ax.carrier``, ``MEMBER.ay.carrier``: the same vector along the axes that turn with the
+  member's stage carrier (for planets: radial, tangential);
+* ``MEMBER.alpha``: angular acceleration (rad/s^2, absolute: planar motion);
+* ``MESH.force`` (N), ``MESH.dte`` (m, the dynamic transmission error: the mesh deflection along the
+  line of action, positive in compression), ``MESH.kv`` (F / F_static) and ``MESH.stiffness`` (N/m);
+* ``PLANET.bearing_radial.force``, ``PLANET.bearing_tangential.force`` (N).
+
+Planets' accelerations, Kv and the stiffness are recorded but not gated: the cross-check sees the
+planets through their meshes and bearings.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+
+@dataclass(frozen=True)
+class Signal:
+    name: str
+    kind: str  # acceleration | angular_acceleration | mesh_force | dte | bearing_force | dynamic_factor | ...
+    unit: str
+    description: str
+    compared: bool = True  # gated by the cross-check
+
+
+@dataclass
+class TimeResult:
+    """Time series of one run: ``values[:, j]`` is signal ``signals[j]`` at the times ``t``."""
+
+    train: str
+    solver: str
+    t: np.ndarray
+    signals: list[Signal]
+    values: np.ndarray  # (n_t, n_signals)
+    settle_time: float = 0.0
+    info: dict = field(default_factory=dict)  # solver settings, wall time, step counts
+    raw: dict = field(default_factory=dict)  # solver-specific extra series (coordinates, sensors)
+    static: dict = field(default_factory=dict)  # signal name -> its value in the static equilibrium
+
+    def __post_init__(self):
+        self._index = {s.name: j for j, s in enumerate(self.signals)}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.values[:, self._index[name]]
+        except KeyError:
+            raise KeyError(f"{self.solver} result of {self.train} has no signal {name!r}") from None
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._index
+
+    def signal(self, name: str) -> Signal:
+        return self.signals[self._index[name]]
+
+    def names(self, kind: str | None = None, compared: bool | None = None) -> list[str]:
+        """Signal names, optionally of one kind and/or only those the cross-check gates (or not)."""
+        return [s.name for s in self.signals
+                if (kind is None or s.kind == kind) and (compared is None or s.compared == compared)]
+
+    def select(self, kind: str) -> np.ndarray:
+        """Every signal of ``kind`` as columns (time along axis 0), in :meth:`names` order."""
+        return self.values[:, [self._index[n] for n in self.names(kind)]]
+
+    @property
+    def steady(self) -> np.ndarray:
+        return self.t >= self.settle_time
+
+    def to_dataframe(self, names=None) -> pd.DataFrame:
+        names = [s.name for s in self.signals] if names is None else list(names)
+        return pd.DataFrame({"t": self.t, **{n: self[n] for n in names}})
+
+    def summary(self) -> dict:
+        """Steady-state mean, RMS, peak-to-peak and largest magnitude of every signal (JSON-ready, SI)."""
+        w = self.steady
+        stats = {}
+        for s in self.signals:
+            x = self[s.name][w]
+            stats[s.name] = {"unit": s.unit, "mean": float(np.mean(x)), "rms": float(np.sqrt(np.mean(x**2))),
+                             "peak_to_peak": float(np.ptp(x)), "max_abs": float(np.max(np.abs(x)))}
+        return {"train": self.train, "solver": self.solver, "settle_time_s": self.settle_time,
+                "samples": int(w.sum()), "info": self.info, "series": stats}
+
+    def write(self, directory) -> list[Path]:
+        """Write ``timeseries.csv`` (and ``raw.csv`` if any) and ``summary.json`` into ``directory``."""
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        written = [out / "timeseries.csv"]
+        self.to_dataframe().to_csv(written[-1], index=False, float_format="%.9g")
+        if self.raw:
+            written.append(out / "raw.csv")
+            pd.DataFrame({"t": self.t, **self.raw}).to_csv(written[-1], index=False, float_format="%.9g")
+        written.append(out / "summary.json")
+        written[-1].write_text(json.dumps(self.summary(), indent=2, sort_keys=True) + "\n")
+        return written
+
+
+def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflection, mesh_force, mesh_stiffness,
+                 static_mesh_force, bearing_names, bearing_force, settle_time, info, raw) -> TimeResult:
+    """The named signals of a gear train run, from what every solver of a train computes.
+
+    acc_carrier: (n_t, n_members, 3) inertial acceleration of each member's centre along its carrier's
+    axes, and its angular acceleration; carrier_angle: (n_t, n_members) angle of those axes
+    (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force
+    (n_t, n_bearing) named ``bearing_names`` (``PLANET.bearing_radial`` ...)."""
+    signals, columns = [], []
+
+    def add(name, kind, unit, description, values, compared=True):
+        signals.append(Signal(name, kind, unit, description, compared))
+        columns.append(values)
+
+    for j, (mid, member) in enumerate(spec.members.items()):
+        a = acc_carrier[:, j, :]
+        c, s = np.cos(carrier_angle[:, j]), np.sin(carrier_angle[:, j])
+        gated = not member.is_planet
+        for frame, ax, ay in (("world", c * a[:, 0] - s * a[:, 1], s * a[:, 0] + c * a[:, 1]),
+                              ("carrier", a[:, 0], a[:, 1])):
+            for axis, values in (("x", ax), ("y", ay)):
+                add(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
+                    f"{mid} acceleration along {axis} ({frame} frame)", values, gated)
+        add(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", a[:, 2], gated)
+    for j, mesh in enumerate(spec.meshes):
+        add(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force", mesh_force[:, j])
+        add(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error", mesh_deflection[:, j])
+        add(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static",
+            mesh_force[:, j] / static_mesh_force[j], False)
+        add(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", mesh_stiffness[:, j], False)
+    for j, name in enumerate(bearing_names):
+        add(f"{name}.force", "bearing_force", "N", f"{name} force", bearing_force[:, j])
+    static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
+    return TimeResult(spec.name, solver, np.asarray(t), signals, np.column_stack(columns), settle_time, info, raw,
+                      static)

@@ -1,0 +1,24 @@
+"""What the cross-check asks of a model: its modes and a time run, both as named results.
+
+The reference lumped model, the MuJoCo twin and the published 4-DOF models of Matejic et al.
+(2021) and their twin all implement this; the cross-check engine knows nothing else about them.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from .modal import ModalResult
+from .results import TimeResult
+from .settings import RunSettings
+
+
+class Side(Protocol):
+    solver: str  # how reports name it: "lumped", "mujoco", "as-published", ...
+    references: tuple[str, ...]  # keys of gearcheck.shared.citations.REFERENCES its equations come from
+
+    def modes(self) -> ModalResult:
+        """Natural frequencies, mode shapes and types of the linear(ised) model."""
+
+    def run(self, settings: RunSettings, progress=None) -> TimeResult:
+        """A time run; ``progress`` is called with the fraction done."""

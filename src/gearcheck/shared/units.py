@@ -1,0 +1,31 @@
+"""Unit conversions, in one place: files and the command line speak rpm, mm, µm and degrees;
+everything inside gearcheck is SI (m, kg, s, N, rad).
+
+``SUFFIXES`` maps a train-file key suffix to its unit label and the factor that takes the value
+to SI; the schema converts with it once, at loading.
+"""
+
+from __future__ import annotations
+
+import math
+
+RAD_S_PER_RPM = 2.0 * math.pi / 60.0
+
+SUFFIXES = {
+    "_mm": ("mm", 1e-3),
+    "_um": ("µm", 1e-6),
+    "_deg": ("deg", math.pi / 180.0),
+    "_rpm": ("rpm", RAD_S_PER_RPM),
+}
+
+
+def rpm_to_rad_s(rpm):
+    """Angular speed in rad/s of ``rpm`` revolutions per minute (scalars or arrays)."""
+    return rpm * RAD_S_PER_RPM
+
+
+def rad_s_to_rpm(omega: float) -> float:
+    """Revolutions per minute of an angular speed ``omega`` in rad/s, to 12 significant digits: a
+    speed means nothing beyond them, and an rpm value taken to rad/s and back then reads as typed
+    (1823 rpm, not 1822.9999999999998)."""
+    return float(f"{omega * 60.0 / (2.0 * math.pi):.12g}")

@@ -47,7 +47,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     speed : float, optional
         Input speed in rpm (default: the train's).
     duration : float, optional
-        Simulated time in s (default 0.1 s; 0.02 s for a published 4-DOF ``model``).
+        Simulated time in s (default: the baseline's when one is checked, else 0.1 s; 0.02 s for a
+        published 4-DOF ``model``).
     model : str
         ``"general"`` (gearcheck's lumped model) or a 4-DOF model of Matejic et al. (2021):
         ``"as-published"``, ``"energy-derived"``, ``"energy-derived-axis"``, ``"consistent"``.
@@ -77,13 +78,13 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     if model not in MODELS:
         raise GearcheckError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
     spec = load_train(train, speed)
-    if duration is None:
-        duration = GENERAL_DURATION if model == "general" else PUBLISHED_DURATION
     tol = Tolerances.for_train(spec, tolerances)
     path = _baseline_path(baseline, spec.name)
-    stored = None
-    if path is not None and not update_baseline:
-        stored = read_baseline(path)  # before the run: a mismatch is refused at once
+    stored = read_baseline(path) if path is not None and not update_baseline else None
+    if duration is None:
+        default = GENERAL_DURATION if model == "general" else PUBLISHED_DURATION
+        duration = default if stored is None else stored["duration_s"]
+    if stored is not None:  # before the run: a mismatch is refused at once
         check_settings(stored, duration, rad_s_to_rpm(spec.operating.input_speed))
     if model == "general":
         reference, test = LumpedSide(spec), MujocoSide(spec)

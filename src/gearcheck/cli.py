@@ -70,7 +70,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
     s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
     s.add_argument("--duration", type=float, metavar="S",
-                   help="simulated time (default 0.1 s; 0.02 s for a --model other than general)")
+                   help="simulated time (default: the baseline's with --baseline, else 0.1 s; 0.02 s for a "
+                        "--model other than general)")
     s.add_argument("--model", default="general", choices=MODELS,
                    help="lumped model checked against MuJoCo: gearcheck's general model (default) or a "
                         "published 4-DOF model (double-planet: as-published, energy-derived, ...)")

@@ -16,7 +16,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from gearcheck.lumped.files import read_text
 from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.outputs import write_file
 
 BASELINE_DIR = Path(__file__).parent / "baselines"
 VERSION = 1
@@ -40,17 +42,39 @@ def snapshot(result) -> dict:
 
 
 def write_baseline(result, path: str | Path) -> None:
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(json.dumps(snapshot(result), indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    write_file(path, json.dumps(snapshot(result), indent=2, sort_keys=True) + "\n", "baseline")
+
+
+NUMBER = (int, float)
+QUANTITY_KEYS = ("lumped_rms", "mujoco_rms", "lumped_peak_to_peak", "mujoco_peak_to_peak")
 
 
 def read_baseline(path: str | Path) -> dict:
+    """A stored baseline, its structure checked (every entry the comparison reads, with its type)."""
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as exc:
-        raise GearcheckError(f"{path}: cannot read baseline: {exc}") from None
-    if data.get("baseline_version") != VERSION:
-        raise GearcheckError(f"{path}: baseline version {data.get('baseline_version')!r}, expected {VERSION}")
+        data = json.loads(read_text(path, "baseline"))
+    except json.JSONDecodeError as exc:
+        raise GearcheckError(f"{path}: the baseline is not JSON: {exc}") from None
+    if not isinstance(data, dict) or data.get("baseline_version") != VERSION:
+        found = data.get("baseline_version") if isinstance(data, dict) else type(data).__name__
+        raise GearcheckError(f"{path}: not a gearcheck baseline of version {VERSION} (found {found!r})")
+
+    def need(ok: bool, what: str):
+        if not ok:
+            raise GearcheckError(f"{path}: not a valid baseline: {what}")
+
+    for key, kind in (("train", str), ("duration_s", NUMBER), ("input_speed_rpm", NUMBER),
+                      ("modes_tolerance", NUMBER), ("modes", list), ("quantities", dict)):
+        need(isinstance(data.get(key), kind), f"{key} missing or not a {getattr(kind, '__name__', 'number')}")
+    for mode in data["modes"]:
+        need(isinstance(mode, dict) and all(isinstance(mode.get(k), NUMBER) for k in ("mode", "lumped_hz",
+                                                                                       "mujoco_hz")),
+             f"modes entry {mode!r} needs numbers mode, lumped_hz, mujoco_hz")
+    for name, q in data["quantities"].items():
+        need(isinstance(q, dict) and all(isinstance(q.get(k), NUMBER) for k in QUANTITY_KEYS)
+             and isinstance(q.get("status"), str) and isinstance(q.get("tolerance"), (*NUMBER, type(None)))
+             and isinstance(q.get("nrmse"), (*NUMBER, type(None))),
+             f"quantity {name!r} needs {', '.join(QUANTITY_KEYS)}, status, tolerance and nrmse")
     return data
 
 
@@ -86,7 +110,7 @@ def compare_to_baseline(result, baseline: dict) -> list[str]:
             moved.append(f"{name}: missing")
             continue
         tol = old["tolerance"] or 0.0
-        for key in ("lumped_rms", "mujoco_rms", "lumped_peak_to_peak", "mujoco_peak_to_peak"):
+        for key in QUANTITY_KEYS:
             if old["status"] != "negligible" and _moved_rel(new[key], old[key], tol):
                 moved.append(f"{name} {key}: {old[key]:.6g} -> {new[key]:.6g}")
         if old["status"] != "negligible" and old["nrmse"] is not None and new["nrmse"] is not None \

@@ -27,8 +27,9 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
-from gearcheck.compare.measure import measure
+from gearcheck.compare.measure import MIN_CYCLES, measure
 from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.kinematics import kinematics
 from gearcheck.lumped.loader import load_text, load_train
 from gearcheck.lumped.spec import beside
 from gearcheck.lumped.time_solver import simulate
@@ -147,6 +148,10 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
     base_rpm = rad_s_to_rpm(base_spec.operating.input_speed)
     rpm = _speeds(entries, base_rpm)
     used = [fit_speeds is None or any(abs(r - f) <= SPEED_MATCH * f for f in fit_speeds) for r in rpm]
+    cycle = 1.0 / min(kinematics(base_spec).mesh_frequency.values()) * base_rpm / min(rpm)  # at the lowest speed
+    if duration < MIN_CYCLES * cycle:
+        raise GearcheckError(f"duration {duration:g} s is shorter than a cycle of the slowest mesh ({cycle:.4g} s), "
+                             "the least a measured statistic needs")
     if not any(used):
         raise GearcheckError(f"no measurement at the fit speeds {fit_speeds} rpm (have {sorted(set(rpm))})")
     start = np.array([f.get(document) for f in fits])

@@ -6,11 +6,12 @@ import json
 from pathlib import Path
 
 
-def write_calibration(result, name: str, out: Path) -> list[str]:
-    """Write the files into ``out``; return the lines printed on the console (the Markdown tables)."""
-    out.mkdir(parents=True, exist_ok=True)
+def write_calibration(result, name: str, out: Path, final: Path | None = None) -> list[str]:
+    """Write the files into the folder ``out``, which will be ``final`` (the calibrated train file's
+    references are written relative to it; default ``out``); return the lines printed on the console."""
+    final = out if final is None else final
     train = out / f"{name}-calibrated.toml"
-    train.write_text(result.text(out), encoding="utf-8")
+    train.write_text(result.text(final), encoding="utf-8")
     rows = result.rows()
     data = {
         "schema": "gearcheck.calibration", "schema_version": 1, "train": name, "runs": result.evaluations,
@@ -30,6 +31,6 @@ def write_calibration(result, name: str, out: Path) -> list[str]:
         lines.append(f"| {r['quantity']} ({r['metric']}) | {r['speed_rpm']:.6g} | {r['role']} | {r['measured']:.4g} | "
                      f"{pub} | {r['before']:.4g} | {r['after']:.4g} | {epub} | {100 * r['error_before']:+.2f} % | "
                      f"{100 * r['error_after']:+.2f} % |")
-    lines += ["", f"Calibrated train file: {train}"]
+    lines += ["", f"Calibrated train file: {final / train.name}"]
     (out / "calibration.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
     return lines

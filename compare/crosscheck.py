@@ -15,16 +15,19 @@ import numpy as np
 
 from gearcheck.compare.baseline import BASELINE_DIR, check_settings, compare_to_baseline, read_baseline, write_baseline
 from gearcheck.compare.engine import CrosscheckResult, compare
-from gearcheck.compare.measurements import attach, load_measurements
+from gearcheck.compare.measure import MIN_CYCLES
+from gearcheck.compare.measurements import attach, check_quantities, load_measurements
 from gearcheck.compare.plan import TrainPlan, TransientPlan
 from gearcheck.compare.tolerances import Tolerances
 from gearcheck.lumped.loader import load_train
 from gearcheck.lumped.published import FINDING
+from gearcheck.lumped.published_parameters import LABELS
 from gearcheck.lumped.published_parameters import MODELS as PUBLISHED_MODELS
 from gearcheck.lumped.side import LumpedSide, PublishedSide
-from gearcheck.lumped.time_solver import max_angular_frequency
+from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide, PublishedTwinSide
 from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import transient_step
 from gearcheck.shared.units import rad_s_to_rpm
@@ -78,6 +81,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     if model not in MODELS:
         raise GearcheckError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
     spec = load_train(train, speed)
+    if sensor_band is not None and not 0 < sensor_band[0] < sensor_band[1]:
+        raise GearcheckError(f"sensor band {sensor_band[0]:g} {sensor_band[1]:g} Hz: needs 0 < LOW < HIGH")
     tol = Tolerances.for_train(spec, tolerances)
     path = _baseline_path(baseline, spec.name)
     stored = read_baseline(path) if path is not None and not update_baseline else None
@@ -88,7 +93,7 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         check_settings(stored, duration, rad_s_to_rpm(spec.operating.input_speed))
     if model == "general":
         reference, test = LumpedSide(spec), MujocoSide(spec)
-        plan = TrainPlan.of(spec, reference.model.kin, max_angular_frequency(reference.model), duration)
+        plan = TrainPlan.of(spec, reference.model.kin, step_limits(reference.model).omega_max, duration)
         settings = (RunSettings(duration, dt_lumped), RunSettings(duration, dt_mujoco))
         notes = []
     else:
@@ -103,11 +108,18 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         plan = TransientPlan(modes_a.frequencies, dt, operating)
         settings = (RunSettings(duration, dt),) * 2
         notes = [FINDING]
-    result = compare(spec, reference, test, plan, settings, tol, sensor_band, progress)
-    result.notes = notes
     entries = list(spec.measurements)
     if measurements is not None:
         entries += load_measurements(measurements) if isinstance(measurements, (str, Path)) else list(measurements)
+    quantities = ([s.name for s in train_signals(spec) if s.compared] if model == "general"
+                  else [f"{label}.acceleration" for label in LABELS])
+    tol.check(quantities)
+    check_quantities(entries, quantities)  # before the runs: a wrong name is refused at once
+    if duration < MIN_CYCLES * plan.cycle:
+        raise GearcheckError(f"duration {duration:g} s is shorter than a cycle of {plan.cycle:.4g} s (the slowest mesh "
+                             f"of {spec.name}, or its lowest mode), the least a comparison needs")
+    result = compare(spec, reference, test, plan, settings, tol, sensor_band, progress)
+    result.notes = notes
     attach(result, entries)
     if path is not None and update_baseline:
         write_baseline(result, path)

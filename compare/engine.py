@@ -28,6 +28,7 @@ from gearcheck.compare.align import resample, sensor_filter, steady_start, unifo
 from gearcheck.compare.metrics import modal_metrics, spectral_metrics, waveform_metrics
 from gearcheck.compare.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError
+from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
 
 NEGLIGIBLE = 1e-6
@@ -90,10 +91,12 @@ class CrosscheckResult:
         raise KeyError(f"no compared quantity {name!r}")
 
     def write(self, directory) -> dict:
-        """Write report.json, report.md, report.html and the figures into ``directory``."""
+        """Write report.json, report.md, report.html and the figures as the folder ``directory``, whole or
+        not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the report's data."""
         from gearcheck.compare.report import write_report
 
-        return write_report(self, directory)
+        with OutputDirectory(directory, "directory") as place:
+            return write_report(self, place.path)
 
 
 def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSettings], tolerances: Tolerances,

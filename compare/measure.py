@@ -14,6 +14,8 @@ import numpy as np
 from gearcheck.compare.align import resample, sensor_filter, steady_start, uniform_grid
 from gearcheck.shared.errors import GearcheckError
 
+MIN_CYCLES = 1  # a run holds at least one cycle of its slowest mesh (or lowest mode) to be compared or measured
+
 STATISTICS = {
     "peak": lambda x: float(np.max(np.abs(x))),
     "rms": lambda x: float(np.sqrt(np.mean(x**2))),
@@ -23,6 +25,9 @@ STATISTICS = {
 
 def chain_statistic(x: np.ndarray, window: np.ndarray, fs: float, metric: str, band=None) -> float:
     """``metric`` of ``x`` over the boolean ``window``, after the optional sensor ``band``."""
+    if band is not None and not band[1] < 0.5 * fs:
+        raise GearcheckError(f"sensor band {band[0]:g}-{band[1]:g} Hz: its upper edge must lie below the sample "
+                             f"rate's Nyquist frequency {0.5 * fs:.6g} Hz")
     if band is not None:
         x = sensor_filter(x, fs, tuple(band))
     return STATISTICS[metric](x[window])

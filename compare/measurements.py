@@ -11,25 +11,31 @@ measuring chain and the value the source's own model gave (``published_model``).
 
 from __future__ import annotations
 
+import difflib
 import math
-import tomllib
 from pathlib import Path
 
 from gearcheck.compare.measure import chain_statistic
+from gearcheck.lumped.files import read_toml
 from gearcheck.lumped.schema import parse_measurements
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError
 
 SPEED_MATCH = 1e-6  # relative
 
 
 def load_measurements(path: str | Path) -> list[dict]:
-    try:
-        document = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise GearcheckError(f"{path}: cannot read: {exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise TrainFileError(str(path), "", f"not valid TOML: {exc}") from None
-    return parse_measurements(document, str(path))
+    """The checked ``[[measurements]]`` of a TOML file."""
+    return parse_measurements(read_toml(path, "measurements file"), str(path))
+
+
+def check_quantities(entries, quantities) -> None:
+    """Refuse a measurement of a quantity the cross-check does not compare."""
+    known = set(quantities)
+    for entry in entries:
+        if entry["quantity"] not in known:
+            close = difflib.get_close_matches(entry["quantity"], sorted(known), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise GearcheckError(f"measurement of {entry['quantity']!r}: no such compared quantity{hint}")
 
 
 def attach(result, entries) -> None:
@@ -44,10 +50,7 @@ def attach(result, entries) -> None:
     for entry in entries:
         if entry.get("speed") is not None and abs(entry["speed"] - speed) > SPEED_MATCH * speed:
             continue
-        q = by_name.get(entry["quantity"])
-        if q is None:
-            raise GearcheckError(f"measurement for unknown quantity {entry['quantity']!r} "
-                                 f"(quantities: {', '.join(sorted(by_name))[:400]}...)")
+        q = by_name[entry["quantity"]]  # known: check_quantities ran before the runs
         metric, band, value = entry["metric"], entry.get("sensor_band_hz"), entry["value"]
         lumped, mujoco = (chain_statistic(x, window, fs, metric, band) for x in result.series[q.name])
         published = entry.get("published_model")

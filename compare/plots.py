@@ -6,6 +6,8 @@ pyplot, so writing a report never touches the user's matplotlib backend.
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -22,7 +24,7 @@ def _figure(rows: int = 1, cols: int = 1, figsize=(9, 5), **kwargs):
 
 def _save(fig, path):
     fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata={"Software": None})
+    fig.savefig(path, dpi=110, metadata={"Software": None}, format="png")
 
 
 def headline_quantities(result) -> list[str]:
@@ -142,8 +144,8 @@ FIGURES = {
 }
 
 
-def mesh_stiffness(spec, path, cycles: int = 2):
-    """k over ``cycles`` mesh cycles for the first planet's mesh with every central gear of every
+def mesh_stiffness(spec, cycles: int = 2) -> bytes:
+    """PNG of k over ``cycles`` mesh cycles for the first planet's mesh with every central gear of every
     stage (the model the train file names), with the number of tooth pairs in contact."""
     first = [m for m in spec.meshes if m.planet_index == 0]
     fig, axes = _figure(len(first), 1, figsize=(9, 2.0 * len(first)), sharex=True, squeeze=False)
@@ -159,4 +161,6 @@ def mesh_stiffness(spec, path, cycles: int = 2):
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
     fig.suptitle(f"{spec.name}: time-varying mesh stiffness", fontsize=9)
-    _save(fig, path)
+    png = io.BytesIO()
+    _save(fig, png)
+    return png.getvalue()

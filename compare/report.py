@@ -258,7 +258,8 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
 
 
 def write_report(result, directory) -> dict:
-    """Write report.json, report.md, report.html and the PNG figures; return the JSON dict."""
+    """Write report.json, report.md, report.html and the PNG figures into the folder ``directory`` (made if
+    missing); return the JSON dict.  :meth:`CrosscheckResult.write` writes them whole or not at all."""
     from gearcheck.compare.plots import FIGURES  # matplotlib only when a report is written
 
     out = Path(directory)

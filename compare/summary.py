@@ -22,7 +22,8 @@ def summary_row(data: dict) -> dict:
         "train": data["train"]["name"], "status": "PASS" if data["verdict"]["passed"] else "FAIL",
         "modes": len(modes), "max_mode_rel_error": max(m["rel_error"]["value"] for m in modes),
         "quantities": len(data["quantities"]), "failed": len(data["verdict"]["failures"]), "moved": len(moved),
-        "worst_nrmse_mesh_force": worst("mesh_force"), "worst_nrmse_acceleration": worst("acceleration", "angular_acceleration"),
+        "worst_nrmse_mesh_force": worst("mesh_force"),
+        "worst_nrmse_acceleration": worst("acceleration", "angular_acceleration"),
         "speed_rpm": data["settings"]["input_speed"]["value"],
     }
 

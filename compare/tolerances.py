@@ -16,12 +16,14 @@ table in a TOML file given with ``--tolerances`` (or a dict from Python; these w
 
 from __future__ import annotations
 
-import tomllib
+import difflib
 from pathlib import Path
 
+from gearcheck.lumped.files import read_toml
 from gearcheck.lumped.spec import flat_tolerances
 from gearcheck.shared.errors import GearcheckError, TrainFileError
 
+METRICS = ("nrmse", "rel_error")
 DEFAULTS = {
     "frequency.rel_error": 1e-6,
     "mesh_force.nrmse": 0.01,
@@ -40,6 +42,19 @@ class Tolerances:
     def lookup(self, quantity: str, kind: str, metric: str) -> float | None:
         return self.values.get(f"{quantity}.{metric}", self.values.get(f"{kind}.{metric}"))
 
+    def check(self, quantities) -> None:
+        """Refuse a key that names no kind and none of ``quantities`` (the cross-check's), or no metric."""
+        kinds = {key.rsplit(".", 1)[0] for key in DEFAULTS}
+        known = kinds | set(quantities)
+        for key in self.values:
+            name, _, metric = key.rpartition(".")
+            if metric not in METRICS:
+                raise GearcheckError(f"tolerance {key!r}: the metric must be one of {', '.join(METRICS)}")
+            if name not in known:
+                close = difflib.get_close_matches(name, sorted(known), n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else f" (kinds: {', '.join(sorted(kinds))})"
+                raise GearcheckError(f"tolerance {key!r}: {name!r} is neither a kind nor a compared quantity{hint}")
+
     @classmethod
     def for_train(cls, spec, extra=None) -> "Tolerances":
         """Defaults, then the train file's [tolerances], then ``extra``: the path of a TOML file with a
@@ -53,10 +68,7 @@ class Tolerances:
 
 
 def read_tolerances(path: str | Path) -> dict[str, float]:
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise GearcheckError(f"{path}: cannot read tolerances: {exc}") from None
+    data = read_toml(path, "tolerances file")
     if not isinstance(data.get("tolerances"), dict) or set(data) != {"tolerances"}:
         raise GearcheckError(f"{path}: expected a single [tolerances] table")
     return flat_tolerances(data["tolerances"], lambda key, msg: TrainFileError(str(path), f"tolerances.{key}", msg))

@@ -17,10 +17,10 @@ from gearcheck.shared.citations import REFERENCES
 
 def models_reference() -> str:
     """One table of every mesh stiffness model's parameters."""
-    rows = ["| model | parameter | type | unit | default | meaning |", "|---|---|---|---|---|---|"]
+    rows = ["| model | parameter | type | unit | default | range | meaning |", "|---|---|---|---|---|---|---|"]
     for name, cls in MODELS.items():
         doc = (cls.__doc__ or "").strip().splitlines()[0]
-        rows.append(f"| `{name}` | | | | | {doc} |")
+        rows.append(f"| `{name}` | | | | | | {doc} |")
         for key, spec in cls.parameters.fields.items():
             rows.append(_row(key, spec).replace(f"| `{key}` |", f"| | `{key}` |", 1))
     return "\n".join(rows) + "\n"

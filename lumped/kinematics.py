@@ -20,6 +20,9 @@ import numpy as np
 from gearcheck.lumped.geometry import base_tooth_thickness
 from gearcheck.lumped.line_of_action import lever, line_of_action
 from gearcheck.shared.errors import TrainFileError
+from gearcheck.shared.units import rad_s_to_rpm
+
+MAX_PITCH_LINE_SPEED = 300.0  # m/s
 
 
 @dataclass(frozen=True)
@@ -75,14 +78,20 @@ def kinematics(spec) -> Kinematics:
         raise TrainFileError(spec.path, "train", f"the train is not a one-degree-of-freedom mechanism: "
                                                  f"{', '.join(idle)} can turn freely with the input and held "
                                                  "members fixed (hold it or couple it)")
-    if np.linalg.norm(A @ sol - rhs) > 1e-9 * max(1.0, np.linalg.norm(rhs)):
-        raise TrainFileError(spec.path, "train.held", "the train is locked: the input cannot turn with the "
-                                                      "held members fixed")
+    if not _consistent(A, rhs):
+        raise _locked(spec, rows, labels, free, rhs, index)
     w[free] = sol
     speeds = {mid: float(w[i]) for mid, i in index.items()}
     w_out = speeds[spec.output]
     if abs(w_out) < 1e-12 * abs(spec.operating.input_speed):
         raise TrainFileError(spec.path, "train.output", f"{spec.output} does not turn when the input turns")
+    for mesh in spec.meshes:
+        v = abs(speeds[mesh.central] - speeds[f"{mesh.stage}.carrier"]) * mesh.geometry.central_pitch_radius
+        if v > MAX_PITCH_LINE_SPEED:
+            raise TrainFileError(spec.path, "operating.input_speed_rpm",
+                                 f"the {mesh.central} mesh would run at a pitch-line speed of {v:.4g} m/s: "
+                                 f"gears are refused above {MAX_PITCH_LINE_SPEED:g} m/s (the fastest turbo gears "
+                                 "run at about 200 m/s)")
 
     # --- statics: output load against grounded input and held members (unit stiffness rows)
     load = spec.operating.output_torque
@@ -136,6 +145,30 @@ def _sun_ring_offset(spec, mesh) -> float:
     q2b2 = rpb * math.tan(a1) + rpb * (math.pi - a1 - a2) + rpb * math.tan(a2) - b2p2 - base_tooth_thickness(planet)
     b2q3 = p * (1.0 - (q2b2 / p) % 1.0)
     return -(b2q3 - b1p1) / p
+
+
+def _consistent(A, rhs) -> bool:
+    sol = np.linalg.lstsq(A, rhs, rcond=None)[0]
+    return bool(np.linalg.norm(A @ sol - rhs) <= 1e-9 * max(1.0, np.linalg.norm(rhs)))
+
+
+def _locked(spec, rows, labels, free, rhs, index) -> TrainFileError:
+    """The error of a locked train, naming the couplings without which it turns: the members each joins
+    turn at different speeds in the train without it."""
+    culprits = []
+    for j, c in enumerate(spec.couplings):
+        keep = [i for i, label in enumerate(labels) if label != c.name]
+        if _consistent(rows[keep][:, free], rhs[keep]):
+            w = np.zeros(len(index))
+            w[index[spec.input]] = spec.operating.input_speed
+            w[free] = np.linalg.lstsq(rows[keep][:, free], rhs[keep], rcond=None)[0]
+            culprits.append(f"{c.name} (couplings[{j}]) joins {c.a} and {c.b}, which turn at "
+                            f"{rad_s_to_rpm(w[index[c.a]]):.6g} and {rad_s_to_rpm(w[index[c.b]]):.6g} rpm without it")
+    if culprits:
+        return TrainFileError(spec.path, "couplings", "the train is locked: " + "; ".join(culprits)
+                              + " (a torsional coupling cannot join members turning at different speeds)")
+    return TrainFileError(spec.path, "train.held", "the train is locked: the input cannot turn with the held "
+                                                   "members fixed")
 
 
 def _free_members(A, free, index):

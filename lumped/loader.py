@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import hashlib
 import math
-import tomllib
 from importlib import resources
 from pathlib import Path
 
 from gearcheck.lumped import schema
+from gearcheck.lumped.files import parse_toml, read_text
+from gearcheck.lumped.kinematics import kinematics
 from gearcheck.lumped.spec import TrainSpec, build_spec
 from gearcheck.shared.errors import GearcheckError, TrainFileError
 from gearcheck.shared.units import rpm_to_rad_s
@@ -30,13 +31,12 @@ def preset_text(name: str) -> str:
 
 
 def load_text(text: str, source: str) -> TrainSpec:
-    """Parse and validate TOML text; ``source`` names it in error messages."""
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise TrainFileError(source, "", f"not valid TOML: {exc}") from None
-    data = schema.parse(document, source)
-    return build_spec(data, source, hashlib.sha256(text.encode("utf-8")).hexdigest())
+    """Parse and validate TOML text; ``source`` names it in error messages.  The train must also be a
+    mechanism that turns at a speed gears survive (:func:`gearcheck.lumped.kinematics.kinematics`)."""
+    data = schema.parse(parse_toml(text, source), source)
+    spec = build_spec(data, source, hashlib.sha256(text.encode("utf-8")).hexdigest())
+    kinematics(spec)
+    return spec
 
 
 def load_train(train: str | Path | TrainSpec, speed: float | None = None) -> TrainSpec:
@@ -47,7 +47,13 @@ def load_train(train: str | Path | TrainSpec, speed: float | None = None) -> Tra
         return spec
     if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not (math.isfinite(speed) and speed > 0):
         raise GearcheckError(f"speed must be a positive number of rpm, got {speed!r}")
-    return spec.with_operating(input_speed=rpm_to_rad_s(speed))
+    schema.OPERATING.fields["input_speed_rpm"].parse(speed, "speed", schema.Context(spec.name))  # its bounds
+    spec = spec.with_operating(input_speed=rpm_to_rad_s(speed))
+    try:
+        kinematics(spec)
+    except TrainFileError as exc:
+        raise GearcheckError(f"speed {speed:g} rpm for {spec.name}: {exc.reason}") from None
+    return spec
 
 
 def read_train_text(train: str | Path) -> tuple[str, str]:
@@ -59,7 +65,4 @@ def read_train_text(train: str | Path) -> tuple[str, str]:
     if not path.exists():
         known = ", ".join(preset_names())
         raise GearcheckError(f"{name}: no such train file or preset (presets: {known})")
-    try:
-        return path.read_text(encoding="utf-8"), str(path)
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GearcheckError(f"{name}: cannot read: {exc}") from None
+    return read_text(path, "train file"), str(path)

@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from gearcheck.lumped import tooth_stiffness
-from gearcheck.lumped.schema import Context, Integer, Number, Positive, Table
+from gearcheck.lumped.schema import REQUIRED, Context, Integer, Number, Positive, Table, bound
 
 
 class MeshStiffness:
@@ -25,7 +25,7 @@ class MeshStiffness:
 
     name = ""
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
-    parameters = Table({"mean": Positive("mean mesh stiffness over a mesh cycle", "N/m")})
+    parameters = Table({"mean": Positive("mean mesh stiffness over a mesh cycle", "N/m", REQUIRED, bound("stiffness"))})
 
     def __init__(self, params: dict, mesh):
         self.mean = float(params["mean"])
@@ -99,11 +99,11 @@ class EnergyMethodStiffness(MeshStiffness):
     name = "energy"
     references = ("weber-1949", "cornell-1981", "li2026")
     parameters = Table({
-        "youngs_modulus": Positive("Young's modulus of both gears", "Pa", 206e9),
+        "youngs_modulus": Number("Young's modulus of both gears", "Pa", 206e9, 1e6, False, 1e13),
         "poisson_ratio": Number("Poisson's ratio of both gears", "-", 0.3, 0.0, True, 0.5),
-        "slices": Integer("slices per tooth in Weber's method", 100, minimum=4),
-        "tooth_load_per_width": Positive("normal load per unit face width at which the load-dependent Hertz "
-                                         "compliance is taken", "N/m", 1.0e5),
+        "slices": Integer("slices per tooth in Weber's method", 100, minimum=4, maximum=10000),
+        "tooth_load_per_width": Number("normal load per unit face width at which the load-dependent Hertz "
+                                       "compliance is taken", "N/m", 1.0e5, 1.0, False, 1e10),
     })
     grid_points = 401  # per part of the cycle
 

@@ -18,7 +18,7 @@ from typing import Any
 
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import TrainFileError
-from gearcheck.shared.units import SUFFIXES
+from gearcheck.shared.units import RAD_S_PER_RPM, SUFFIXES
 
 REQUIRED = object()
 
@@ -42,7 +42,10 @@ def _si_name(key: str) -> tuple[str, float]:
 
 @dataclass(frozen=True)
 class Number:
-    """A real number; ``minimum`` is exclusive when ``strict``."""
+    """A real number in [minimum, maximum] (``minimum`` exclusive when ``strict``), in the file's unit.
+
+    Every number of a train file is bounded: past the bounds it is no gear train any more, and the
+    solvers' arithmetic overflows (:data:`LIMITS` says why each bound is where it is)."""
 
     doc: str
     unit: str = ""
@@ -55,27 +58,60 @@ class Number:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ctx.fail(path, f"must be a number, got {value!r}")
         value = float(value)
+        unit = f" {self.unit}" if self.unit not in ("", "-") else ""
         if not math.isfinite(value):
             raise ctx.fail(path, f"must be finite, got {value}")
         if self.minimum is not None:
             if self.strict and value <= self.minimum:
-                raise ctx.fail(path, f"must be > {self.minimum:g}, got {value:g}")
+                raise ctx.fail(path, f"must be > {self.minimum:g}{unit}, got {value:g}")
             if not self.strict and value < self.minimum:
-                raise ctx.fail(path, f"must be >= {self.minimum:g}, got {value:g}")
+                raise ctx.fail(path, f"must be >= {self.minimum:g}{unit}, got {value:g}")
         if self.maximum is not None and value > self.maximum:
-            raise ctx.fail(path, f"must be <= {self.maximum:g}, got {value:g}")
+            raise ctx.fail(path, f"must be <= {self.maximum:g}{unit}, got {value:g}")
         return value
 
     def type_name(self) -> str:
         return "number"
 
+    def range_text(self) -> str:
+        low = "" if self.minimum is None else f"{self.minimum:g} {'<' if self.strict else '≤'} "
+        high = "" if self.maximum is None else f" ≤ {self.maximum:g}"
+        return f"{low}x{high}" if low or high else ""
 
-def Positive(doc: str, unit: str = "", default=REQUIRED) -> Number:
-    return Number(doc, unit, default, minimum=0.0, strict=True)
+
+LIMITS = {
+    # name: (upper bound in SI, why); fields state it in their own unit with bound()
+    "length": (20.0, "m: the largest gear rims are about 15 m across"),
+    "module": (0.1, "m: the coarsest gears made (mill girth gears) have modules of about 0.05 m"),
+    "displacement": (0.01, "m: an eccentricity, error or backlash of a centimetre is no gear mesh"),
+    "mass": (1e6, "kg: a thousand tonnes, beyond any geared machine's single part"),
+    "inertia": (1e8, "kg·m²: a million kilograms at a 10 m radius"),
+    "stiffness": (1e18, "N/m or N·m/rad: a steel block of 1 m² section and 0.2 µm length; 'rigid' is 1e16"),
+    "damping": (1e12, "N·s/m or N·m·s/rad: critical damping of the stiffest part on the lightest one"),
+    "speed": (1e6 * RAD_S_PER_RPM, "rad/s (a million rpm): pitch-line speeds past 300 m/s are refused separately"),
+    "torque": (1e9, "N·m: a hundred times the largest wind-turbine gearbox"),
+    "frequency": (1e7, "Hz: far above any mesh harmonic"),
+    "time": (1e4, "s: a ramp of hours is no start-up"),
+    "teeth": (1000, "no cylindrical gear has more"),
+    "planets": (32, "no planetary stage has more; they must also fit on the carrier circle"),
+}
 
 
-def NonNegative(doc: str, unit: str = "", default=0.0) -> Number:
-    return Number(doc, unit, default, minimum=0.0)
+def bound(name: str, unit_in_si: float = 1.0) -> float:
+    """The upper bound :data:`LIMITS` sets for a quantity, in a unit worth ``unit_in_si`` SI units."""
+    return LIMITS[name][0] / unit_in_si
+
+
+MM, UM = 1e-3, 1e-6
+MIN_MODULE_MM = 0.01  # the finest gears made (watches) have modules of about 0.05 mm
+
+
+def Positive(doc: str, unit: str = "", default=REQUIRED, maximum: float | None = None) -> Number:
+    return Number(doc, unit, default, minimum=0.0, strict=True, maximum=maximum)
+
+
+def NonNegative(doc: str, unit: str = "", default=0.0, maximum: float | None = None) -> Number:
+    return Number(doc, unit, default, minimum=0.0, maximum=maximum)
 
 
 @dataclass(frozen=True)
@@ -84,18 +120,24 @@ class Integer:
     default: Any = REQUIRED
     minimum: int | None = None
     unit: str = ""
+    maximum: int | None = None
 
     def parse(self, value, path: str, ctx: Context) -> int:
-        if isinstance(value, float) and value.is_integer():
-            value = int(value)
         if isinstance(value, bool) or not isinstance(value, int):
             raise ctx.fail(path, f"must be an integer, got {value!r}")
         if self.minimum is not None and value < self.minimum:
             raise ctx.fail(path, f"must be an integer >= {self.minimum}, got {value}")
+        if self.maximum is not None and value > self.maximum:
+            raise ctx.fail(path, f"must be an integer <= {self.maximum}, got {value}")
         return value
 
     def type_name(self) -> str:
         return "integer"
+
+    def range_text(self) -> str:
+        low = "" if self.minimum is None else f"{self.minimum} ≤ "
+        high = "" if self.maximum is None else f" ≤ {self.maximum}"
+        return f"{low}n{high}" if low or high else ""
 
 
 @dataclass(frozen=True)
@@ -127,13 +169,21 @@ class ListOf:
     default: Any = REQUIRED
     min_length: int = 0
     unit: str = ""
+    max_length: int | None = None
+    increasing: bool = False
 
     def parse(self, value, path: str, ctx: Context) -> list:
         if not isinstance(value, list):
             raise ctx.fail(path, f"must be a list, got {value!r}")
-        if len(value) < self.min_length:
-            raise ctx.fail(path, f"needs at least {self.min_length} entries, got {len(value)}")
-        return [self.item.parse(v, f"{path}[{i}]", ctx) for i, v in enumerate(value)]
+        if len(value) < self.min_length or (self.max_length is not None and len(value) > self.max_length):
+            count = (f"{self.min_length}" if self.max_length == self.min_length
+                     else f"at least {self.min_length}" if self.max_length is None
+                     else f"{self.min_length} to {self.max_length}")
+            raise ctx.fail(path, f"needs {count} entries, got {len(value)}")
+        items = [self.item.parse(v, f"{path}[{i}]", ctx) for i, v in enumerate(value)]
+        if self.increasing and any(b <= a for a, b in zip(items, items[1:])):
+            raise ctx.fail(path, f"must increase, got {value}")
+        return items
 
     def type_name(self) -> str:
         return f"list of {self.item.type_name()}"
@@ -237,41 +287,51 @@ def _did_you_mean(word: str, candidates) -> str:
 # --------------------------------------------------------------------------------------
 
 GEOMETRY = {
-    "teeth": Integer("number of teeth (ring: internal teeth)", minimum=1),
-    "module_mm": Positive("transverse module; defaults to the stage's module", "mm", None),
+    "teeth": Integer("number of teeth (ring: internal teeth)", minimum=1, maximum=int(bound("teeth"))),
+    "module_mm": Number("transverse module; defaults to the stage's module", "mm", None, MIN_MODULE_MM, False,
+                        bound("module", MM)),
     "pressure_angle_deg": Number("standard pressure angle; defaults to the stage's", "deg", None, 0.0, True, 45.0),
-    "face_width_mm": Positive("face width; defaults to the stage's", "mm", None),
-    "helix_angle_deg": Number("helix angle (reserved for helical gears: must be 0 for now)", "deg", 0.0),
-    "addendum_coefficient": NonNegative("addendum h_a* in modules; defaults to the stage's", "-", None),
-    "dedendum_coefficient": NonNegative("dedendum h_f* in modules; defaults to the stage's", "-", None),
-    "profile_shift": Number("profile shift coefficient x (ring: positive moves the teeth outward)", "-", 0.0),
-    "base_radius_mm": Positive("base radius; derived from module, teeth and pressure angle unless given", "mm", None),
-    "eccentricity_um": NonNegative("eccentricity (run-out) of the gear's pitch circle", "µm"),
-    "eccentricity_phase_deg": Number("angle of the eccentricity at t = 0, in the member's own frame", "deg", 0.0),
+    "face_width_mm": Number("face width; defaults to the stage's", "mm", None, MIN_MODULE_MM, False,
+                            bound("length", MM)),
+    "helix_angle_deg": Number("helix angle (reserved for helical gears: must be 0 for now)", "deg", 0.0,
+                              -89.0, False, 89.0),
+    "addendum_coefficient": NonNegative("addendum h_a* in modules; defaults to the stage's", "-", None, 3.0),
+    "dedendum_coefficient": NonNegative("dedendum h_f* in modules; defaults to the stage's", "-", None, 3.0),
+    "profile_shift": Number("profile shift coefficient x (ring: positive moves the teeth outward)", "-", 0.0,
+                            -3.0, False, 3.0),
+    "base_radius_mm": Positive("base radius; derived from module, teeth and pressure angle unless given", "mm", None,
+                               bound("length", MM)),
+    "eccentricity_um": NonNegative("eccentricity (run-out) of the gear's pitch circle", "µm", 0.0,
+                                   bound("displacement", UM)),
+    "eccentricity_phase_deg": Number("angle of the eccentricity at t = 0, in the member's own frame", "deg", 0.0,
+                                     -3600.0, False, 3600.0),
 }
 
 BODY = {
-    "mass": Positive("mass", "kg"),
-    "inertia": Positive("polar moment of inertia about the rotation axis", "kg·m²", None),
-    "inertia_over_r2": Positive(
-        "I/r² with r the base radius (carrier: carrier radius); give this or `inertia`", "kg", None
-    ),
+    "mass": Number("mass", "kg", REQUIRED, 1e-9, False, bound("mass")),
+    "inertia": Number("polar moment of inertia about the rotation axis", "kg·m²", None, 1e-18, False,
+                      bound("inertia")),
+    "inertia_over_r2": Number("I/r² with r the base radius (carrier: carrier radius); give this or `inertia`", "kg",
+                              None, 1e-9, False, bound("mass")),
 }
 
 SUPPORT = Table(
     {
-        "radial_stiffness": Positive("stiffness of the bearing/support in x and in y (isotropic)", "N/m"),
-        "radial_damping": NonNegative("damping of the bearing/support in x and y", "N·s/m"),
-        "torsional_stiffness": NonNegative("torsional stiffness to the housing (0 = free rotation)", "N·m/rad"),
-        "torsional_damping": NonNegative("torsional damping to the housing", "N·m·s/rad"),
+        "radial_stiffness": Positive("stiffness of the bearing/support in x and in y (isotropic)", "N/m", REQUIRED,
+                                     bound("stiffness")),
+        "radial_damping": NonNegative("damping of the bearing/support in x and y", "N·s/m", 0.0, bound("damping")),
+        "torsional_stiffness": NonNegative("torsional stiffness to the housing (0 = free rotation)", "N·m/rad", 0.0,
+                                           bound("stiffness")),
+        "torsional_damping": NonNegative("torsional damping to the housing", "N·m·s/rad", 0.0, bound("damping")),
     },
     "support of a central member (sun, ring, carrier) on the housing",
 )
 
 PLANET_BEARING = Table(
     {
-        "radial_stiffness": Positive("stiffness of the planet bearing, radial and tangential", "N/m"),
-        "radial_damping": NonNegative("damping of the planet bearing", "N·s/m"),
+        "radial_stiffness": Positive("stiffness of the planet bearing, radial and tangential", "N/m", REQUIRED,
+                                     bound("stiffness")),
+        "radial_damping": NonNegative("damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
     },
     "planet bearing on the carrier pin",
 )
@@ -288,8 +348,9 @@ STIFFNESS = Table(
 
 DAMPING = Table(
     {
-        "ratio": NonNegative("damping ratio ζ: c = 2ζ·sqrt(k_mean·m_eq), m_eq of the gear pair", "-", None),
-        "coefficient": NonNegative("mesh damping coefficient (instead of ratio)", "N·s/m", None),
+        "ratio": NonNegative("damping ratio ζ: c = 2ζ·sqrt(k_mean·m_eq), m_eq of the gear pair (at most critical: "
+                             "measured mesh damping ratios are 0.02-0.17)", "-", None, 1.0),
+        "coefficient": NonNegative("mesh damping coefficient (instead of ratio)", "N·s/m", None, bound("damping")),
     },
     "mesh damping",
     default=None,
@@ -297,9 +358,9 @@ DAMPING = Table(
 
 STE = Table(
     {
-        "harmonic": Integer("harmonic of the mesh frequency", minimum=1),
-        "amplitude_um": NonNegative("amplitude along the line of action", "µm", REQUIRED),
-        "phase_deg": Number("phase of this harmonic (added to the mesh phase)", "deg", 0.0),
+        "harmonic": Integer("harmonic of the mesh frequency", minimum=1, maximum=1000),
+        "amplitude_um": NonNegative("amplitude along the line of action", "µm", REQUIRED, bound("displacement", UM)),
+        "phase_deg": Number("phase of this harmonic (added to the mesh phase)", "deg", 0.0, -3600.0, False, 3600.0),
     },
     "static transmission error harmonic",
 )
@@ -308,7 +369,8 @@ MESH = Table(
     {
         "stiffness": STIFFNESS,
         "damping": DAMPING,
-        "backlash_um": NonNegative("total backlash 2b along the line of action (dead zone ±b)", "µm", None),
+        "backlash_um": NonNegative("total backlash 2b along the line of action (dead zone ±b)", "µm", None,
+                                   bound("displacement", UM)),
         "ste": TableList(STE, "static transmission error: harmonic series at the mesh frequency", default=()),
     },
     "mesh properties; a stage-level [stages.mesh] gives defaults for its central gears",
@@ -334,7 +396,7 @@ PLANET_GEAR = Table({k: v for k, v in GEOMETRY.items()}, "one gear of a compound
 PLANET = Table(
     {
         **{k: v for k, v in GEOMETRY.items() if k != "teeth"},
-        "teeth": Integer("teeth of a simple planet (omit when `gears` is given)", None, 1),
+        "teeth": Integer("teeth of a simple planet (omit when `gears` is given)", None, 1, maximum=int(bound("teeth"))),
         **BODY,
         "bearing": PLANET_BEARING,
         "gears": Table({}, "compound planet: named gears, e.g. [stages.planet.gears.f]", None,
@@ -346,14 +408,16 @@ PLANET = Table(
 STAGE = Table(
     {
         "name": Text("stage name, used in member references (`stage1.sun`)", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
-        "planets": Integer("number of planets", minimum=1),
-        "planet_angles_deg": ListOf(Number("angle", "deg"), "planet angles (default: equally spaced)", None,
+        "planets": Integer("number of planets", minimum=1, maximum=int(bound("planets"))),
+        "planet_angles_deg": ListOf(Number("angle", "deg", REQUIRED, -3600.0, False, 3600.0),
+                                    "planet angles (default: equally spaced)", None,
                                     unit="deg"),
-        "module_mm": Positive("default transverse module of the stage's gears", "mm", None),
+        "module_mm": Number("default transverse module of the stage's gears", "mm", None, MIN_MODULE_MM, False,
+                            bound("module", MM)),
         "pressure_angle_deg": Number("default pressure angle", "deg", 20.0, 0.0, True, 45.0),
-        "face_width_mm": Positive("default face width", "mm", None),
-        "addendum_coefficient": NonNegative("default addendum coefficient h_a*", "-", 1.0),
-        "dedendum_coefficient": NonNegative("default dedendum coefficient h_f*", "-", 1.25),
+        "face_width_mm": Number("default face width", "mm", None, MIN_MODULE_MM, False, bound("length", MM)),
+        "addendum_coefficient": NonNegative("default addendum coefficient h_a*", "-", 1.0, 3.0),
+        "dedendum_coefficient": NonNegative("default dedendum coefficient h_f*", "-", 1.25, 3.0),
         "mesh": MESH,
         "carrier": CARRIER,
         "planet": PLANET,
@@ -368,29 +432,31 @@ STAGE = Table(
 RIPPLE = Table(
     {
         "member": Text("which torque it modulates", REQUIRED, ("input", "output")),
-        "order": Positive("frequency as a multiple of that member's rotation frequency", "-", None),
-        "frequency_hz": Positive("frequency (instead of order)", "Hz", None),
-        "amplitude": NonNegative("amplitude as a fraction of the mean torque", "-", REQUIRED),
-        "phase_deg": Number("phase", "deg", 0.0),
+        "order": Positive("frequency as a multiple of that member's rotation frequency", "-", None, 1e4),
+        "frequency_hz": Positive("frequency (instead of order)", "Hz", None, bound("frequency")),
+        "amplitude": NonNegative("amplitude as a fraction of the mean torque", "-", REQUIRED, 100.0),
+        "phase_deg": Number("phase", "deg", 0.0, -3600.0, False, 3600.0),
     },
     "harmonic torque ripple ([[operating.ripple]])",
 )
 
 OPERATING = Table(
     {
-        "input_speed_rpm": Positive("nominal input speed (positive = counter-clockwise seen from +z)", "rpm"),
-        "output_torque": NonNegative("load torque on the output member, opposing its rotation", "N·m"),
+        "input_speed_rpm": Positive("nominal input speed (positive = counter-clockwise seen from +z)", "rpm",
+                                    REQUIRED, bound("speed", RAD_S_PER_RPM)),
+        "output_torque": NonNegative("load torque on the output member, opposing its rotation", "N·m", 0.0,
+                                     bound("torque")),
         "input_shaft_stiffness": Positive(
             "torsional stiffness of the input shaft to a reference turning at the nominal speed "
-            "(omit for a torque-driven input with a rigid-body mode)", "N·m/rad", None),
-        "input_shaft_damping": NonNegative("damping of the input shaft", "N·m·s/rad"),
+            "(omit for a torque-driven input with a rigid-body mode)", "N·m/rad", None, bound("stiffness")),
+        "input_shaft_damping": NonNegative("damping of the input shaft", "N·m·s/rad", 0.0, bound("damping")),
         "ripple": TableList(RIPPLE, "torque ripple harmonics", default=()),
         "torque_function": Text("Python `module:function` f(t) -> N·m added to the input torque", None,
                                 pattern=r"[A-Za-z_][\w.]*:[A-Za-z_]\w*"),
         "torque_csv": Text("CSV file (relative to the train file) of time [s], torque [N·m] added to the input "
                            "torque, repeated with the file's period", None),
         "ramp_s": NonNegative("duration of the smooth start-up ramp of the load torque (0 = start at the "
-                              "static deflection)", "s"),
+                              "static deflection)", "s", 0.0, bound("time")),
     },
     "operating point",
 )
@@ -401,10 +467,11 @@ COUPLING = Table(
         "kind": Text("what it is (ring: two stages' rings joined into one, by a stiff coupling)", "spline", ("spline", "shaft", "ring")),
         "from": Text("first member (`stage1.carrier`)", REQUIRED),
         "to": Text("second member (`stage2.sun`)", REQUIRED),
-        "torsional_stiffness": Positive("torsional stiffness", "N·m/rad"),
-        "torsional_damping": NonNegative("torsional damping", "N·m·s/rad"),
-        "radial_stiffness": NonNegative("radial stiffness in x and y (0 = torsional only)", "N/m"),
-        "radial_damping": NonNegative("radial damping", "N·s/m"),
+        "torsional_stiffness": Positive("torsional stiffness", "N·m/rad", REQUIRED, bound("stiffness")),
+        "torsional_damping": NonNegative("torsional damping", "N·m·s/rad", 0.0, bound("damping")),
+        "radial_stiffness": NonNegative("radial stiffness in x and y (0 = torsional only)", "N/m", 0.0,
+                                        bound("stiffness")),
+        "radial_damping": NonNegative("radial damping", "N·s/m", 0.0, bound("damping")),
     },
     "a coupling between members of different stages ([[couplings]])",
 )
@@ -413,12 +480,16 @@ MEASUREMENT = Table(
     {
         "quantity": Text("a cross-check quantity name (`stage1.ring.ay.world`, see README)"),
         "metric": Text("which statistic of the steady window", REQUIRED, ("peak", "rms", "peak_to_peak")),
-        "value": Number("the measured value, in the quantity's SI unit"),
-        "speed_rpm": Positive("input speed the value was measured at (attached only at that speed)", "rpm", None),
-        "sensor_band_hz": ListOf(Positive("frequency", "Hz"), "band (low, high) of the measuring chain, applied to "
-                                 "both solvers' series before the statistic", None, unit="Hz"),
-        "uncertainty": Positive("relative standard uncertainty of the value (calibration weights)", "-", 0.1),
-        "published_model": Number("the value the source's own model gave (shown beside both solvers)", "", None),
+        "value": Number("the measured value, in the quantity's SI unit", "", REQUIRED, -1e12, False, 1e12),
+        "speed_rpm": Positive("input speed the value was measured at (attached only at that speed)", "rpm", None,
+                              bound("speed", RAD_S_PER_RPM)),
+        "sensor_band_hz": ListOf(Positive("frequency", "Hz", REQUIRED, bound("frequency")),
+                                 "band [low, high] of the measuring chain, applied to "
+                                 "both solvers' series before the statistic", None, 2, unit="Hz", max_length=2,
+                                 increasing=True),
+        "uncertainty": Positive("relative standard uncertainty of the value (calibration weights)", "-", 0.1, 10.0),
+        "published_model": Number("the value the source's own model gave (shown beside both solvers)", "", None,
+                                  -1e12, False, 1e12),
         "source": Text("where the value comes from", ""),
     },
     "a measured reference value ([[measurements]])",
@@ -471,7 +542,7 @@ def parse_measurements(document: dict, source: str) -> list[dict]:
 
 def markdown_reference() -> str:
     """The field-by-field reference of the train file, as a Markdown table."""
-    rows = ["| field | type | unit | default | meaning |", "|---|---|---|---|---|"]
+    rows = ["| field | type | unit | default | range | meaning |", "|---|---|---|---|---|---|"]
     seen: dict[int, str] = {}
 
     def walk(table: Table, prefix: str):
@@ -507,5 +578,7 @@ def _row(path: str, spec, note: str = "") -> str:
         doc = f"{doc}; {note}"
     if getattr(spec, "choices", None):
         doc += " (" + ", ".join(spec.choices) + ")"
-    return f"| `{path}` | {spec.type_name()} | {spec.unit or '-'} | {default} | {doc} |"
+    item = spec.item if isinstance(spec, ListOf) else spec
+    bounds = item.range_text() if hasattr(item, "range_text") else ""
+    return f"| `{path}` | {spec.type_name()} | {spec.unit or '-'} | {default} | {bounds} | {doc} |"
 

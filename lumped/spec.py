@@ -9,14 +9,25 @@ with an error that names the file and the field.
 
 from __future__ import annotations
 
+import difflib
+import importlib
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from math import gcd
+from pathlib import Path
 
-from gearcheck.lumped.geometry import Gear, MeshGeometry, mesh_geometry
-from gearcheck.shared.errors import TrainFileError
+import numpy as np
+
+from gearcheck.lumped.files import read_text, read_toml
+from gearcheck.lumped.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
+from gearcheck.lumped.mesh_stiffness import MODELS
+from gearcheck.lumped.schema import Context, parse_measurements
+from gearcheck.shared.errors import GearcheckError, TrainFileError
 
 MIN_TEETH = 6
+MAX_BACKLASH = 0.5  # modules: beyond, the backlash is more than the tooth space leaves
+MAX_TOLERANCE = 1e6  # a relative error of a million is no tolerance
+MAX_ERROR = 0.1  # modules: a transmission error or an eccentricity that large is a broken or misplaced gear
 CENTRE_DISTANCE_TOLERANCE = 1e-6  # m: sun-planet and ring-planet operating centre distances must match
 
 
@@ -154,8 +165,6 @@ class TrainSpec:
 
     def with_operating(self, **changes) -> "TrainSpec":
         """A copy with operating-point fields replaced (e.g. ``input_speed``)."""
-        from dataclasses import replace
-
         return replace(self, operating=replace(self.operating, **changes))
 
 
@@ -182,6 +191,8 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         if train[key] not in members:
             raise fail(f"train.{key}", f"no member {train[key]!r}{_known(train[key], members)}")
     for j, ref in enumerate(train["held"]):
+        if ref in train["held"][:j]:
+            raise fail(f"train.held[{j}]", f"{ref} is held twice")
         if ref not in members:
             raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
         if members[ref].is_planet:
@@ -240,8 +251,8 @@ def flat_tolerances(table: dict, fail) -> dict[str, float]:
             if isinstance(value, dict):
                 walk(value, name)
             elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                    or value <= 0:
-                raise fail(name, f"must be a positive number, got {value!r}")
+                    or not 0 < value <= MAX_TOLERANCE:
+                raise fail(name, f"must be a positive number up to {MAX_TOLERANCE:g}, got {value!r}")
             elif "." not in name:
                 raise fail(name, "expected KIND.METRIC or QUANTITY.METRIC")
             else:
@@ -252,8 +263,6 @@ def flat_tolerances(table: dict, fail) -> dict[str, float]:
 
 
 def _known(ref: str, members) -> str:
-    import difflib
-
     close = difflib.get_close_matches(ref, list(members), n=1)
     return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
 
@@ -261,70 +270,72 @@ def _known(ref: str, members) -> str:
 def beside(source: str, name: str):
     """A file named in a train file: relative to that file (presets and their edited variants: the presets
     folder)."""
-    from pathlib import Path
-
     base = Path(__file__).parent / "presets" if source.startswith("preset:") else Path(source).parent
     return base / name
 
 
 def _measurements(data: dict, source: str, fail) -> list[dict]:
-    """Inline [[measurements]] plus those of train.measurements_file, checked; bands sorted."""
-    import tomllib
-
-    from gearcheck.lumped.schema import parse_measurements
+    """Inline [[measurements]] plus those of train.measurements_file, checked."""
 
     entries = list(data["measurements"])
     name = data["train"]["measurements_file"]
     if name is not None:
         path = beside(source, name)
         try:
-            document = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (OSError, tomllib.TOMLDecodeError) as exc:
-            raise fail("train.measurements_file", f"cannot read {path}: {exc}") from None
+            document = read_toml(path, "measurements file")
+        except TrainFileError:
+            raise
+        except GearcheckError as exc:
+            raise fail("train.measurements_file", str(exc)) from None
         entries += parse_measurements(document, str(path))
-    for j, entry in enumerate(entries):
-        band = entry.get("sensor_band_hz")
-        if band is not None and (len(band) != 2 or band[0] >= band[1]):
-            raise fail(f"measurements[{j}].sensor_band_hz", f"needs [low, high] with low < high, got {band}")
     return entries
 
 
 def _torque_profile(name: str, source: str, fail):
     """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
-    import numpy as np
-
     path = beside(source, name)
     try:
-        data = np.loadtxt(path, delimiter=",", ndmin=2, skiprows=_header_rows(path))
-    except (OSError, ValueError) as exc:
-        raise fail("operating.torque_csv", f"cannot read {path}: {exc}") from None
-    if data.shape[1] != 2 or data.shape[0] < 2:
+        lines = read_text(path, "torque profile").splitlines()
+    except GearcheckError as exc:
+        raise fail("operating.torque_csv", str(exc)) from None
+    if lines and not _numbers(lines[0]):
+        lines = lines[1:]  # a header line
+    try:
+        data = np.loadtxt(lines, delimiter=",", ndmin=2)
+    except ValueError as exc:
+        raise fail("operating.torque_csv", f"{path}: {exc}") from None
+    if data.ndim != 2 or data.shape[1] != 2 or data.shape[0] < 2:
         raise fail("operating.torque_csv", f"{path} needs two columns (time, torque) and at least two rows")
     if not np.all(np.isfinite(data)) or np.any(np.diff(data[:, 0]) <= 0):
         raise fail("operating.torque_csv", f"{path}: times must increase strictly and all values be finite")
     return tuple(data[:, 0]), tuple(data[:, 1])
 
 
-def _header_rows(path) -> int:
-    with open(path, encoding="utf-8") as f:
-        first = f.readline()
+def _numbers(line: str) -> bool:
     try:
-        [float(x) for x in first.split(",")]
-        return 0
+        [float(x) for x in line.split(",")]
+        return True
     except ValueError:
-        return 1
+        return False
 
 
 def _check_torque_function(ref: str, fail):
-    import importlib
-
+    """The function must import and map a time in s to a finite torque in N·m: it is called once at t = 0."""
     module, _, func = ref.partition(":")
     try:
         obj = getattr(importlib.import_module(module), func)
-    except (ImportError, AttributeError) as exc:
-        raise fail("operating.torque_function", f"cannot import {ref!r}: {exc}") from None
+    except Exception as exc:  # whatever the user's module raises on import
+        raise fail("operating.torque_function", f"cannot import {ref!r}: {type(exc).__name__}: {exc}") from None
     if not callable(obj):
         raise fail("operating.torque_function", f"{ref!r} is not callable")
+    try:
+        value = obj(0.0)
+    except Exception as exc:  # a wrong signature, or an error inside the user's function
+        raise fail("operating.torque_function", f"{ref}(0.0) raised {type(exc).__name__}: {exc} (it must map a time "
+                                                "in s to a torque in N·m)") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(value):
+        raise fail("operating.torque_function", f"{ref}(0.0) returned {value!r}; it must return a finite torque in N·m")
 
 
 def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:
@@ -343,7 +354,12 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
         raise fail(f"{path}.helix_angle_deg", "helical gears are not supported yet; helix angle must be 0")
     module = pick("module", "module_mm")
     alpha = pick("pressure_angle", "pressure_angle_deg")
+    _check_small(raw["eccentricity"], MAX_ERROR, module, f"{path}.eccentricity_um", "eccentricity", fail)
     base = raw["base_radius"] if raw["base_radius"] is not None else 0.5 * module * teeth * math.cos(alpha)
+    pitch = 0.5 * module * teeth
+    if not 0.5 * pitch < base < pitch:  # cos a between 0.5 and 1: pressure angles of 0 to 60 deg
+        raise fail(f"{path}.base_radius_mm", f"base radius {base * 1e3:.4g} mm does not fit the pitch radius "
+                                             f"{pitch * 1e3:.4g} mm (it must lie between half of it and all of it)")
     return Gear(
         name=name, teeth=teeth, module=module, pressure_angle=alpha, face_width=pick("face_width", "face_width_mm"),
         addendum=pick("addendum_coefficient", "addendum_coefficient"),
@@ -410,8 +426,30 @@ def _build_stage(st: dict, path: str, fail):
                 raise fail(f"{gpath}.planet_gear", f"no planet gear {pg!r} (have {', '.join(planet_gears)})")
         centrals[key] = (gear, pg, raw)
 
+    # --- every gear an involute gear, every pair an involute mesh
+    planet_paths = {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}"
+                    for name in planet_gears}
+    for gear, gpath in [(planet_gears[n], p) for n, p in planet_paths.items()] + \
+            [(g, f"{path}.{key}") for key, (g, _, _) in centrals.items()]:
+        problem = gear_problem(gear)
+        if problem:
+            raise fail(f"{gpath}.{problem[0]}", problem[1])
+    geoms = {}
+    for key, (gear, pg, _) in centrals.items():
+        planet = planet_gears[pg]
+        if gear.internal and gear.teeth <= planet.teeth:
+            raise fail(f"{path}.{key}.teeth", f"a ring needs more teeth than its planet gear ({planet.teeth}), "
+                                              f"got {gear.teeth}")
+        try:
+            geoms[key] = mesh_geometry(gear, planet)
+        except ValueError as exc:
+            raise fail(f"{path}.{key}.profile_shift", f"no operating geometry with the planet: {exc}") from None
+        problem = mesh_problem(gear, planet, geoms[key])
+        if problem:
+            where = f"{path}.{key}" if problem[0] == "central" else planet_paths[pg]
+            raise fail(f"{where}.teeth", f"meshing {key} with the planet: {problem[1]}")
+
     # --- operating centre distances must agree (ring teeth consistent with sun and planet)
-    geoms = {key: mesh_geometry(gear, planet_gears[pg]) for key, (gear, pg, _) in centrals.items()}
     first = central_keys[0]
     a0 = geoms[first].centre_distance
     for key in central_keys[1:]:
@@ -424,10 +462,6 @@ def _build_stage(st: dict, path: str, fail):
                 hint = f"; with zero profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth"
             raise fail(f"{path}.{key}.teeth", f"{key} with {g.teeth} teeth meets the planet at centre distance "
                                               f"{a * 1e3:.4f} mm but {first} at {a0 * 1e3:.4f} mm{hint}")
-    for key, gm in geoms.items():
-        if gm.contact_ratio < 1.0:
-            raise fail(f"{path}.{key}.teeth", f"transverse contact ratio {gm.contact_ratio:.3f} < 1 with the "
-                                              "planet: the mesh cannot transmit motion continuously")
 
     # --- planet angles and the assembly condition
     if st["planet_angles"] is None:
@@ -479,6 +513,10 @@ def _build_stage(st: dict, path: str, fail):
         if damping["ratio"] is not None and damping["coefficient"] is not None:
             raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")
         ste = tuple((s["harmonic"], s["amplitude"], s["phase"]) for s in mesh["ste"])
+        _check_small(mesh["backlash"] or 0.0, MAX_BACKLASH, gear.module, f"{mpath}.backlash_um", "backlash", fail)
+        for j, (_, amplitude, _) in enumerate(ste):
+            _check_small(amplitude, MAX_ERROR, gear.module, f"{mpath}.ste[{j}].amplitude_um",
+                         "transmission error amplitude", fail)
         for k, pid in enumerate(planet_ids):
             meshes.append(MeshSpec(
                 id=f"{pid}.{key}", stage=name, central=f"{name}.{key}", planet=pid, central_gear=gear,
@@ -491,15 +529,18 @@ def _build_stage(st: dict, path: str, fail):
     return members, stage, meshes
 
 
+def _check_small(value: float, limit: float, module: float, path: str, what: str, fail) -> None:
+    """A deviation from the perfect mesh (backlash, transmission error, eccentricity) well below the
+    teeth: at ``limit`` modules the teeth would leave each other's flanks or hit the mate's tip."""
+    if value > limit * module:
+        raise fail(path, f"{what} {value * 1e6:.4g} µm is over {limit:g} of the module {module * 1e3:.4g} mm: "
+                         "no tooth pair stays on its flanks")
+
+
 def _check_stiffness(params: dict, path: str, fail):
     """Check a ``stiffness`` table against its model's parameter table; store SI values in place."""
-    from gearcheck.lumped.mesh_stiffness import MODELS
-    from gearcheck.lumped.schema import Context
-
     name = params["model"]
     if name not in MODELS:
-        import difflib
-
         close = difflib.get_close_matches(name, list(MODELS), n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{hint}")

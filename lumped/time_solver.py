@@ -24,14 +24,13 @@ from __future__ import annotations
 import time as clock
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
 from gearcheck.lumped.static import mean_load, static_solution
-from gearcheck.shared import stepping
+from gearcheck.shared import divergence, stepping
 from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
-from gearcheck.shared.results import TimeResult, train_result
+from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
 
@@ -39,20 +38,20 @@ CHUNK = 20000
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
 
-def max_angular_frequency(model) -> float:
-    """Highest natural angular frequency with every mesh at its largest stiffness over a cycle."""
+def step_limits(model) -> stepping.StepLimits:
+    """The RK4 step limits of the model with every mesh at its largest stiffness over a cycle, damping,
+    gyroscopic and rotating-frame terms included."""
     K = model.K_b + model.K_mesh(model.excitation.max_stiffness) + model.K_frame
-    w2 = sla.eigh(0.5 * (K + K.T), model.M, eigvals_only=True)
-    return float(np.sqrt(max(w2.max(), 0.0)))
+    return stepping.StepLimits.of(model.M, K, model.C + model.G)
 
 
 def stable_step(model) -> float:
-    return stepping.stable_step(max_angular_frequency(model))
+    return stepping.stable_step(step_limits(model))
 
 
 def default_step(model) -> float:
     """:func:`gearcheck.shared.stepping.default_step` for this model."""
-    return stepping.default_step(max_angular_frequency(model), model.excitation.frequency)
+    return stepping.default_step(step_limits(model), model.excitation.frequency)
 
 
 class _System:
@@ -174,26 +173,37 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
         raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
     if drive not in ("steps", "stages"):
         raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
-    omega_max = max_angular_frequency(model)
-    dt = stepping.default_step(omega_max, model.excitation.frequency) if settings.dt is None else settings.dt
-    stepping.check_step(dt, omega_max, model.excitation.frequency, f"lumped model of {model.spec.name}")
-    n_steps, every = settings.grid(dt)
+    limits = step_limits(model)
+    dt = stepping.default_step(limits, model.excitation.frequency) if settings.dt is None else settings.dt
+    what = f"lumped model of {model.spec.name}"
+    stepping.check_step(dt, limits, model.excitation.frequency, what)
+    n_steps, every = settings.check_work(dt, len(model.spec.members) * 5 + len(model.spec.meshes) * 4 + 4 * model.n,
+                                         what)
     q0, v0 = initial_state(model) if y0 is None else y0
     sys = _System(model)
+    static = static_solution(model)
+    scale = divergence.deflection_scale(static.mesh_deflection, sys.b)
+
+    def runaway(t, q):
+        divergence.check(t, q @ sys.A.T, scale, what)
+
     started = clock.perf_counter()
     if method in ("rk4", "rk4-stages"):
-        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, method == "rk4-stages", drive)
+        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway, method == "rk4-stages", drive)
         evaluations = 4 * n_steps
     else:
         t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
+        runaway(t_out, q_out)
     wall = clock.perf_counter() - started
     info = {"method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
             "rhs_evaluations": evaluations, "wall_time_s": wall,
             "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms}
-    return _result(model, sys, t_out, q_out, v_out, settings.settle_time(model.spec.operating.ramp), info)
+    return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
-def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="steps"):
+def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, drive="steps"):
+    """Fixed-step RK4 over n_steps, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
+    samples and its last state for divergence."""
     n = q.size
     n_out = n_steps // every + 1
     t_out = np.empty(n_out)
@@ -204,7 +214,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
     linear = None if stage_by_stage or sys.turning else _LinearStep(sys, h)  # turning couplings: periodic
     stages = np.array(STAGE_OFFSETS)
     y = np.concatenate([q, v])
-    j = 1
+    j = j0 = 1
     for start in range(0, n_steps, CHUNK):
         stop = min(start + CHUNK, n_steps)
         times = (np.arange(start, stop)[:, None] + stages[None, :]) * h
@@ -238,8 +248,8 @@ def _rk4(sys, q, v, h, n_steps, every, progress, stage_by_stage=False, drive="st
             if step % every == 0:
                 t_out[j], q_out[j], v_out[j] = step * h, y[:n], y[n:]
                 j += 1
-        if not np.all(np.isfinite(y)):
-            raise DivergenceError(stop * h, "state became NaN or infinite")
+        runaway(np.append(t_out[j0:j], stop * h), np.vstack([q_out[j0:j], y[None, :n]]))
+        j0 = j
         if progress is not None:
             progress(stop / n_steps)
     return t_out[:j], q_out[:j], v_out[:j]
@@ -273,7 +283,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
     return sol.t, sol.y[:n].T, sol.y[n:].T, int(sol.nfev)
 
 
-def _result(model, sys, t, q, v, settle, info) -> TimeResult:
+def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
     k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
     qdd = sys.acceleration(q, v, k, e, de, tin[:, None], tout[:, None], t)
@@ -293,10 +303,11 @@ def _result(model, sys, t, q, v, settle, info) -> TimeResult:
         # the carrier axes turn with the carrier's actual angle: nominal plus its vibration (wind-up)
         carrier = f"{member.stage}.carrier"
         angle[:, j] = model.kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
-    bearings = [r for r in model.rows if r.kind == "bearing"]
-    rows = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)
-    bearing_force = (q @ rows.T) * [r.stiffness for r in bearings] + (v @ rows.T) * [r.damping for r in bearings]
+    rows = {r.name: r for r in model.rows if r.kind == "bearing"}
+    bearings = [rows[name] for name in bearing_names(spec)]
+    a = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)
+    bearing_force = (q @ a.T) * [r.stiffness for r in bearings] + (v @ a.T) * [r.damping for r in bearings]
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
-    return train_result(spec, "lumped", t, acc, angle, delta, force, k, static_solution(model).mesh_force,
-                        [r.name for r in bearings], bearing_force, settle, info, raw)
+    return train_result(spec, "lumped", t, acc, angle, delta, force, k, static.mesh_force, bearing_force, settle,
+                        info, raw)

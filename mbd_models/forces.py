@@ -42,7 +42,6 @@ class ForceReader:
         planets = [mid for mid, member in mb.spec.members.items() if member.is_planet]
         self.dofs = np.array([dof for mid in planets for dof in mb.dadr[mid]], dtype=int)
         self.slides = np.array([3 * i + axis for i in range(len(planets)) for axis in (0, 1)], dtype=int)
-        self.bearing_names = [f"{mid}.bearing_{axis}" for mid in planets for axis in ("radial", "tangential")]
         J_P = mb.mesh_jacobian()[:, self.dofs]
         if np.linalg.matrix_rank(J_P) < self.n_mesh:
             raise SolverError(f"{mb.spec.name}: the mesh forces cannot be told apart at the planets' joints "
@@ -51,8 +50,9 @@ class ForceReader:
         # views kept once: the hot path only copies into them
         self._sum = np.empty(m.nv)
         self._spring, self._damper, self._applied = d.qfrc_spring, d.qfrc_damper, d.qfrc_applied
-        self._stiffness, self._probe_stiffness = m.tendon_stiffness[:self.n_mesh], self.probe.tendon_stiffness[:self.n_mesh]
-        self._lengths, self._probe_lengths = m.tendon_lengthspring[:self.n_mesh], self.probe.tendon_lengthspring[:self.n_mesh]
+        n = self.n_mesh
+        self._stiffness, self._probe_stiffness = m.tendon_stiffness[:n], self.probe.tendon_stiffness[:n]
+        self._lengths, self._probe_lengths = m.tendon_lengthspring[:n], self.probe.tendon_lengthspring[:n]
 
     @property
     def width(self) -> int:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result
 
 FD_STEP = 1e-6  # m or rad; the spring forces are linear in qpos, so the step only sets rounding
@@ -77,17 +78,28 @@ def stiffness_matrix(mb, tendon_stiffness: np.ndarray | None = None,
     return 0.5 * (K + K.T)
 
 
-def max_angular_frequency(mb) -> float:
-    """Highest natural angular frequency of the MuJoCo model with every mesh at its cycle-maximum stiffness."""
-    w2 = np.linalg.eigvalsh(_reduce(stiffness_matrix(mb, mb.excitation.max_stiffness), mass_matrix(mb)))
-    return float(np.sqrt(max(w2.max(), 0.0)))
+def damping_matrix(mb, qpos: np.ndarray | None = None) -> np.ndarray:
+    """-d(qfrc_passive + qfrc_actuator)/dqvel by central differences, at rest: the joints' and tendons'
+    damping and the input shaft's damper."""
+    m = mb.model
+    d = mujoco.MjData(m)
+    q0 = m.qpos0 if qpos is None else qpos
+    C = np.zeros((m.nv, m.nv))
+    for j in range(m.nv):
+        forces = []
+        for sign in (1.0, -1.0):
+            _set_rest(mb, d, q0)
+            d.qvel[j] = sign * FD_STEP
+            mujoco.mj_forward(m, d)
+            forces.append(d.qfrc_passive + d.qfrc_actuator)
+        C[:, j] = -(forces[0] - forces[1]) / (2.0 * FD_STEP)
+    return C
 
 
-def _reduce(K, M):
-    L = np.linalg.cholesky(M)
-    Li = np.linalg.inv(L)
-    A = Li @ K @ Li.T
-    return 0.5 * (A + A.T)
+def step_limits(mb) -> stepping.StepLimits:
+    """RK4 step limits of the MuJoCo model with every mesh at its cycle-maximum stiffness, damping included."""
+    return stepping.StepLimits.of(mass_matrix(mb), stiffness_matrix(mb, mb.excitation.max_stiffness),
+                                  damping_matrix(mb))
 
 
 def joint_labels(mb) -> list[str]:

@@ -26,9 +26,9 @@ excitation at the weighted time of the remaining stages, (4 x(t+h/2) + x(t+h))/5
 the stage weights of RK4 (2/6, 2/6, 1/6) then integrate a linear-in-time drive
 exactly over the step.
 
-Time step: from the highest natural frequency of MuJoCo's own linearisation with every
-mesh at its cycle-maximum stiffness (``MbdModel.omega_max``); the rule of
-:mod:`gearcheck.shared.stepping`, the same as the lumped solver's.
+Time step: from MuJoCo's own linearisation with every mesh at its cycle-maximum stiffness, damping
+included (``MbdModel.limits``); the rule of :mod:`gearcheck.shared.stepping`, the same as the lumped
+solver's.
 
 Start: the steady rotating state at the nominal operating point of the MuJoCo model
 itself (:func:`static_state`): a Newton solve on MuJoCo's forward dynamics for the
@@ -51,14 +51,13 @@ import numpy as np
 
 from gearcheck.mbd_models.forces import ForceReader
 from gearcheck.mbd_models.twin import MbdModel
-from gearcheck.shared import stepping
-from gearcheck.shared.errors import DivergenceError, SolverError
+from gearcheck.shared import divergence, stepping
+from gearcheck.shared.errors import SolverError
 from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
 
 CHUNK = 10000
-DIVERGENCE_FACTOR = 1e3  # |delta| beyond this times the static scale counts as runaway
 
 
 # --------------------------------------------------------------------------- drive
@@ -367,8 +366,9 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
     spec, m = mb.spec, mb.model
     dt = mb.default_step if settings.dt is None else settings.dt
-    stepping.check_step(dt, mb.omega_max, mb.excitation.frequency, f"MuJoCo model of {spec.name}")
-    n_steps, every = settings.grid(dt)
+    what = f"MuJoCo model of {spec.name}"
+    stepping.check_step(dt, mb.limits, mb.excitation.frequency, what)
+    n_steps, every = settings.check_work(dt, m.nsensordata + 3 * 3 * len(spec.members) + 2 * len(spec.meshes), what)
     static = static_state(mb)
     if initial_state is None:
         start = static if spec.operating.ramp == 0 else static_state(mb, 0.0)
@@ -388,13 +388,14 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
             and stiffness_clock == "nominal" and not record_energy)
     stepper = (_LeanStepper if lean else _Stepper)(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies",
                                                    record_energy)
-    scale = float(np.max(np.abs(static.mesh_deflection))) + float(np.max(mb.half_backlash, initial=0.0)) + 1e-6
+    scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
     try:
         started = clock.perf_counter()
         for start in range(0, n_steps, CHUNK):
             stop = min(start + CHUNK, n_steps)
+            j0 = stepper.j
             stepper.run(start, stop, every, stepper.drive.steps(dt * np.arange(start, stop), dt))
-            _check_divergence(d, stop * dt, mb, scale)
+            _check_divergence(stepper, j0, stop * dt, every * dt, scale, what)
             if progress is not None:
                 progress(stop / n_steps)
         stepper.finish(n_steps * dt)
@@ -404,20 +405,20 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         m.opt.enableflags, m.opt.timestep, m.opt.integrator = saved[3], saved[4], saved[5]
     t = dt * every * np.arange(stepper.j)
     info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
-            "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.omega_max),
+            "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
             "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
             "static_newton_iterations": static.iterations, "static_residual": static.residual,
             "forward_evaluations": 4 * n_steps}
     return _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
 
 
-def _check_divergence(d: mujoco.MjData, t_now: float, mb: MbdModel, scale: float) -> None:
-    if not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))):
-        raise DivergenceError(t_now, "MuJoCo state became NaN or infinite")
-    delta = d.ten_length[:len(mb.mesh_tendon)]
-    if np.max(np.abs(delta), initial=0.0) > DIVERGENCE_FACTOR * scale:
-        raise DivergenceError(t_now, f"mesh deflection {np.max(np.abs(delta)):.3g} m is over "
-                                     f"{DIVERGENCE_FACTOR:g} times the static scale {scale:.3g} m: runaway energy")
+def _check_divergence(stepper: _Stepper, j0: int, t_now: float, interval: float, scale: float, what: str) -> None:
+    """Samples j0.. of the stepper and its current state, against :mod:`gearcheck.shared.divergence`."""
+    mb, d, j = stepper.mb, stepper.d, stepper.j
+    columns = [mb.sensor[f"{m.label}_deflection"][0] for m in mb.spec.meshes]
+    state = d.ten_length[:len(mb.mesh_tendon)] if np.all(np.isfinite(d.qpos)) else np.full(len(columns), np.nan)
+    deflection = np.vstack([stepper.sensors[j0:j][:, columns], state[None]])
+    divergence.check(np.append(interval * np.arange(j0, j), t_now), deflection, scale, what)
 
 
 def _body_clock(mb: MbdModel):
@@ -482,5 +483,5 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     if stepper.energy is not None:  # MuJoCo's d.energy is (potential, kinetic)
         raw["energy_potential"] = stepper.energy[:stepper.j, 0]
         raw["energy_kinetic"] = stepper.energy[:stepper.j, 1]
-    return train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force,
-                        stepper.reader.bearing_names, bearing_force, settle, info, raw)
+    return train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force, bearing_force, settle,
+                        info, raw)

@@ -90,7 +90,7 @@ class MbdModel:
     excitation: Excitation
     xml: str
     model: mujoco.MjModel
-    omega_max: float  # highest natural angular frequency, every mesh at its cycle-maximum stiffness
+    limits: stepping.StepLimits  # of MuJoCo's linearisation, every mesh at its cycle-maximum stiffness
     body: dict[str, int]  # member id -> body id
     qadr: dict[str, tuple[int, int, int]]  # member id -> qpos addresses (x|radial, y|tangential, rz)
     dadr: dict[str, tuple[int, int, int]]  # member id -> dof addresses
@@ -102,8 +102,12 @@ class MbdModel:
     turning: TurningCoefficients
 
     @property
+    def omega_max(self) -> float:
+        return self.limits.omega_max
+
+    @property
     def default_step(self) -> float:
-        return stepping.default_step(self.omega_max, self.excitation.frequency)
+        return stepping.default_step(self.limits, self.excitation.frequency)
 
     def refresh(self, qpos: np.ndarray) -> None:
         """Turn the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
@@ -215,7 +219,7 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     model.tendon_damping[:len(spec.meshes)] = damping
 
     mb = _indices(spec, kin, exc, model)
-    mb.omega_max = linearise.max_angular_frequency(mb)
+    mb.limits = linearise.step_limits(mb)
     model.opt.timestep = mb.default_step
     stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
     mb.xml = document(spec, mesh_tendons(spec, coefficients, k, damping) + couplings, model.opt.timestep,
@@ -224,7 +228,7 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
 
 
 def _indices(spec, kin, exc, model) -> MbdModel:
-    """Named indices of the compiled model (its xml and omega_max are filled in by the caller)."""
+    """Named indices of the compiled model (its xml and step limits are filled in by the caller)."""
     J, B, T, A, S = (mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON,
                      mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR)
     body, qadr, dadr = {}, {}, {}
@@ -263,6 +267,6 @@ def _indices(spec, kin, exc, model) -> MbdModel:
     single = int(carrier_qadr[0]) if len(set(carrier_qadr.tolist())) == 1 else None
     turning = TurningCoefficients(wraps, base, carrier_qadr, np.array(tendon + tendon, dtype=int), slide_qadr,
                                   slide_dof, single)
-    return MbdModel(spec, kin, exc, "", model, 0.0, body, qadr, dadr, mesh_tendon,
+    return MbdModel(spec, kin, exc, "", model, None, body, qadr, dadr, mesh_tendon,
                     model.tendon_damping[mesh_tendon].copy(), model.tendon_lengthspring[mesh_tendon, 1].copy(),
                     actuator, sensor, turning)

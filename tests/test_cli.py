@@ -38,15 +38,3 @@ def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
     assert df["t"].iloc[-1] == pytest.approx(0.01, rel=1e-3)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["solver"] == "lumped" and summary["info"]["method"] == "rk4"
-
-
-@pytest.mark.parametrize("argv, message", [
-    (["show", "no-such-train"], "no such train file or preset"),
-    (["run", "demo-3p", "--duration", "-1"], "duration must be a positive number"),
-    (["run", "demo-3p", "--speed", "nan"], "speed must be a positive number"),
-    (["run", "demo-3p", "--dt", "1e-3", "--duration", "0.001"], "cannot resolve the highest natural frequency"),
-])
-def test_bad_requests_exit_2_with_one_line(argv, message, capsys, tmp_path):
-    assert main(argv + (["--out", str(tmp_path)] if argv[0] == "run" else [])) == 2
-    err = capsys.readouterr().err
-    assert message in err and err.count("\n") == 1

@@ -8,6 +8,7 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.loader import load_train
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.lumped.variants import edited
+from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.settings import RunSettings
 
 EXCITED = [
@@ -71,5 +72,5 @@ def test_torque_profile_from_a_csv_file(tmp_path):
     np.testing.assert_allclose(t_in, [20.0, 40.0, 20.0, 0.0])
     bad = tmp_path / "bad.toml"
     bad.write_text(edited_text("demo-3p", [(r"^input_shaft_damping = .*", 'torque_csv = "missing.csv"')]))
-    with pytest.raises(Exception, match="operating.torque_csv: cannot read"):
+    with pytest.raises(GearcheckError, match="operating.torque_csv: .*missing.csv: no such torque profile"):
         load_train(bad)

@@ -53,7 +53,7 @@ def test_shifted_ring_keeps_the_stage_consistent():
     a_sp = mesh_geometry(sun, planet).centre_distance
     from scipy.optimize import brentq
 
-    x_r = brentq(lambda x: mesh_geometry(gear(62, True, x), planet).centre_distance - a_sp, -1, 2)
+    x_r = brentq(lambda x: mesh_geometry(gear(62, True, x), planet).centre_distance - a_sp, -0.5, 2)
     assert mesh_geometry(gear(62, True, x_r), planet).centre_distance == pytest.approx(a_sp, abs=1e-12)
 
 

@@ -1,12 +1,19 @@
 """The ``gearcheck`` command line: parses arguments, calls the front door, prints.
 
-Every GearcheckError becomes one line on stderr and exit status 2; no traceback.
+Exit status: 0 done (a cross-check passed), 1 a cross-check failed (a tolerance exceeded or a
+baseline metric moved), 2 bad input (one line on stderr naming the file, field or option, and the
+value; nothing written), 130 interrupted (SIGINT), 143 terminated (SIGTERM); a closed pipe ends the
+program quietly, as other command-line tools do.  Outputs are written whole or not at all
+(:class:`~gearcheck.shared.outputs.OutputDirectory`).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import re
+import signal
 import sys
 from pathlib import Path
 
@@ -18,11 +25,36 @@ from gearcheck.compare.summary import summary_row, write_summary
 from gearcheck.lumped.describe import describe
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
+
+
+class Terminated(Exception):
+    """SIGTERM, raised where the program is so that every ``finally`` runs."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``gearcheck: error: ...``, exit status 2, no usage block) that reads
+    every negative number as a value, ``--dt -1e-6`` and ``--speed -inf`` too (argparse's own pattern
+    knows only plain decimals and would take them for options)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$",
+                                                   re.IGNORECASE)
+
+    def error(self, message):
+        raise GearcheckError(message)
+
+
+def _terminate(signum, frame):
+    raise Terminated()
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `gearcheck show | head`: end quietly, like other tools
+    previous = signal.signal(signal.SIGTERM, _terminate)
     try:
+        args = _parser().parse_args(argv)
         return args.func(args)
     except GearcheckError as exc:
         print(f"gearcheck: error: {exc}", file=sys.stderr)
@@ -30,11 +62,32 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("gearcheck: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("gearcheck: terminated", file=sys.stderr)
+        return 143
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _number(kind: str, positive: bool = True):
+    """An argparse type: a finite number (positive unless told otherwise); ``kind`` says of what."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a number of {kind}, got {text!r}") from None
+        if not math.isfinite(value) or (positive and value <= 0):
+            raise argparse.ArgumentTypeError(f"must be a positive number of {kind}, got {text}")
+        return value
+    return parse
+
+
+SECONDS, RPM, HZ = _number("seconds"), _number("rpm"), _number("Hz")
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="gearcheck", description="Cross-verify lumped-parameter planetary gear "
-                                                              "models against MuJoCo multibody twins.")
+    p = _Parser(prog="gearcheck", description="Cross-verify lumped-parameter planetary gear "
+                                              "models against MuJoCo multibody twins.")
     p.add_argument("--version", action="version", version=f"gearcheck {gearcheck.__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -55,10 +108,10 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser("run", help="time response at the operating point")
     _train_arg(s)
     s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS), default="lumped")
-    s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
-    s.add_argument("--duration", type=float, default=0.2, metavar="S", help="simulated time (default 0.2 s)")
-    s.add_argument("--dt", type=float, metavar="S", help="time step (default: from the highest natural frequency)")
-    s.add_argument("--output-dt", type=float, metavar="S", help="output sampling interval (default: every step)")
+    s.add_argument("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)")
+    s.add_argument("--duration", type=SECONDS, default=0.2, metavar="S", help="simulated time (default 0.2 s)")
+    s.add_argument("--dt", type=SECONDS, metavar="S", help="time step (default: from the highest natural frequency)")
+    s.add_argument("--output-dt", type=SECONDS, metavar="S", help="output sampling interval (default: every step)")
     s.add_argument("--method", default="rk4", help="lumped integrator: rk4 (default) or RK45, DOP853, Radau, "
                                                    "BDF, LSODA")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
@@ -68,17 +121,17 @@ def _parser() -> argparse.ArgumentParser:
                                           "tolerance is exceeded or a baseline metric moved")
     s.add_argument("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file")
     s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
-    s.add_argument("--speed", type=float, metavar="RPM", help="input speed (default: the train file's)")
-    s.add_argument("--duration", type=float, metavar="S",
+    s.add_argument("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)")
+    s.add_argument("--duration", type=SECONDS, metavar="S",
                    help="simulated time (default: the baseline's with --baseline, else 0.1 s; 0.02 s for a "
                         "--model other than general)")
     s.add_argument("--model", default="general", choices=MODELS,
                    help="lumped model checked against MuJoCo: gearcheck's general model (default) or a "
                         "published 4-DOF model (double-planet: as-published, energy-derived, ...)")
-    s.add_argument("--dt-lumped", type=float, metavar="S", help="lumped RK4 step (default: derived)")
-    s.add_argument("--dt-mujoco", type=float, metavar="S", help="MuJoCo step (default: derived)")
+    s.add_argument("--dt-lumped", type=SECONDS, metavar="S", help="lumped RK4 step (default: derived)")
+    s.add_argument("--dt-mujoco", type=SECONDS, metavar="S", help="MuJoCo step (default: derived)")
     s.add_argument("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table")
-    s.add_argument("--sensor-band", type=float, nargs=2, metavar=("LOW", "HIGH"),
+    s.add_argument("--sensor-band", type=HZ, nargs=2, metavar=("LOW", "HIGH"),
                    help="accelerometer chain: band-pass both solvers' accelerations to LOW-HIGH Hz")
     s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]")
     s.add_argument("--baseline", type=str, metavar="FILE", nargs="?", const="shipped",
@@ -93,9 +146,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="a train-file field in its own units, e.g. stages[0].mesh.ste[0].amplitude_um=0.05:20")
     s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]] "
                                                                      "(default: the train file's)")
-    s.add_argument("--fit-speed", type=float, action="append", metavar="RPM",
+    s.add_argument("--fit-speed", type=RPM, action="append", metavar="RPM",
                    help="use only the measurements at this speed for the fit; the others are predicted")
-    s.add_argument("--duration", type=float, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)")
+    s.add_argument("--duration", type=SECONDS, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_calibrate)
 
@@ -180,15 +233,16 @@ def cmd_modes(args) -> int:
 
 def cmd_run(args) -> int:
     spec = gearcheck.load(args.train, args.speed)
-    bar = ProgressBar(f"{args.solver} {spec.name}")
-    result = gearcheck.simulate(spec, args.solver, args.duration, dt=args.dt, output_dt=args.output_dt,
-                                method=args.method, progress=bar)
-    bar.close()
-    written = result.write(args.out)
+    with OutputDirectory(args.out) as place:
+        bar = ProgressBar(f"{args.solver} {spec.name}")
+        result = gearcheck.simulate(spec, args.solver, args.duration, dt=args.dt, output_dt=args.output_dt,
+                                    method=args.method, progress=bar)
+        bar.close()
+        written = [path.name for path in result.write_files(place.path)]
     print(f"{spec.name} ({args.solver}): {result.t.size} samples over {result.t[-1]:.6g} s, "
           f"dt = {result.info['dt_s']:.4g} s, wall {result.info['wall_time_s']:.3g} s")
-    for path in written:
-        print(f"  wrote {path}")
+    for name in written:
+        print(f"  wrote {args.out / name}")
     return 0
 
 
@@ -197,28 +251,22 @@ def cmd_stiffness(args) -> int:
 
     spec = gearcheck.load(args.train)
     path = args.output or Path("out") / f"{spec.name}-stiffness.png"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    mesh_stiffness(spec, path)
+    check_place(path, "-o", folder=False)
+    write_file(path, mesh_stiffness(spec))
     print(f"wrote {path}")
     return 0
 
 
 def cmd_mjcf(args) -> int:
+    if args.output is not None:
+        check_place(args.output, "-o", folder=False)
     text = gearcheck.mjcf(args.train)
     if args.output is None:
         sys.stdout.write(text)
         return 0
-    _write_atomic(args.output, text)
+    write_file(args.output, text)
     print(f"wrote {args.output}")
     return 0
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file, so nothing is left half-written."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
 
 
 def cmd_calibrate(args) -> int:
@@ -236,10 +284,12 @@ def cmd_calibrate(args) -> int:
         if sys.stderr.isatty():
             print(f"\rcalibrate {spec.name}: {runs} runs", end="", file=sys.stderr, flush=True)
 
-    result = calibrate(text, source, entries, fits, args.duration, args.fit_speed, progress)
-    if sys.stderr.isatty():
-        print(file=sys.stderr)
-    for line in write_calibration(result, spec.name, args.out):
+    with OutputDirectory(args.out) as place:
+        result = calibrate(text, source, entries, fits, args.duration, args.fit_speed, progress)
+        if sys.stderr.isatty():
+            print(file=sys.stderr)
+        lines = write_calibration(result, spec.name, place.path, args.out)
+    for line in lines:
         print(line)
     return 0
 
@@ -250,20 +300,24 @@ def cmd_crosscheck(args) -> int:
     if args.all and args.speed is not None:
         raise GearcheckError("--speed applies to one train; --all runs each preset at its own speed")
     names = gearcheck.presets() if args.all else [args.train]
-    rows = []
-    for name in names:
-        out = args.out / name if args.all else args.out
-        bar = ProgressBar(f"crosscheck {name}")
-        result = gearcheck.crosscheck(
-            name, speed=args.speed, duration=args.duration, model=args.model, dt_lumped=args.dt_lumped,
-            dt_mujoco=args.dt_mujoco, tolerances=args.tolerances, measurements=args.measurements,
-            sensor_band=args.sensor_band, baseline=args.baseline, update_baseline=args.update_baseline, progress=bar)
-        bar.close()
-        data = write_report(result, out)
-        print(_verdict_line(result, out))
-        rows.append(summary_row(data))
+    rows, lines = [], []
+    with OutputDirectory(args.out) as place:
+        for name in names:
+            bar = ProgressBar(f"crosscheck {name}")
+            result = gearcheck.crosscheck(
+                name, speed=args.speed, duration=args.duration, model=args.model, dt_lumped=args.dt_lumped,
+                dt_mujoco=args.dt_mujoco, tolerances=args.tolerances, measurements=args.measurements,
+                sensor_band=args.sensor_band, baseline=args.baseline, update_baseline=args.update_baseline,
+                progress=bar)
+            bar.close()
+            data = write_report(result, place.path / name if args.all else place.path)
+            lines.append(_verdict_line(result, args.out / name if args.all else args.out))
+            rows.append(summary_row(data))
+        if args.all:
+            write_summary(place.path, rows)
+    for line in lines:
+        print(line)
     if args.all:
-        write_summary(args.out, rows)
         print(f"summary: {args.out / 'summary.md'}")
     return 0 if all(r["status"] == "PASS" for r in rows) else 1
 

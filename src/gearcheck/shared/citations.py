@@ -36,6 +36,9 @@ REFERENCES: dict[str, Reference] = {
     "parker-2000": Reference(
         "Parker R. G.", 2000, "A physical explanation for the effectiveness of planet phasing to suppress "
         "planetary gear vibration", "Journal of Sound and Vibration 236(4), 561-573"),
+    "lin-parker-2002": Reference(
+        "Lin J., Parker R. G.", 2002, "Planetary gear parametric instability caused by mesh stiffness variation",
+        "Journal of Sound and Vibration 249(1), 129-145"),
     "parker-lin-2004": Reference(
         "Parker R. G., Lin J.", 2004, "Mesh phasing relationships in planetary and epicyclic gears",
         "Journal of Mechanical Design 126(2), 365-370"),

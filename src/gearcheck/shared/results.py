@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from gearcheck.shared.outputs import OutputDirectory
+
 
 @dataclass(frozen=True)
 class Signal:
@@ -96,9 +98,14 @@ class TimeResult:
                 "samples": int(w.sum()), "info": self.info, "series": stats}
 
     def write(self, directory) -> list[Path]:
-        """Write ``timeseries.csv`` (and ``raw.csv`` if any) and ``summary.json`` into ``directory``."""
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
+        """Write ``timeseries.csv`` (and ``raw.csv`` if any) and ``summary.json`` as the folder ``directory``,
+        whole or not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the files' paths."""
+        with OutputDirectory(directory, "directory") as place:
+            names = [p.name for p in self.write_files(place.path)]
+        return [Path(directory) / name for name in names]
+
+    def write_files(self, out: Path) -> list[Path]:
+        """Write the files into the existing folder ``out``."""
         written = [out / "timeseries.csv"]
         self.to_dataframe().to_csv(written[-1], index=False, float_format="%.9g")
         if self.raw:
@@ -109,38 +116,48 @@ class TimeResult:
         return written
 
 
+def bearing_names(spec) -> list[str]:
+    """``PLANET.bearing_radial`` and ``PLANET.bearing_tangential`` of every planet, in member order."""
+    planets = [mid for mid, m in spec.members.items() if m.is_planet]
+    return [f"{mid}.bearing_{axis}" for mid in planets for axis in ("radial", "tangential")]
+
+
+def train_signals(spec) -> list[Signal]:
+    """The signals of a gear train run, in the order :func:`train_result` holds them."""
+    signals = []
+    for mid, member in spec.members.items():
+        gated = not member.is_planet
+        for frame in ("world", "carrier"):
+            for axis in "xy":
+                signals.append(Signal(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
+                                      f"{mid} acceleration along {axis} ({frame} frame)", gated))
+        signals.append(Signal(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", gated))
+    for mesh in spec.meshes:
+        signals += [Signal(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force"),
+                    Signal(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error"),
+                    Signal(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static", False),
+                    Signal(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", False)]
+    signals += [Signal(f"{name}.force", "bearing_force", "N", f"{name} force") for name in bearing_names(spec)]
+    return signals
+
+
 def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflection, mesh_force, mesh_stiffness,
-                 static_mesh_force, bearing_names, bearing_force, settle_time, info, raw) -> TimeResult:
+                 static_mesh_force, bearing_force, settle_time, info, raw) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
     acc_carrier: (n_t, n_members, 3) inertial acceleration of each member's centre along its carrier's
     axes, and its angular acceleration; carrier_angle: (n_t, n_members) angle of those axes
     (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force
-    (n_t, n_bearing) named ``bearing_names`` (``PLANET.bearing_radial`` ...)."""
-    signals, columns = [], []
-
-    def add(name, kind, unit, description, values, compared=True):
-        signals.append(Signal(name, kind, unit, description, compared))
-        columns.append(values)
-
-    for j, (mid, member) in enumerate(spec.members.items()):
+    (n_t, n_bearing) in :func:`bearing_names` order."""
+    columns = []
+    for j in range(len(spec.members)):
         a = acc_carrier[:, j, :]
         c, s = np.cos(carrier_angle[:, j]), np.sin(carrier_angle[:, j])
-        gated = not member.is_planet
-        for frame, ax, ay in (("world", c * a[:, 0] - s * a[:, 1], s * a[:, 0] + c * a[:, 1]),
-                              ("carrier", a[:, 0], a[:, 1])):
-            for axis, values in (("x", ax), ("y", ay)):
-                add(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
-                    f"{mid} acceleration along {axis} ({frame} frame)", values, gated)
-        add(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", a[:, 2], gated)
-    for j, mesh in enumerate(spec.meshes):
-        add(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force", mesh_force[:, j])
-        add(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error", mesh_deflection[:, j])
-        add(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static",
-            mesh_force[:, j] / static_mesh_force[j], False)
-        add(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", mesh_stiffness[:, j], False)
-    for j, name in enumerate(bearing_names):
-        add(f"{name}.force", "bearing_force", "N", f"{name} force", bearing_force[:, j])
+        columns += [c * a[:, 0] - s * a[:, 1], s * a[:, 0] + c * a[:, 1], a[:, 0], a[:, 1], a[:, 2]]
+    for j in range(len(spec.meshes)):
+        columns += [mesh_force[:, j], mesh_deflection[:, j], mesh_force[:, j] / static_mesh_force[j],
+                    mesh_stiffness[:, j]]
+    columns += [bearing_force[:, j] for j in range(bearing_force.shape[1])]
     static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
-    return TimeResult(spec.name, solver, np.asarray(t), signals, np.column_stack(columns), settle_time, info, raw,
-                      static)
+    return TimeResult(spec.name, solver, np.asarray(t), train_signals(spec), np.column_stack(columns), settle_time,
+                      info, raw, static)

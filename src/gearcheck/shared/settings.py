@@ -12,7 +12,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .errors import SolverError
+from gearcheck.shared.errors import SolverError
+
+MAX_STEPS = 2e8  # about an hour of the slowest solver: longer runs are refused, not started
+MAX_OUTPUT_BYTES = 4 * 2**30  # what one run may hold in memory for its samples
 
 
 def _positive(name: str, value, optional: bool) -> None:
@@ -42,6 +45,22 @@ class RunSettings:
         ``duration``, and samples fall every ``output_dt`` rounded to whole steps."""
         every = 1 if self.output_dt is None else max(1, round(self.output_dt / dt))
         return every * max(1, math.ceil(self.duration / (dt * every) - 1e-9)), every
+
+    def check_work(self, dt: float, columns: int, model: str) -> tuple[int, int]:
+        """(steps, steps between samples) for the step ``dt``, refused before anything is allocated when the
+        run would take more than ``MAX_STEPS`` steps or its ``columns`` sampled series more than
+        ``MAX_OUTPUT_BYTES``; ``model`` names the model in the message."""
+        steps = self.duration / dt
+        if steps > MAX_STEPS:
+            raise SolverError(f"duration {self.duration:g} s at the step {dt:.4g} s of the {model} is {steps:.3g} "
+                              f"steps, more than the {MAX_STEPS:.0e} gearcheck runs in one go: shorten the duration")
+        n_steps, every = self.grid(dt)
+        size = (n_steps // every + 1) * columns * 8.0
+        if size > MAX_OUTPUT_BYTES:
+            raise SolverError(f"duration {self.duration:g} s sampled every {every * dt:.4g} s would hold "
+                              f"{size / 2**30:.1f} GiB of series of the {model} (at most {MAX_OUTPUT_BYTES / 2**30:g} "
+                              "GiB): sample less often (output_dt) or shorten the duration")
+        return n_steps, every
 
     def settle_time(self, ramp: float) -> float:
         """Start of the steady window: ``settle``, or the larger of the load ramp and half the duration."""

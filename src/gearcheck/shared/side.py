@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from .modal import ModalResult
-from .results import TimeResult
-from .settings import RunSettings
+from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.results import TimeResult
+from gearcheck.shared.settings import RunSettings
 
 
 class Side(Protocol):

@@ -1,21 +1,24 @@
 """The fixed RK4 time step both solvers take by default and refuse beyond, and how a step samples
 the drive.
 
-RK4 is stable for omega h < 2.83 on an undamped mode.  A step above ``STABILITY_MARGIN`` times
-that limit for the highest natural frequency omega_max (every mesh at its cycle-maximum
-stiffness) is refused; the default takes ``POINTS_PER_PERIOD`` steps per period of that mode and
-at least ``POINTS_PER_MESH_CYCLE`` per mesh cycle, made a whole fraction of the slowest mesh
-period (:func:`commensurate_step`).  Each solver supplies its own omega_max: the lumped model's
-eigenvalues, or MuJoCo's own linearisation.
+RK4 is stable for omega h < 2.83 on an undamped mode and h |lambda| < 2.79 on an overdamped one
+(:func:`rk4_stable_step` finds the limit for every eigenvalue of the damped system, every mesh at
+its cycle-maximum stiffness).  A step above ``STABILITY_MARGIN`` times that limit is refused; the
+default takes ``POINTS_PER_PERIOD`` steps per period of the highest natural frequency (at most the
+refusal limit) and at least ``POINTS_PER_MESH_CYCLE`` per mesh cycle, made a whole fraction of the
+slowest mesh period (:func:`commensurate_step`).  Each solver supplies its own matrices: the lumped
+model's, or MuJoCo's own linearisation.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 
-from .errors import SolverError
+from gearcheck.shared.errors import SolverError
 
 RK4_LIMIT = 2.0 * math.sqrt(2.0)
 STABILITY_MARGIN = 0.9
@@ -50,27 +53,73 @@ def commensurate_step(h_max: float, mesh_frequencies, points_per_cycle: int) -> 
     return float(period / math.ceil(period / h - 1e-9))
 
 
-def stable_step(omega_max: float) -> float:
-    return STABILITY_MARGIN * RK4_LIMIT / omega_max
+@dataclass(frozen=True)
+class StepLimits:
+    """What bounds a model's RK4 step: its highest undamped natural angular frequency (rad/s, every mesh
+    at its cycle-maximum stiffness), and the largest step at which RK4 keeps every mode of the damped
+    first-order system from growing (s)."""
+
+    omega_max: float
+    stable: float
+
+    @classmethod
+    def of(cls, M: np.ndarray, K: np.ndarray, D: np.ndarray) -> "StepLimits":
+        """The limits of M q'' + D q' + K q = 0 (D: damping and gyroscopic terms)."""
+        w2 = sla.eigh(0.5 * (K + K.T), M, eigvals_only=True)
+        n = M.shape[0]
+        MinvK, MinvD = np.linalg.solve(M, K), np.linalg.solve(M, D)
+        J = np.block([[np.zeros((n, n)), np.eye(n)], [-MinvK, -MinvD]])
+        return cls(float(np.sqrt(max(w2.max(), 0.0))), rk4_stable_step(np.linalg.eigvals(J)))
 
 
-def default_step(omega_max: float, mesh_frequencies) -> float:
-    h = 2.0 * math.pi / (POINTS_PER_PERIOD * omega_max)
+def rk4_growth(z) -> np.ndarray:
+    """|R(z)|, R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24: how much RK4 multiplies a mode per step (z = h lambda)."""
+    return np.abs(1 + z * (1 + z * (1 / 2 + z * (1 / 6 + z / 24))))
+
+
+def rk4_stable_step(eigenvalues) -> float:
+    """The largest step h with |R(h lambda)| <= 1 for every eigenvalue lambda of y' = J y: 2.83/|lambda| for an
+    undamped mode, 2.79/|lambda| for an overdamped one.  A mode that grows physically (Re lambda > 0, an
+    instability of the model itself) is taken at its magnitude, as if undamped."""
+    lam = np.asarray(eigenvalues, dtype=complex)
+    lam = lam[np.abs(lam) > 1e-9 * np.max(np.abs(lam), initial=1.0)]
+    if lam.size == 0:
+        return math.inf
+    rays = np.where(lam.real > 0, 1j, lam / np.abs(lam))  # directions of z = h lambda
+    r = np.linspace(0.0, 3.0, 3001)[1:]
+    outside = rk4_growth(np.outer(rays, r)) > 1 + 1e-12
+    first = np.where(outside.any(axis=1), outside.argmax(axis=1), r.size - 1)
+    best = math.inf
+    for ray, i, size in zip(rays, first, np.abs(lam)):
+        lo, hi = (r[i - 1] if i else 0.0), r[i]
+        for _ in range(60):  # bisection on the ray to round-off
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if rk4_growth(mid * ray) <= 1 + 1e-12 else (lo, mid)
+        best = min(best, lo / size)
+    return best
+
+
+def stable_step(limits: StepLimits) -> float:
+    return STABILITY_MARGIN * limits.stable
+
+
+def default_step(limits: StepLimits, mesh_frequencies) -> float:
+    h = min(2.0 * math.pi / (POINTS_PER_PERIOD * limits.omega_max), stable_step(limits))
     return commensurate_step(h, mesh_frequencies, POINTS_PER_MESH_CYCLE)
 
 
-def check_step(dt, omega_max: float, mesh_frequencies, model: str) -> None:
+def check_step(dt, limits: StepLimits, mesh_frequencies, model: str) -> None:
     """Refuse a step that is not a positive number or that RK4 cannot run stably on ``model``
     (named in the message, e.g. 'MuJoCo model of demo-3p')."""
     if not (isinstance(dt, (int, float)) and dt > 0 and math.isfinite(dt)):
         raise SolverError(f"time step must be a positive number of seconds, got {dt!r}")
-    limit = stable_step(omega_max)
+    limit = stable_step(limits)
     if dt > limit:
         raise SolverError(
-            f"time step {dt:.4g} s is unstable for the {model}: it cannot resolve the highest natural frequency "
-            f"{omega_max / (2 * math.pi):.6g} Hz (meshes at maximum stiffness); RK4 is stable only for "
-            f"dt < 2.83/omega_max = {RK4_LIMIT / omega_max:.4g} s; use dt <= "
-            f"{default_step(omega_max, mesh_frequencies):.4g} s (the default) or at most {limit:.4g} s")
+            f"time step {dt:.4g} s is unstable for the {model}: RK4 keeps its modes from growing only for "
+            f"dt < {limits.stable:.4g} s (highest natural frequency {limits.omega_max / (2 * math.pi):.6g} Hz with "
+            f"the meshes at maximum stiffness, and its damping); use dt <= "
+            f"{default_step(limits, mesh_frequencies):.4g} s (the default) or at most {limit:.4g} s")
 
 
 def per_step_drive(x: np.ndarray) -> np.ndarray:

@@ -1,0 +1,142 @@
+"""Output places: checked before any work, written whole or not at all, one writer at a time.
+
+:class:`OutputDirectory` wraps everything a command writes into one folder ``out``:
+
+* on entry it refuses a place that cannot be written (``out`` is a file, an ancestor is a file, the
+  nearest existing ancestor is not writable) and takes a lock on ``out`` (a file lock in the system's
+  temporary folder, so nothing is written near ``out`` yet): a second run into the same folder is
+  refused at once, naming the process that holds it;
+* ``.path`` is a temporary folder beside ``out``, made (with any missing parents) when first asked for;
+* on a clean exit the temporary folder replaces ``out``; on an error or an interruption it is removed,
+  with any parents it made, and ``out`` stays as it was: the previous complete output, or nothing.
+
+:func:`write_file` does the same for one file.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+from gearcheck.shared.errors import GearcheckError
+
+
+def check_place(out: Path, what: str, folder: bool = True) -> None:
+    """Refuse ``out`` (a folder, or a file when not ``folder``; ``what`` names the option) when it cannot
+    be written."""
+    out = Path(out)
+    if out.exists() and out.is_dir() != folder:
+        raise GearcheckError(f"{what} {out}: exists and is {'a folder' if out.is_dir() else 'not a folder'}")
+    ancestor = out.absolute().parent
+    while not ancestor.exists():
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise GearcheckError(f"{what} {out}: {ancestor} is a file, not a folder")
+    try:  # the only sure test of writing is to write: a file made and gone at once
+        with tempfile.TemporaryFile(dir=ancestor):
+            pass
+    except OSError as exc:
+        raise GearcheckError(f"{what} {out}: {ancestor} is not writable ({exc.strerror or exc})") from None
+
+
+def _make_parents(path: Path) -> list[Path]:
+    """mkdir -p, returning the folders it made (deepest last)."""
+    made = []
+    for parent in reversed(path.absolute().parents):
+        if not parent.exists():
+            parent.mkdir()
+            made.append(parent)
+    return made
+
+
+class OutputDirectory:
+    """Context manager: a folder written whole or not at all, one writer at a time (see the module doc)."""
+
+    def __init__(self, out, what: str = "--out"):
+        self.out = Path(out)
+        self.what = what
+        self._tmp: Path | None = None
+        self._made: list[Path] = []
+        self._lock = None
+
+    def __enter__(self) -> "OutputDirectory":
+        check_place(self.out, self.what)
+        key = hashlib.sha256(str(self.out.absolute()).encode()).hexdigest()[:24]
+        self._lock = open(Path(tempfile.gettempdir()) / f"gearcheck-{key}.lock", "a+")
+        try:
+            fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            self._lock.seek(0)
+            holder = self._lock.read().strip() or "another process"
+            self._lock.close()
+            raise GearcheckError(f"{self.what} {self.out}: another gearcheck run (pid {holder}) is writing it"
+                                 ) from None
+        self._lock.seek(0)
+        self._lock.truncate()
+        self._lock.write(str(os.getpid()))
+        self._lock.flush()
+        return self
+
+    @property
+    def path(self) -> Path:
+        """The temporary folder to write into (made when first asked for)."""
+        if self._tmp is None:
+            try:
+                self._made = _make_parents(self.out)
+                self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.", suffix=".partial",
+                                                  dir=self.out.parent))
+            except OSError as exc:
+                raise GearcheckError(f"{self.what} {self.out}: cannot be written ({exc.strerror or exc})") from None
+        return self._tmp
+
+    def __exit__(self, kind, error, trace) -> None:
+        try:
+            if kind is None and self._tmp is not None:
+                self._replace()
+            elif self._tmp is not None:
+                shutil.rmtree(self._tmp, ignore_errors=True)
+                for folder in reversed(self._made):
+                    try:
+                        folder.rmdir()
+                    except OSError:
+                        break
+        finally:
+            self._lock.close()
+
+    def _replace(self) -> None:
+        if not self.out.exists():
+            os.rename(self._tmp, self.out)
+            return
+        old = self._tmp.with_name(self._tmp.name[:-len(".partial")] + ".previous")
+        os.rename(self.out, old)
+        try:
+            os.rename(self._tmp, self.out)
+        except BaseException:
+            os.rename(old, self.out)  # interrupted between the two renames: the previous output back
+            shutil.rmtree(self._tmp, ignore_errors=True)
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def write_file(path, data: bytes | str, what: str = "-o") -> None:
+    """Write ``data`` to ``path`` whole or not at all: through a temporary file in the same folder."""
+    path = Path(path)
+    check_place(path, what, folder=False)
+    try:
+        made = _make_parents(path)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+    except OSError as exc:
+        raise GearcheckError(f"{what} {path}: cannot be written ({exc.strerror or exc})") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data.encode("utf-8") if isinstance(data, str) else data)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        for folder in reversed(made):
+            folder.rmdir()
+        raise

@@ -104,12 +104,12 @@ def test_measured_values_appear_as_a_third_column(tmp_path, capsys):
     measurements.write_text('[[measurements]]\nquantity = "stage1.ring.ay.world"\nmetric = "rms"\n'
                             'value = 100.0\nspeed_rpm = 1500.0\nsource = "made up for the test"\n')
     assert main(["crosscheck", "demo-3p", "--duration", DURATION, "--measurements", str(measurements),
-                 "--out", str(tmp_path)]) == 0
-    data = json.loads((tmp_path / "report.json").read_text())
+                 "--out", str(tmp_path / "out")]) == 0
+    data = json.loads((tmp_path / "out" / "report.json").read_text())
     (row,) = data["measurements"]
     assert row["measured"] == {"value": 100.0, "unit": "m/s^2"}
     assert row["error_lumped"]["value"] == pytest.approx(row["lumped"]["value"] / 100.0 - 1.0)
-    assert "Measured reference values" in (tmp_path / "report.md").read_text()
+    assert "Measured reference values" in (tmp_path / "out" / "report.md").read_text()
 
 
 def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):

@@ -18,10 +18,10 @@ from pathlib import Path
 import pytest
 
 from gearcheck.cli import main
-from gearcheck.shared.outputs import OutputDirectory
+from gearcheck.shared.outputs import MARKER, OutputDirectory
 
 REPORT = {"report.json", "report.md", "report.html", "time_histories.png", "spectra.png", "natural_frequencies.png",
-          "errors.png"}
+          "errors.png", MARKER}
 COMMAND = [sys.executable, "-m", "gearcheck", "crosscheck", "demo-3p", "--duration", "0.01", "--out"]
 
 
@@ -52,7 +52,7 @@ def interrupted_run(out: Path, signum: int, delay: float) -> int:
 def test_a_run_interrupted_while_writing_leaves_the_previous_output_or_the_new_one(signum, code, tmp_path):
     out = tmp_path / "out"
     assert subprocess.run(COMMAND + [str(out)], capture_output=True).returncode == 0
-    previous = {name: (out / name).read_bytes() for name in REPORT}
+    previous = {name: (out / name).read_bytes() for name in REPORT - {MARKER}}
     outcomes = []
     for delay in (0.0, 0.3):
         rc = interrupted_run(out, signum, delay)
@@ -103,3 +103,19 @@ def test_a_closed_pipe_ends_the_program_quietly(tmp_path):
     assert first == b"<!--\n"
     assert "Traceback" not in err and "BrokenPipe" not in err, err
     assert run.returncode == -signal.SIGPIPE
+
+
+def test_a_folder_that_is_no_earlier_output_is_never_replaced(tmp_path, capsys):
+    """An output folder is replaced whole by the next run into it, so a folder holding anything gearcheck
+    did not write (a project, the current directory) is refused; an empty one is used."""
+    project = tmp_path / "project"
+    project.mkdir()
+    (project / "notes.txt").write_text("mine")
+    assert main(["run", "demo-3p", "--duration", "0.001", "--out", str(project)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "holds files that gearcheck did not write (notes.txt, ...)" in err
+    assert [p.name for p in project.iterdir()] == ["notes.txt"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["run", "demo-3p", "--duration", "0.001", "--out", str(empty)]) == 0
+    assert (empty / MARKER).exists() and (empty / "timeseries.csv").exists()

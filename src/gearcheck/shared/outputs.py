@@ -3,9 +3,10 @@
 :class:`OutputDirectory` wraps everything a command writes into one folder ``out``:
 
 * on entry it refuses a place that cannot be written (``out`` is a file, an ancestor is a file, the
-  nearest existing ancestor is not writable) and takes a lock on ``out`` (a file lock in the system's
-  temporary folder, so nothing is written near ``out`` yet): a second run into the same folder is
-  refused at once, naming the process that holds it;
+  nearest existing ancestor is not writable) and a folder it must not replace (one that holds files
+  and is no earlier output: every output carries a ``MARKER`` file), and takes a lock on ``out`` (a file
+  lock in the system's temporary folder, so nothing is written near ``out`` yet): a second run into the
+  same folder is refused at once, naming the process that holds it;
 * ``.path`` is a temporary folder beside ``out``, made (with any missing parents) when first asked for;
 * on a clean exit the temporary folder replaces ``out``; on an error or an interruption it is removed,
   with any parents it made, and ``out`` stays as it was: the previous complete output, or nothing.
@@ -23,6 +24,9 @@ import tempfile
 from pathlib import Path
 
 from gearcheck.shared.errors import GearcheckError
+
+MARKER = ".gearcheck"
+"""The file that marks a folder as gearcheck's output, which the next run into it may replace whole."""
 
 
 def check_place(out: Path, what: str, folder: bool = True) -> None:
@@ -57,14 +61,21 @@ class OutputDirectory:
     """Context manager: a folder written whole or not at all, one writer at a time (see the module doc)."""
 
     def __init__(self, out, what: str = "--out"):
-        self.out = Path(out)
+        self.out = Path(os.path.normpath(Path(out).absolute()))
+        self.given = out
         self.what = what
         self._tmp: Path | None = None
         self._made: list[Path] = []
         self._lock = None
 
     def __enter__(self) -> "OutputDirectory":
+        if self.out == self.out.parent:
+            raise GearcheckError(f"{self.what} {self.given}: give a folder of its own, not the file system's root")
         check_place(self.out, self.what)
+        if self.out.is_dir() and any(self.out.iterdir()) and not (self.out / MARKER).exists():
+            found = ", ".join(sorted(p.name for p in self.out.iterdir())[:3])
+            raise GearcheckError(f"{self.what} {self.given}: holds files that gearcheck did not write ({found}, ...), "
+                                 "which a run would replace: give a new or empty folder, or an earlier output")
         key = hashlib.sha256(str(self.out.absolute()).encode()).hexdigest()[:24]
         self._lock = open(Path(tempfile.gettempdir()) / f"gearcheck-{key}.lock", "a+")
         try:
@@ -73,7 +84,7 @@ class OutputDirectory:
             self._lock.seek(0)
             holder = self._lock.read().strip() or "another process"
             self._lock.close()
-            raise GearcheckError(f"{self.what} {self.out}: another gearcheck run (pid {holder}) is writing it"
+            raise GearcheckError(f"{self.what} {self.given}: another gearcheck run (pid {holder}) is writing it"
                                  ) from None
         self._lock.seek(0)
         self._lock.truncate()
@@ -89,8 +100,10 @@ class OutputDirectory:
                 self._made = _make_parents(self.out)
                 self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.", suffix=".partial",
                                                   dir=self.out.parent))
+                (self._tmp / MARKER).write_text("gearcheck output: the next gearcheck run into this folder replaces "
+                                                "it whole\n", encoding="utf-8")
             except OSError as exc:
-                raise GearcheckError(f"{self.what} {self.out}: cannot be written ({exc.strerror or exc})") from None
+                raise GearcheckError(f"{self.what} {self.given}: cannot be written ({exc.strerror or exc})") from None
         return self._tmp
 
     def __exit__(self, kind, error, trace) -> None:

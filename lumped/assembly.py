@@ -17,15 +17,16 @@ k (constant, or k(t) for a mesh) and damping c, so
 with G the Coriolis terms of each member's translations and K_frame the stiffness-like
 terms of the rotating frame:
 
-* centripetal softening -m Omega^2 on every translation (Lin & Parker 1999, Eq. 4);
-* the geometric stiffness of the planets' centripetal preload, +m_p Omega^2 r_c^2 on the
-  carrier rotation.  Lin & Parker's model omits it: the bearing carries the preload
-  m_p Omega^2 r_c, and when the carrier turns by theta_c its pin moves by -r_c theta_c^2/2
-  radially (second order), which stores m_p Omega^2 r_c^2 theta_c^2/2.  Without it a rigid
-  rotation of the whole train is not free of the centripetal softening of the planets'
-  tangential motion, and a wound-up carrier feels a spurious torque
-  m_p Omega^2 r_c^2 theta_c per planet (found by the MuJoCo twin, which turns the pin
-  exactly);
+* the planets' centripetal potential -1/2 m Omega^2 |r|^2 written in the coordinates in which
+  the bearing and the mesh are linear: the carrier's translation c and rotation theta_c and the
+  planet's offset s from its pin in carrier axes, r = c + R(theta_c)(r_c e_r + s).  To second
+  order, and expressed back in absolute coordinates, it is Lin & Parker's (1999, Eq. 4)
+  softening -m Omega^2 of every translation plus m Omega^2 (r_c^2 theta_c^2 / 2 + r_c theta_c s_t),
+  s_t the bearing's tangential deflection.  Lin & Parker keep only the softening: then a rigid
+  turn of the mechanism (each planet moving r_c theta_c with its pin) is not force-free, its
+  stiffness is negative, and a train whose input is driven by a torque (no shaft holding it)
+  drifts away until the planets' softening carries the load instead of their bearings;
+  MuJoCo, whose planets are children of the carrier, has the exact potential;
 * circulatory terms of the supports' damping: a support damps the member's velocity
   relative to the housing, q' + Omega k x q in rotating coordinates, so -c Omega k x q
   appears beside -c q' (whirl damping), and a rotating member with torsional damping to the
@@ -212,8 +213,11 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
         K_frame[iu, iu] = K_frame[iv, iv] = -member.mass * omega**2
         if member.is_planet:
             F[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
-            ic = dofs(carrier, "theta")
-            K_frame[ic, ic] += member.mass * omega**2 * member.radius**2  # geometric stiffness of that load
+            # m Omega^2 (r_c^2 theta_c^2 / 2 + r_c theta_c s_t): the potential in carrier coordinates
+            e_c = _unit(n, (dofs(carrier, "theta"), 1.0))
+            s_t = _pin_rows(spec, dofs, mid)[1]
+            K_frame += member.mass * omega**2 * member.radius * (
+                member.radius * np.outer(e_c, e_c) + np.outer(e_c, s_t) + np.outer(s_t, e_c))
         else:
             c = member.support.radial_damping  # damping relative to the housing: -c (q' + Omega k x q)
             K_frame[iu, iv] -= c * omega
@@ -265,19 +269,25 @@ def _support_rows(spec, dofs) -> list[Row]:
     return rows
 
 
-def _bearing_rows(spec, dofs) -> list[Row]:
-    """Planet bearing: planet centre minus the carrier's pin point, radial and tangential."""
+def _pin_rows(spec, dofs, pid) -> tuple[np.ndarray, np.ndarray]:
+    """Planet centre minus its carrier's pin point, along the planet's radial and tangential axes."""
     n = len(dofs)
+    p = spec.members[pid]
+    c = f"{p.stage}.carrier"
+    cs, sn = math.cos(p.angle), math.sin(p.angle)
+    radial = _unit(n, (dofs(pid, "radial"), 1.0), (dofs(c, "x"), -cs), (dofs(c, "y"), -sn))
+    tangential = _unit(n, (dofs(pid, "tangential"), 1.0), (dofs(c, "x"), sn), (dofs(c, "y"), -cs),
+                       (dofs(c, "theta"), -p.radius))
+    return radial, tangential
+
+
+def _bearing_rows(spec, dofs) -> list[Row]:
+    """Planet bearing: an isotropic spring-damper between the planet centre and its pin."""
     rows = []
     for stage in spec.stages:
-        c = stage.carrier
         for pid in stage.planets:
-            p = spec.members[pid]
-            cs, sn = math.cos(p.angle), math.sin(p.angle)
-            radial = _unit(n, (dofs(pid, "radial"), 1.0), (dofs(c, "x"), -cs), (dofs(c, "y"), -sn))
-            tangential = _unit(n, (dofs(pid, "tangential"), 1.0), (dofs(c, "x"), sn), (dofs(c, "y"), -cs),
-                               (dofs(c, "theta"), -p.radius))
-            b = p.bearing
+            radial, tangential = _pin_rows(spec, dofs, pid)
+            b = spec.members[pid].bearing
             rows.append(Row(f"{pid}.bearing_radial", "bearing", radial, b.radial_stiffness, b.radial_damping))
             rows.append(Row(f"{pid}.bearing_tangential", "bearing", tangential, b.radial_stiffness,
                             b.radial_damping))

@@ -309,5 +309,6 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     bearing_force = (q @ a.T) * [r.stiffness for r in bearings] + (v @ a.T) * [r.damping for r in bearings]
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
-    return train_result(spec, "lumped", t, acc, angle, delta, force, k, static.mesh_force, bearing_force, settle,
-                        info, raw)
+    static_bearing = [static.row_forces[static.row_names.index(r.name)] for r in bearings]
+    return train_result(spec, "lumped", t, acc, angle, delta, force, k, static.mesh_force, static_bearing,
+                        bearing_force, settle, info, raw)

@@ -50,8 +50,14 @@ def chained_text(n_stages: int, radial_stiffness: float = 0.0) -> str:
     return "\n".join(parts)
 
 
-def wide_stage(n_planets: int) -> TrainSpec:
-    """demo-3p's stage with z = 30/24/78: z_s + z_r = 108 admits 3, 4 and 6 equally spaced planets."""
-    return edited("demo-3p", [(r"^planets = 3", f"planets = {n_planets}"), (r"^teeth = 22", "teeth = 30"),
-                              (r"^teeth = 20", "teeth = 24"), (r"^teeth = 62", "teeth = 78")],
-                  f"wide-stage-{n_planets}")
+def wide_stage(n_planets: int, teeth: tuple[int, int, int] = (30, 24, 78), torque_driven: bool = False) -> TrainSpec:
+    """demo-3p's stage with ``n_planets`` and the tooth counts (sun, planet, ring): the default
+    z = 30/24/78 (z_s + z_r = 108) admits 3, 4 and 6 equally spaced planets, 21/24/69 admits 5.
+    ``torque_driven``: without the input shaft, the sun driven by the torque that balances the load."""
+    z_s, z_p, z_r = teeth
+    pairs = [(r"^planets = 3", f"planets = {n_planets}"), (r"^teeth = 22", f"teeth = {z_s}"),
+             (r"^teeth = 20", f"teeth = {z_p}"), (r"^teeth = 62 .*$", f"teeth = {z_r}")]
+    if torque_driven:
+        pairs.append((r"^input_shaft_.*\n", ""))
+    return edited("demo-3p", pairs, f"{n_planets} planets, z = {z_s}/{z_p}/{z_r}"
+                  + (", torque-driven" if torque_driven else ""))

@@ -132,6 +132,7 @@ class StaticState:
     qvel: np.ndarray
     mesh_deflection: np.ndarray
     mesh_force: np.ndarray
+    bearing_force: np.ndarray  # in gearcheck.shared.results.bearing_names order
     iterations: int
     residual: float
 
@@ -225,9 +226,9 @@ def static_state(mb: MbdModel, load_scale: float = 1.0, tol: float = 1e-13, max_
         reader = ForceReader(mb, d)
         sample = np.empty((1, reader.width))
         reader.sample(sample[0])
-        force = reader.forces(sample)[0][0]
+        force, bearing = (f[0] for f in reader.forces(sample))
         qpos, qvel, _ = _nominal(mb, q)
-        return StaticState(qpos, qvel, d.ten_length[t].copy(), force, iterations, res)
+        return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res)
     finally:
         m.tendon_stiffness[:] = saved_k
         m.tendon_lengthspring[:] = saved_l
@@ -483,5 +484,6 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     if stepper.energy is not None:  # MuJoCo's d.energy is (potential, kinetic)
         raw["energy_potential"] = stepper.energy[:stepper.j, 0]
         raw["energy_kinetic"] = stepper.energy[:stepper.j, 1]
-    return train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force, bearing_force, settle,
+    return train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force, static.bearing_force,
+                        bearing_force, settle,
                         info, raw)

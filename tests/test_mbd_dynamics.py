@@ -43,18 +43,18 @@ def nrms(a, b):
 def test_static_state_matches_lumped_statics():
     """MuJoCo's own steady rotating equilibrium: the load shared equally and the lumped static force.
 
-    At 1500 rpm they differ by 6.3e-6 relative: the carrier winds up by theta_c = -4.1 mrad
-    under load and MuJoCo turns the whole mesh geometry by that finite angle, which the linear
-    model cannot (second order: theta_c^2/2 = 8e-6).  Before the lumped model had the geometric
-    stiffness of the planets' centripetal preload the difference was 3.4e-5 (this test found
-    it).  At 0.001 rad/s input speed they agree to 1e-10.
+    They agree to 1e-12 at 1500 rpm.  With Lin & Parker's (1999) centripetal softening alone they
+    differed by 3.4e-5, and with a geometric stiffness of the pins' preload added (the lumped model
+    of an earlier version) still by 6.3e-6, which was blamed on the carrier's finite wind-up: it was
+    the centripetal potential's carrier-rotation x bearing-deflection term (the lumped assembly's
+    docstring), which MuJoCo, moving the planets with their carrier, has exactly.
     """
     spec = load_train("demo-3p")
     mb = compile_train(spec)
     st = static_state(mb)
     ref = static_solution(build_model(spec)).mesh_force
     assert np.all(st.mesh_deflection > 0)  # compressed under the nominal load
-    np.testing.assert_allclose(st.mesh_force, ref, rtol=1e-5)
+    np.testing.assert_allclose(st.mesh_force, ref, rtol=1e-10)
     slow = spec.with_operating(input_speed=1e-3)
     np.testing.assert_allclose(static_state(compile_train(slow)).mesh_force,
                                static_solution(build_model(slow)).mesh_force, rtol=1e-10)

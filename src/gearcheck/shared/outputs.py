@@ -10,16 +10,20 @@
 * ``.path`` is a temporary folder beside ``out``, made (with any missing parents) when first asked for;
 * on a clean exit the temporary folder replaces ``out``; on an error or an interruption it is removed,
   with any parents it made, and ``out`` stays as it was: the previous complete output, or nothing.
+  Ctrl-C and SIGTERM wait while the folders are swapped or removed (a few milliseconds), so neither
+  can leave a half-removed folder behind; they take effect right after.
 
 :func:`write_file` does the same for one file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import hashlib
 import os
 import shutil
+import signal
 import tempfile
 from pathlib import Path
 
@@ -107,6 +111,10 @@ class OutputDirectory:
         return self._tmp
 
     def __exit__(self, kind, error, trace) -> None:
+        with _signals_deferred():
+            self._finish(kind)
+
+    def _finish(self, kind) -> None:
         try:
             if kind is None and self._tmp is not None:
                 self._replace()
@@ -129,10 +137,25 @@ class OutputDirectory:
         try:
             os.rename(self._tmp, self.out)
         except BaseException:
-            os.rename(old, self.out)  # interrupted between the two renames: the previous output back
+            os.rename(old, self.out)  # the new one could not be put in place: the previous one back
             shutil.rmtree(self._tmp, ignore_errors=True)
             raise
         shutil.rmtree(old, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _signals_deferred():
+    """Hold SIGINT and SIGTERM back (delivered on leaving) where the process can block signals."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    try:
+        before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    except (AttributeError, ValueError):  # no POSIX signal masks here, or not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def write_file(path, data: bytes | str, what: str = "-o") -> None:

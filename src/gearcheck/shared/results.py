@@ -142,13 +142,14 @@ def train_signals(spec) -> list[Signal]:
 
 
 def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflection, mesh_force, mesh_stiffness,
-                 static_mesh_force, bearing_force, settle_time, info, raw) -> TimeResult:
+                 static_mesh_force, static_bearing_force, bearing_force, settle_time, info, raw) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
     acc_carrier: (n_t, n_members, 3) inertial acceleration of each member's centre along its carrier's
     axes, and its angular acceleration; carrier_angle: (n_t, n_members) angle of those axes
     (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force
-    (n_t, n_bearing) in :func:`bearing_names` order."""
+    (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and bearings are the
+    run's ``static`` values."""
     columns = []
     for j in range(len(spec.members)):
         a = acc_carrier[:, j, :]
@@ -159,5 +160,6 @@ def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflecti
                     mesh_stiffness[:, j]]
     columns += [bearing_force[:, j] for j in range(bearing_force.shape[1])]
     static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
+    static.update({f"{name}.force": float(f) for name, f in zip(bearing_names(spec), static_bearing_force)})
     return TimeResult(spec.name, solver, np.asarray(t), train_signals(spec), np.column_stack(columns), settle_time,
                       info, raw, static)

@@ -10,6 +10,10 @@
   mean and standard deviation differ from the previous cycle's by less than
   ``threshold`` of the standard deviation (the fluctuation, not the mean load, sets the
   scale).
+* :func:`steady_state` — the steady window of a train: every stage's mesh forces steady over
+  that stage's own mesh cycle (detected), or else the start's free vibration decayed to
+  ``STEADY_THRESHOLD`` by the model's own damping (decayed: stages whose mesh frequencies are
+  incommensurate make each other's forces quasi-periodic, which no cycle test settles).
 * :func:`sensor_filter` — an optional model of the accelerometer chain: a zero-phase
   4th-order Butterworth band-pass between the sensor's lower and upper band limits, applied
   alike to both solvers' accelerations (published test amplitudes are filtered measurements).
@@ -76,6 +80,24 @@ def steady_start(t: np.ndarray, x: np.ndarray, cycle: float, threshold: float = 
         if run >= cycles:
             return float(edges[k - cycles])
     return None
+
+
+STEADY_WINDOW_CYCLES = 4  # slowest mesh cycles a steady window must hold after a start found by decay
+
+
+def steady_state(t: np.ndarray, groups, settle: float | None) -> tuple[float | None, str | None]:
+    """(start, how) of the steady state of a run sampled at ``t``: ``groups`` is a list of (forces
+    (time x meshes), cycle) per stage; ``settle`` the time the model's free vibration takes to decay to
+    ``STEADY_THRESHOLD`` (None: unknown).  ``how`` is "detected" (every stage passes
+    :func:`steady_start` over its own cycle), "decayed" (the run holds ``settle`` plus
+    ``STEADY_WINDOW_CYCLES`` of the slowest cycle) or None (no steady state in this run)."""
+    starts = [steady_start(t, x, cycle) for x, cycle in groups]
+    if all(s is not None for s in starts):
+        return max(starts), "detected"
+    slowest = max(cycle for _, cycle in groups)
+    if settle is not None and settle + STEADY_WINDOW_CYCLES * slowest <= t[-1] + 1e-12:
+        return settle, "decayed"
+    return None, None
 
 
 def sensor_filter(x: np.ndarray, fs: float, band: tuple[float, float]) -> np.ndarray:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gearcheck.compare.align import STEADY_THRESHOLD
 from gearcheck.compare.baseline import BASELINE_DIR, check_settings, compare_to_baseline, read_baseline, write_baseline
 from gearcheck.compare.engine import CrosscheckResult, compare
 from gearcheck.compare.measure import MIN_CYCLES
@@ -20,6 +21,7 @@ from gearcheck.compare.measurements import attach, check_quantities, load_measur
 from gearcheck.compare.plan import TrainPlan, TransientPlan
 from gearcheck.compare.tolerances import Tolerances
 from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.modal import settling_time
 from gearcheck.lumped.published import FINDING
 from gearcheck.lumped.published_parameters import LABELS
 from gearcheck.lumped.published_parameters import MODELS as PUBLISHED_MODELS
@@ -75,7 +77,7 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     Returns
     -------
     CrosscheckResult
-        ``.verdict`` ("PASS" or "FAIL"), ``.failures``, ``.quantities`` (``result[name]``),
+        ``.verdict`` ("PASS", "FAIL" or "INCONCLUSIVE"), ``.failures``, ``.unresolved``, ``.quantities`` (``result[name]``),
         ``.measurements``, ``.moved`` (metrics moved from the baseline), ``.write(directory)``.
     """
     if model not in MODELS:
@@ -93,7 +95,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         check_settings(stored, duration, rad_s_to_rpm(spec.operating.input_speed))
     if model == "general":
         reference, test = LumpedSide(spec), MujocoSide(spec)
-        plan = TrainPlan.of(spec, reference.model.kin, step_limits(reference.model).omega_max, duration)
+        plan = TrainPlan.of(spec, reference.model.kin, step_limits(reference.model).omega_max, duration,
+                            settling_time(reference.model, STEADY_THRESHOLD))
         settings = (RunSettings(duration, dt_lumped), RunSettings(duration, dt_mujoco))
         notes = []
     else:
@@ -119,7 +122,7 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         raise GearcheckError(f"duration {duration:g} s is shorter than a cycle of {plan.cycle:.4g} s (the slowest mesh "
                              f"of {spec.name}, or its lowest mode), the least a comparison needs")
     result = compare(spec, reference, test, plan, settings, tol, sensor_band, progress)
-    result.notes = notes
+    result.notes = notes + result.notes
     attach(result, entries)
     if path is not None and update_baseline:
         write_baseline(result, path)

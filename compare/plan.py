@@ -7,8 +7,9 @@ negligibility scale of each kind; below which floor a solver cannot resolve a ki
 operating-point settings the report states.
 
 * :class:`TrainPlan` -- a gear train in steady operation: resampled onto the lower of the two
-  output rates, steady window from the mesh-cycle detector on the mesh forces, lags within half a
-  mesh period, mesh harmonics and carrier sidebands, translational scale also from r alpha of every
+  output rates, steady window from each stage's mesh forces over its own mesh cycle or from the
+  decay of the reference model's free vibration (:func:`gearcheck.compare.align.steady_state`),
+  lags within half a mesh period, mesh harmonics and carrier sidebands, translational scale also from r alpha of every
   central member, and MuJoCo's round-off floor of absolute angles (:func:`round_off_floor`);
 * :class:`TransientPlan` -- a start-stop transient on one shared step grid (the 4-DOF models of
   Matejic et al. 2021 and their twin): the whole record, lags within one step, lines at the natural
@@ -19,9 +20,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 import numpy as np
 
+from gearcheck.compare.align import STEADY_WINDOW_CYCLES
 from gearcheck.compare.metrics import spectral_lines
 from gearcheck.shared.units import rad_s_to_rpm
 
@@ -32,18 +35,40 @@ class TrainPlan:
     mesh_frequency: dict[str, float]  # mesh id -> Hz
     stage_frequencies: dict[str, tuple[float, float]]  # stage -> (slowest mesh frequency, carrier frequency) Hz
     floors: dict[str, float]  # kind -> the smallest amplitude a solver resolves
+    settle: float | None = None  # s: the reference's free vibration decays to the steady threshold
     resample: bool = True
     detect_steady: bool = True
 
     @classmethod
-    def of(cls, spec, kin, omega_max: float, duration: float) -> "TrainPlan":
+    def of(cls, spec, kin, omega_max: float, duration: float, settle: float | None = None) -> "TrainPlan":
         """The plan of ``spec`` (kinematics ``kin``) for runs of ``duration`` s; ``omega_max`` the
-        reference model's highest natural angular frequency."""
+        reference model's highest natural angular frequency, ``settle`` its free vibration's decay time."""
         stages = {}
         for stage in spec.stages:
             f_mesh = min(kin.mesh_frequency[m.id] for m in spec.meshes if m.stage == stage.name)
             stages[stage.name] = (f_mesh, abs(kin.speeds[stage.carrier]) / (2 * math.pi))
-        return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, omega_max, duration))
+        return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, omega_max, duration), settle)
+
+    def steady_groups(self, names) -> list[tuple[list[str], float]]:
+        """The mesh-force signals among ``names`` with the cycle over which they repeat in steady state: all
+        of them over the train's common mesh period when its mesh frequencies are in small-integer ratios
+        (:func:`common_period`), else each stage's over its own slowest mesh cycle."""
+        forces = [n for n in names if n.endswith(".force") and n.rsplit(".", 1)[0] in self.mesh_frequency]
+        period = common_period(self.mesh_frequency.values())
+        if period is not None:
+            return [(forces, period)]
+        groups = []
+        for stage, (f_mesh, _) in self.stage_frequencies.items():
+            forces = [n for n in names if n.startswith(f"{stage}.") and n.endswith(".force")
+                      and n.rsplit(".", 1)[0] in self.mesh_frequency]
+            if forces:
+                groups.append((forces, 1.0 / f_mesh))
+        return groups
+
+    def needed_duration(self) -> float | None:
+        """The shortest run whose steady state the decay of the free vibration guarantees."""
+        return None if self.settle is None or math.isinf(self.settle) else \
+            self.settle + STEADY_WINDOW_CYCLES * self.cycle
 
     @property
     def cycle(self) -> float:
@@ -96,6 +121,24 @@ class TransientPlan:
 
     def scale_from(self, name: str) -> list[tuple[str, float]]:
         return []
+
+
+MAX_DENOMINATOR = 64  # mesh frequencies in ratios p/q with q up to this have a common period worth waiting for
+
+
+def common_period(frequencies) -> float | None:
+    """The shortest time in which every frequency (Hz) completes whole cycles, when their ratios to the
+    lowest are fractions with denominators up to ``MAX_DENOMINATOR`` (to 1e-9); None otherwise."""
+    f = sorted({float(x) for x in frequencies if x > 0})
+    if not f:
+        return None
+    denominator = 1
+    for x in f[1:]:
+        ratio = Fraction(x / f[0]).limit_denominator(MAX_DENOMINATOR)
+        if abs(float(ratio) * f[0] - x) > 1e-9 * x:
+            return None
+        denominator = math.lcm(denominator, ratio.denominator)
+    return denominator / f[0]
 
 
 def central_radius(spec, member: str) -> float:

@@ -22,6 +22,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from gearcheck.compare.align import STEADY_THRESHOLD
 from gearcheck.shared.citations import cite
 
 SCHEMA = "gearcheck.crosscheck"
@@ -70,6 +71,8 @@ def to_dict(result) -> dict:
                        "rel_peak": _u(m["rel_peak"], RATIO), "nrmse": _u(m["nrmse"], RATIO),
                        "nrmse_ac": _u(m["nrmse_ac"], RATIO), "correlation": _u(m["correlation"], RATIO),
                        "lag": _u(m["lag_s"], "s")},
+            "integration_error": {"lumped": _u(m["integration_error"]["reference"], RATIO),
+                                  "mujoco": _u(m["integration_error"]["test"], RATIO)},
             "spectrum": [{"line": s["line"], "frequency": _u(s["frequency_hz"], "Hz"),
                           "lumped": _u(s["reference"], q.unit), "mujoco": _u(s["test"], q.unit),
                           "rel_error": _u(s["rel_error"], RATIO)} for s in q.spectrum],
@@ -80,8 +83,10 @@ def to_dict(result) -> dict:
         "train": {"name": spec.name, "description": spec.description, "source": spec.source},
         "provenance": provenance(result),
         "settings": _settings_with_units(result.settings),
-        "verdict": {"passed": result.passed, "failures": result.failures, "moved_from_baseline": result.moved},
-        "steady_state": {"start": _u(result.steady_start_s, "s"), "detected": result.steady_found},
+        "verdict": {"verdict": result.verdict, "passed": result.passed, "failures": result.failures,
+                    "unresolved": result.unresolved, "moved_from_baseline": result.moved},
+        "steady_state": {"start": _u(result.steady_start_s, "s"), "detected": result.steady_found,
+                         "how": result.steady_how, "settling_time": _u(result.settle_s, "s")},
         "modes": [{"mode": r["mode"], "type": r["type"], "multiplicity": r["multiplicity"],
                    "lumped": _u(r["reference_hz"], "Hz"), "mujoco": _u(r["test_hz"], "Hz"),
                    "mujoco_type": r["test_type"], "rel_error": _u(r["rel_error"], RATIO),
@@ -97,10 +102,10 @@ def to_dict(result) -> dict:
 
 
 def _settings_with_units(settings: dict) -> dict:
-    units = {"duration_s": ("duration", "s"), "input_speed_rpm": ("input_speed", "rpm"),
+    units = {"duration_s": ("duration", "s"), "simulated_s": ("simulated", "s"), "input_speed_rpm": ("input_speed", "rpm"),
              "output_torque_nm": ("output_torque", "N·m"), "common_sample_rate_hz": ("common_sample_rate", "Hz"),
              "sensor_band_hz": ("sensor_band", "Hz"),
-             "steady_cycle_s": ("steady_cycle", "s")}
+             "steady_cycle_s": ("steady_cycle", "s"), "integration_check_steps_s": ("integration_check_steps", "s")}
     out = {}
     for key, value in settings.items():
         if key in units:
@@ -139,15 +144,17 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]]]]:
                     for m in data["modes"]]))
     rows = []
     for q in data["quantities"]:
-        e = q["errors"]
+        e, ie = q["errors"], q["integration_error"]
         rows.append([q["name"], q["unit"], _fmt(q["lumped"]["rms"]["value"]), _fmt(q["mujoco"]["rms"]["value"]),
                      _fmt(q["lumped"]["peak_to_peak"]["value"]), _fmt(q["mujoco"]["peak_to_peak"]["value"]),
                      _fmt(e["rel_rms"] and e["rel_rms"]["value"], 3), _fmt(e["nrmse"] and e["nrmse"]["value"], 3),
                      _fmt(e["correlation"] and e["correlation"]["value"], 6), _fmt(e["lag"]["value"] * 1e6, 3),
+                     _fmt(ie["lumped"] and ie["lumped"]["value"], 2), _fmt(ie["mujoco"] and ie["mujoco"]["value"], 2),
                      _fmt(q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"], 3), q["status"]])
     tables.append(("Time-domain quantities (steady window)",
                    ["quantity", "unit", "RMS lumped", "RMS MuJoCo", "p-p lumped", "p-p MuJoCo", "rel. RMS err.",
-                    "NRMSE", "correlation", "lag [µs]", "tol. NRMSE", "status"], rows))
+                    "NRMSE", "correlation", "lag [µs]", "integr. err. lumped", "integr. err. MuJoCo", "tol. NRMSE",
+                    "status"], rows))
     rows = []
     for q in data["quantities"]:
         if q["name"].endswith(".ay.world") or q["name"].endswith(".force"):
@@ -190,15 +197,21 @@ def _settings_line(settings: dict) -> str:
 def _summary_lines(data) -> list[str]:
     s = data["settings"]
     v = data["verdict"]
-    verdict = "PASS" if v["passed"] else "FAIL: " + ", ".join(v["failures"] + (v["moved_from_baseline"] or []))
+    verdict = {"PASS": "PASS", "FAIL": "FAIL: " + ", ".join(v["failures"] + (v["moved_from_baseline"] or [])),
+               "INCONCLUSIVE": "INCONCLUSIVE: " + ", ".join(v["unresolved"])}[v["verdict"]]
+    steady = data["steady_state"]
+    how = {"detected": "detected: the mesh forces repeat cycle after cycle",
+           "decayed": f"the free vibration of the start decayed to {STEADY_THRESHOLD:g}",
+           "transient": "the whole transient",
+           None: "NO steady state: second half shown, verdict inconclusive"}[steady["how"]]
+    steps = s["integration_check_steps"]["value"]
     p = data["provenance"]
     return [
         f"Verdict: **{verdict}**",
         "",
         f"- Train: {data['train']['name']} — {data['train']['description']} ({data['train']['source']})",
         f"- Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
-        f" simulated {s['duration']['value']:.6g} s; steady window from {data['steady_state']['start']['value']:.6g} s"
-        f" ({'detected' if data['steady_state']['detected'] else 'NOT detected: second half used'})",
+        f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})",
         f"- Lumped solver: {_settings_line(s['lumped'])}",
         f"- MuJoCo solver: {_settings_line(s['mujoco'])}",
         f"- gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "
@@ -206,6 +219,9 @@ def _summary_lines(data) -> list[str]:
         f"sha256 {p['train_sha256'][:16]}…",
         "- Metrics: NRMSE = rms(b − a)/rms(a) after removing the lag; lumped = a (reference), MuJoCo = b; "
         "'negligible' = below 1e-6 of the largest quantity of its kind in both solvers (not gated).",
+        "- Integration error: a bound per solver, rms(x_h − x_2h)/rms(a) against the same run at twice the step "
+        f"(check steps {', '.join(f'{x:.4g} s' for x in steps)}; an order-p integrator's error is at most that, RK4's "
+        "a fifteenth of it); 'unresolved' = the two bounds together reach the tolerance.",
     ]
 
 
@@ -231,7 +247,7 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
              "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
              "table{border-collapse:collapse;font-size:0.85em;margin-bottom:1.5em}"
              "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}th{background:#eee}"
-             "td:first-child{text-align:left}.fail{background:#fdd}.pass{background:#dfd}"
+             "td:first-child{text-align:left}.fail{background:#fdd}.pass{background:#dfd}.unresolved{background:#ffd}"
              "img{max-width:100%}</style></head><body>",
              f"<h1>gearcheck cross-check: {esc(data['train']['name'])}</h1>"]
     summary = _summary_lines(data)
@@ -243,7 +259,7 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
     for title, header, rows in markdown_tables(data):
         parts.append(f"<h2>{esc(title)}</h2><table><tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>")
         for r in rows:
-            cls = f" class=\"{r[-1]}\"" if r[-1] in ("pass", "fail") else ""
+            cls = f" class=\"{r[-1]}\"" if r[-1] in ("pass", "fail", "unresolved") else ""
             parts.append(f"<tr{cls}>" + "".join(f"<td>{esc(c)}</td>" for c in r) + "</tr>")
         parts.append("</table>")
     parts.append("<h2>Figures</h2>")

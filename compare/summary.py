@@ -19,7 +19,7 @@ def summary_row(data: dict) -> dict:
 
     moved = data["verdict"]["moved_from_baseline"] or []
     return {
-        "train": data["train"]["name"], "status": "PASS" if data["verdict"]["passed"] else "FAIL",
+        "train": data["train"]["name"], "status": data["verdict"]["verdict"],
         "modes": len(modes), "max_mode_rel_error": max(m["rel_error"]["value"] for m in modes),
         "quantities": len(data["quantities"]), "failed": len(data["verdict"]["failures"]), "moved": len(moved),
         "worst_nrmse_mesh_force": worst("mesh_force"),
@@ -54,7 +54,7 @@ def write_summary(out: Path, rows: list[dict]) -> None:
     esc = html.escape
     body = ["<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>gearcheck summary</title>",
             "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid "
-            "#ccc;padding:3px 8px}.FAIL{background:#fdd}.PASS{background:#dfd}</style></head><body>",
+            "#ccc;padding:3px 8px}.FAIL{background:#fdd}.PASS{background:#dfd}.INCONCLUSIVE{background:#ffd}</style></head><body>",
             "<h1>gearcheck cross-check of every preset</h1><table><tr>"
             + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>"]
     for r in rows:

@@ -64,6 +64,17 @@ class Excitation:
             k[..., j] = model(xi[..., j])
         return k
 
+    def switch_times(self, t0: float, t1: float) -> np.ndarray:
+        """Sorted times in (t0, t1) at which some mesh's stiffness jumps (its model's ``breaks``)."""
+        times = []
+        for f, phase, model in zip(self.frequency, self.phase, self.models):
+            for b in model.breaks:
+                if f > 0:  # xi = f t - phase = n + b
+                    n = np.arange(math.floor(f * t0 - phase - b), math.ceil(f * t1 - phase - b) + 1)
+                    times.append((n + b + phase) / f)
+        t = np.concatenate(times) if times else np.empty(0)
+        return np.unique(t[(t > t0) & (t < t1)])
+
     @property
     def has_transmission_error(self) -> bool:
         return bool(self._ste or self._eccentric)

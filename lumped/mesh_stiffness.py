@@ -44,6 +44,12 @@ class MeshStiffness:
         """eps - floor(eps): the part of a cycle, from xi = 0, with one pair more in contact."""
         return self.contact_ratio - self.pairs_low
 
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Mesh positions in [0, 1) where k jumps: a pair enters contact (0) and one leaves (eps - floor(eps));
+        none when the contact ratio is whole.  The solvers end their steps there."""
+        return (0.0, self.multi_fraction) if self.multi_fraction > 0 else ()
+
     def pairs(self, xi):
         """Tooth pairs in contact at mesh position ``xi``, from the contact ratio."""
         frac = np.mod(np.asarray(xi, dtype=float), 1.0)
@@ -63,6 +69,7 @@ class ConstantStiffness(MeshStiffness):
     """k(xi) = k_mean."""
 
     name = "constant"
+    breaks = ()
 
     def __call__(self, xi):
         return np.full_like(np.asarray(xi, dtype=float), self.mean)

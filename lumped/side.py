@@ -15,10 +15,11 @@ from gearcheck.lumped.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.published import FourDofModel, four_dof_model, natural_frequencies
 from gearcheck.lumped.published import simulate as simulate_4dof
-from gearcheck.lumped.time_solver import simulate
+from gearcheck.lumped.time_solver import simulate, stable_step
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.stepping import undamped_stable_step
 
 
 class LumpedSide:
@@ -46,6 +47,9 @@ class LumpedSide:
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate(self.model, settings, method=self.method, progress=progress)
 
+    def stable_step(self) -> float:
+        return stable_step(self.model)
+
 
 class PublishedSide:
     """A 4-DOF model of Matejic et al. (2021) (``name`` one of
@@ -69,3 +73,6 @@ class PublishedSide:
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate_4dof(self.model, settings, self.load)
+
+    def stable_step(self) -> float:
+        return undamped_stable_step(self.modes().frequencies)

@@ -13,10 +13,10 @@ highest natural frequency of this model with every mesh at its cycle-maximum sti
 The drive is sampled at t + h (eps, 1/2, 1 - eps) (:data:`~gearcheck.shared.stepping.STAGE_OFFSETS`).
 By default (``drive="steps"``) RK4's first stage sees x(t + eps) and the other three
 (4 x(t + h/2) + x(t + h - eps))/5, exactly as the MuJoCo runner drives its model
-(:func:`~gearcheck.shared.stepping.per_step_drive`): exact for drives linear over a step, and a
-stiffness switch inside a step is treated alike by both solvers, so what the cross-check
-measures is the models, not two treatments of a discontinuity.  ``drive="stages"`` is the
-textbook RK4 with the drive at each stage's own time.
+(:func:`~gearcheck.shared.stepping.per_step_drive`): exact for drives linear over a step.  A step
+inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as
+the MuJoCo runner does), so the stiffness is constant over every sub-step and RK4 keeps its order.
+``drive="stages"`` is the textbook RK4 with the drive at each stage's own time.
 """
 
 from __future__ import annotations
@@ -224,9 +224,12 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
         if linear is not None:
             load = sys.load(k, e, de, tin, tout)
             smooth = np.all(k[:, 0, :] == k[:, 1, :], axis=1) & np.all(k[:, 1, :] == k[:, 2, :], axis=1)
+        split = stepping.split_steps(h, start, stop, sys.exc.switch_times(start * h, stop * h))
         for i in range(stop - start):
             mapped = None
-            if linear is not None and smooth[i]:
+            if start + i in split:
+                y = _split_step(sys, y, (start + i) * h, h, split[start + i], drive)
+            elif linear is not None and smooth[i]:
                 P, Q1, Q2, Q3, Q23 = linear.maps(k[i, 0])
                 if drive == "steps":
                     mapped = P @ y + Q1 @ load[i, 0] + Q23 @ load[i, 1]
@@ -237,7 +240,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
                     mapped = None
             if mapped is not None:
                 y = mapped
-            else:  # stage by stage: a contact change, or a stiffness switch inside the step
+            elif start + i not in split:  # stage by stage: a contact change
                 t0 = (start + i) * h
 
                 def stage(s, q, v, i=i, t0=t0):
@@ -253,6 +256,22 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
         if progress is not None:
             progress(stop / n_steps)
     return t_out[:j], q_out[:j], v_out[:j]
+
+
+def _split_step(sys, y, t0, h, inner, drive):
+    """One step ended at the stiffness jumps ``inner`` inside it: RK4 sub-steps, each with its own drive."""
+    n = y.size // 2
+    q, v = y[:n], y[n:]
+    for a, length in zip(*stepping.sub_steps(t0, h, inner)):
+        k, e, de, tin, tout = sys.drive(a + length * np.array(STAGE_OFFSETS)[None, :])
+        if drive == "steps":
+            k, e, de, tin, tout = (per_step_drive(x) for x in (k, e, de, tin, tout))
+
+        def stage(s, q, v, a=a, length=length, k=k[0], e=e[0], de=de[0], tin=tin[0], tout=tout[0]):
+            return sys.acceleration(q, v, k[s], e[s], de[s], tin[s], tout[s], a + 0.5 * s * length)
+
+        q, v = rk4_step(stage, q, v, length)
+    return np.concatenate([q, v])
 
 
 def rk4_step(acceleration, q, v, h):

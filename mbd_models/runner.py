@@ -24,7 +24,10 @@ step, so the runner calls ``mj_forward`` itself with the excitation at t_n (RK4'
 first stage, which also gives the outputs at t_n) and then ``mj_RungeKutta`` with the
 excitation at the weighted time of the remaining stages, (4 x(t+h/2) + x(t+h))/5:
 the stage weights of RK4 (2/6, 2/6, 1/6) then integrate a linear-in-time drive
-exactly over the step.
+exactly over the step.  A step inside which a mesh stiffness jumps (on the nominal clock) is
+split there into sub-steps, MuJoCo's timestep set to each one's length, as the lumped solver
+does (:func:`gearcheck.shared.stepping.split_steps`): the stiffness is constant over every
+sub-step and RK4 keeps its fourth order.
 
 Time step: from MuJoCo's own linearisation with every mesh at its cycle-maximum stiffness, damping
 included (``MbdModel.limits``); the rule of :mod:`gearcheck.shared.stepping`, the same as the lumped
@@ -277,11 +280,15 @@ class _Stepper:
             self.energy[j] = self.d.energy
         self.j += 1
 
-    def run(self, start: int, stop: int, every: int, values) -> None:
-        """Steps start..stop-1, sampling the steps that begin on a multiple of ``every``."""
+    def run(self, start: int, stop: int, every: int, values, split) -> None:
+        """Steps start..stop-1, sampling the steps that begin on a multiple of ``every``; the steps in
+        ``split`` (:func:`gearcheck.shared.stepping.split_steps`) end sub-steps at their stiffness jumps."""
         (k1, k2), (u1, u2), (e1, e2), (de1, de2) = values
         m, d = self.m, self.d
         for i in range(stop - start):
+            if start + i in split:
+                self.split_step(start + i, split[start + i], (start + i) % every == 0)
+                continue
             self.mb.refresh(d.qpos)
             if self.clock is not None:
                 k_now, k_later = _body_stiffness(self.mb, self.clock, d.qpos, d.qvel, self.h)
@@ -293,6 +300,22 @@ class _Stepper:
                 self.sample()
             self.set_stage(k_later, u2[i], None if e2 is None else e2[i], None if de2 is None else de2[i])
             mujoco.mj_RungeKutta(m, d, 4)
+
+    def split_step(self, step: int, inner, sample: bool) -> None:
+        """Step ``step`` as RK4 sub-steps ended at the times ``inner``: MuJoCo's timestep set to each
+        sub-step's length, the drive sampled over it as over a whole step."""
+        m, d = self.m, self.d
+        for j, (a, length) in enumerate(zip(*stepping.sub_steps(step * self.h, self.h, inner))):
+            m.opt.timestep = length
+            (k1, k2), (u1, u2), (e1, e2), (de1, de2) = self.drive.steps(np.array([a]), length)
+            self.mb.refresh(d.qpos)
+            self.set_stage(k1[0], u1[0], None if e1 is None else e1[0], None if de1 is None else de1[0])
+            mujoco.mj_forward(m, d)
+            if sample and j == 0:
+                self.sample()
+            self.set_stage(k2[0], u2[0], None if e2 is None else e2[0], None if de2 is None else de2[0])
+            mujoco.mj_RungeKutta(m, d, 4)
+        m.opt.timestep = self.h
 
     def finish(self, t_end: float) -> None:
         """Sample the final state (the drive of the step that would start there)."""
@@ -319,7 +342,7 @@ class _LeanStepper(_Stepper):
         self.coef = np.zeros(len(tc.wraps))
         self.rate = np.zeros(len(tc.wraps))
 
-    def run(self, start, stop, every, values) -> None:
+    def run(self, start, stop, every, values, split) -> None:
         (k1, k2), (u1, u2), _, _ = values
         m, d, n = self.m, self.d, self.n_mesh
         tc, corr = self.mb.turning, self.correction
@@ -330,6 +353,9 @@ class _LeanStepper(_Stepper):
         dot, multiply, cos, sin = np.dot, np.multiply, math.cos, math.sin
         forward, rk = mujoco.mj_forward, mujoco.mj_RungeKutta
         for i in range(stop - start):
+            if start + i in split:
+                self.split_step(start + i, split[start + i], (start + i) % every == 0)
+                continue
             phi = qpos[phi_adr]
             cs[0] = cos(phi)
             cs[1] = sin(phi)
@@ -395,7 +421,9 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         for start in range(0, n_steps, CHUNK):
             stop = min(start + CHUNK, n_steps)
             j0 = stepper.j
-            stepper.run(start, stop, every, stepper.drive.steps(dt * np.arange(start, stop), dt))
+            split = ({} if stiffness_clock == "bodies"
+                     else stepping.split_steps(dt, start, stop, mb.excitation.switch_times(start * dt, stop * dt)))
+            stepper.run(start, stop, every, stepper.drive.steps(dt * np.arange(start, stop), dt), split)
             _check_divergence(stepper, j0, stop * dt, every * dt, scale, what)
             if progress is not None:
                 progress(stop / n_steps)

@@ -16,6 +16,7 @@ from gearcheck.mbd_models.runner import simulate_mujoco
 from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
+from gearcheck.shared import stepping
 from gearcheck.shared.settings import RunSettings
 
 
@@ -39,6 +40,9 @@ class MujocoSide:
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock)
+
+    def stable_step(self) -> float:
+        return stepping.stable_step(self.model.limits)
 
 
 class PublishedTwinSide:
@@ -65,3 +69,6 @@ class PublishedTwinSide:
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate_twin(self.model, settings, self.name, self.load)
+
+    def stable_step(self) -> float:
+        return stepping.undamped_stable_step(self.modes().frequencies)

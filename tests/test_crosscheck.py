@@ -80,10 +80,14 @@ def test_reports_identical_across_runs(tmp_path, capsys):
 def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
     """CI's regression dashboard: every preset cross-checked, nothing moved from the shipped baselines
     (package data: this also fails when the installed package lacks them)."""
-    assert main(["crosscheck", "--all", "--baseline", "--out", str(tmp_path)]) == 0  # the baselines' duration
+    # double-planet cannot settle in the baselines' 0.05 s: its 145 Hz mode (damping ratio 0.27 %) rings for
+    # 2.5 s, so its verdict is INCONCLUSIVE (exit 3) while its metrics are still tracked
+    assert main(["crosscheck", "--all", "--baseline", "--out", str(tmp_path)]) == 3  # the baselines' duration
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert {r["train"] for r in summary["presets"]} == set(preset_names())
-    assert all(r["status"] == "PASS" and r["moved"] == 0 for r in summary["presets"])
+    assert all(r["moved"] == 0 and r["failed"] == 0 for r in summary["presets"])
+    assert {r["train"]: r["status"] for r in summary["presets"]} == {
+        name: "INCONCLUSIVE" if name == "double-planet" else "PASS" for name in preset_names()}
     assert (tmp_path / "summary.html").read_text().count("report.html") == len(summary["presets"])
 
 
@@ -113,13 +117,17 @@ def test_measured_values_appear_as_a_third_column(tmp_path, capsys):
 
 
 def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
-    """Tightening the mesh-force tolerance below the measured error must fail the run, by name."""
+    """A mesh-force tolerance tighter than the integration error cannot be decided: those quantities are
+    unresolved, by name, and the verdict INCONCLUSIVE (exit 3), not PASS; the steps were refined first."""
     from gearcheck.lumped.variants import edited
 
     strict = edited("demo-3p", [(r"^\[\[stages\]\]", "[tolerances]\nmesh_force.nrmse = 1e-9\n\n[[stages]]")])
     assert strict.tolerances == {"mesh_force.nrmse": 1e-9}
     result = crosscheck(strict, duration=0.05)
-    assert "stage1.planet1.sun.force" in result.failures and "stage1.ring.ay.world" not in result.failures
+    assert result.verdict == "INCONCLUSIVE" and not result.failures
+    assert "stage1.planet1.sun.force (integration error)" in result.unresolved
+    assert result["stage1.ring.ay.world"].status == "pass"
+    assert any("halved (2x)" in note for note in result.notes)
     loose = tmp_path / "tol.toml"
     loose.write_text("[tolerances]\n\"stage1.planet1.sun.force.nrmse\" = 0.5\n")
     from gearcheck.compare.tolerances import Tolerances

@@ -1,7 +1,8 @@
 """The ``gearcheck`` command line: parses arguments, calls the front door, prints.
 
 Exit status: 0 done (a cross-check passed), 1 a cross-check failed (a tolerance exceeded or a
-baseline metric moved), 2 bad input (one line on stderr naming the file, field or option, and the
+baseline metric moved), 3 a cross-check inconclusive (no steady state reached, or an integration
+error bound as large as a tolerance), 2 bad input (one line on stderr naming the file, field or option, and the
 value; nothing written), 130 interrupted (SIGINT), 143 terminated (SIGTERM); a closed pipe ends the
 program quietly, as other command-line tools do.  Outputs are written whole or not at all
 (:class:`~gearcheck.shared.outputs.OutputDirectory`).
@@ -118,7 +119,8 @@ def _parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_run)
 
     s = sub.add_parser("crosscheck", help="run both solvers, compare them, write a report; exit 1 when a "
-                                          "tolerance is exceeded or a baseline metric moved")
+                                          "tolerance is exceeded or a baseline metric moved, 3 when the "
+                                          "comparison is inconclusive")
     s.add_argument("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file")
     s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
     s.add_argument("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)")
@@ -319,7 +321,16 @@ def cmd_crosscheck(args) -> int:
         print(line)
     if args.all:
         print(f"summary: {args.out / 'summary.md'}")
-    return 0 if all(r["status"] == "PASS" for r in rows) else 1
+    return exit_status([r["status"] for r in rows])
+
+
+EXIT_STATUS = {"PASS": 0, "FAIL": 1, "INCONCLUSIVE": 3}
+
+
+def exit_status(verdicts) -> int:
+    """1 when any cross-check failed, else 3 when any was inconclusive, else 0."""
+    codes = {EXIT_STATUS[v] for v in verdicts}
+    return 1 if 1 in codes else max(codes, default=0)
 
 
 def _verdict_line(result, out: Path) -> str:
@@ -328,6 +339,8 @@ def _verdict_line(result, out: Path) -> str:
         detail += f"; beyond tolerance: {', '.join(result.failures)}"
     if result.moved:
         detail += f"; moved from baseline: {'; '.join(result.moved)}"
+    if result.verdict == "INCONCLUSIVE":
+        detail += f"; cannot decide: {', '.join(result.unresolved)}"
     return f"{result.spec.name}: {result.verdict}{detail} (report: {out / 'report.md'})"
 
 

@@ -18,6 +18,7 @@ types do not depend on a solver's choice of coordinates.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,6 +62,25 @@ def generalized_modes(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndar
     w2, shapes = sla.eigh(K, M)
     w2[np.abs(w2) < RIGID_TOLERANCE * np.max(np.abs(w2))] = 0.0
     return np.sqrt(np.clip(w2, 0.0, None)) / (2.0 * np.pi), shapes
+
+
+def quadratic_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenpairs of (M s^2 + D s + K) x = 0 through the first-order form y = (x, s x): (s, x), x over the
+    coordinates.  D holds damping and gyroscopic terms, K every stiffness term (rotating frame included)."""
+    n = M.shape[0]
+    J = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, D)]])
+    s, y = np.linalg.eig(J)
+    return s, y[:n]
+
+
+def settling_time(M: np.ndarray, D: np.ndarray, K: np.ndarray, fraction: float) -> float:
+    """How long the slowest-decaying free vibration of M q'' + D q' + K q = 0 takes to fall to ``fraction``
+    of its start: ln(1/fraction) / min(-Re s) over the elastic eigenvalues s (rigid ones, |s| below
+    ``RIGID_TOLERANCE`` of the largest in the square, left out); infinite when one does not decay."""
+    s, _ = quadratic_eigenvalues(M, D, K)
+    s = s[np.abs(s) ** 2 > RIGID_TOLERANCE * np.max(np.abs(s)) ** 2]
+    rate = float(np.min(-s.real)) if s.size else math.inf
+    return math.log(1.0 / fraction) / rate if rate > 0 else math.inf
 
 
 def multiplicities(frequencies: np.ndarray) -> list[int]:

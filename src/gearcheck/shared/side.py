@@ -22,3 +22,6 @@ class Side(Protocol):
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         """A time run; ``progress`` is called with the fraction done."""
+
+    def stable_step(self) -> float:
+        """The largest fixed step its runs accept (s)."""

@@ -38,6 +38,33 @@ weights (2, 2, 1)/6 this integrates a drive linear in time over the step exactly
 switch inside a step is then seen as a weighted mean, the same in both solvers."""
 
 
+def split_steps(h: float, start: int, stop: int, switches) -> dict[int, np.ndarray]:
+    """The steps among start..stop-1 (step i spans [i h, (i + 1) h]) inside which the drive jumps, each with
+    the times of its jumps: both solvers end a sub-step there, so a rectangular mesh stiffness is constant
+    over every (sub-)step and RK4 keeps its fourth order (a jump inside a step, seen as the step's mean,
+    costs an error of the order of h).  A jump within ``STAGE_OFFSETS[0]`` h of a step boundary is left
+    to the stage sampling, which sees it on the same side in every mesh; jumps that close together are
+    one."""
+    switches = np.asarray(switches, dtype=float)
+    tol = STAGE_OFFSETS[0] * h
+    index = np.floor(switches / h).astype(int)
+    inside = ((switches - index * h) > tol) & (((index + 1) * h - switches) > tol) & (index >= start) & (index < stop)
+    out: dict[int, np.ndarray] = {}
+    for i, t in zip(index[inside], switches[inside]):
+        times = out.get(int(i))
+        if times is None:
+            out[int(i)] = np.array([t])
+        elif t - times[-1] > tol:
+            out[int(i)] = np.append(times, t)
+    return out
+
+
+def sub_steps(t0: float, h: float, inner) -> tuple[np.ndarray, np.ndarray]:
+    """(starts, lengths) of the sub-steps of the step [t0, t0 + h] ended at the sorted times ``inner``."""
+    bounds = np.concatenate([[t0], inner, [t0 + h]])
+    return bounds[:-1], np.diff(bounds)
+
+
 def commensurate_step(h_max: float, mesh_frequencies, points_per_cycle: int) -> float:
     """The largest step <= h_max that divides the slowest mesh period into whole steps, with at
     least ``points_per_cycle`` steps per period of the fastest mesh.  A rectangular stiffness
@@ -101,6 +128,11 @@ def rk4_stable_step(eigenvalues) -> float:
 
 def stable_step(limits: StepLimits) -> float:
     return STABILITY_MARGIN * limits.stable
+
+
+def undamped_stable_step(frequencies) -> float:
+    """The stable step of an undamped model with natural frequencies ``frequencies`` (Hz)."""
+    return STABILITY_MARGIN * RK4_LIMIT / (2.0 * math.pi * float(np.max(frequencies)))
 
 
 def default_step(limits: StepLimits, mesh_frequencies) -> float:

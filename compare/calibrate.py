@@ -27,10 +27,12 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
+from gearcheck.compare.align import STEADY_THRESHOLD
 from gearcheck.compare.measure import MIN_CYCLES, measure
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.kinematics import kinematics
 from gearcheck.lumped.loader import load_text, load_train
+from gearcheck.lumped.modal import settling_time
 from gearcheck.lumped.spec import beside
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.errors import GearcheckError
@@ -174,7 +176,8 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
             result = simulate(lumped, RunSettings(duration))
             cycle = 1.0 / float(np.min(lumped.excitation.frequency))
             idx = [i for i in which if rpm[i] == speed]
-            for i, value in zip(idx, measure(result, [entries[i] for i in idx], cycle)):
+            settle = settling_time(lumped, STEADY_THRESHOLD)
+            for i, value in zip(idx, measure(result, [entries[i] for i in idx], cycle, settle)):
                 out[i] = value
             evaluations += 1
             if progress is not None:

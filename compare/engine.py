@@ -34,8 +34,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from gearcheck.compare.align import (STEADY_THRESHOLD, STEADY_WINDOW_CYCLES, resample, sensor_filter, steady_state,
-                                     uniform_grid)
+from gearcheck.compare.align import (
+    STEADY_THRESHOLD,
+    STEADY_WINDOW_CYCLES,
+    resample,
+    sensor_filter,
+    steady_state,
+    uniform_grid,
+)
 from gearcheck.compare.metrics import modal_metrics, spectral_metrics, waveform_metrics
 from gearcheck.compare.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearcheck.compare.align import resample, sensor_filter, steady_start, uniform_grid
+from gearcheck.compare.align import STEADY_WINDOW_CYCLES, resample, sensor_filter, steady_state, uniform_grid
 from gearcheck.shared.errors import GearcheckError
 
 MIN_CYCLES = 1  # a run holds at least one cycle of its slowest mesh (or lowest mode) to be compared or measured
@@ -33,20 +33,25 @@ def chain_statistic(x: np.ndarray, window: np.ndarray, fs: float, metric: str, b
     return STATISTICS[metric](x[window])
 
 
-def steady_window(grid: np.ndarray, forces: np.ndarray, cycle: float) -> tuple[np.ndarray, bool]:
-    """The steady window of a run from its mesh forces (time x meshes): from the detected start,
-    or the second half when no steady state is found."""
-    start = steady_start(grid, forces, cycle)
-    found = start is not None
-    return grid >= (start if found else 0.5 * grid[-1]), found
+def steady_window(grid: np.ndarray, forces: np.ndarray, cycle: float, settle: float | None) -> np.ndarray:
+    """The steady window of a run from its mesh forces (time x meshes), by the cross-check's rule
+    (:func:`gearcheck.compare.align.steady_state`; ``settle`` the decay time of the model's free vibration);
+    a run that reaches no steady state is refused, naming the duration it needs."""
+    start, how = steady_state(grid, [(forces, cycle)], settle)
+    if how is None:
+        need = "" if settle is None else f"; its start's free vibration decays in {settle:.4g} s, so give at least " \
+            f"{settle + STEADY_WINDOW_CYCLES * cycle:.4g} s"
+        raise GearcheckError(f"a run of {grid[-1]:.4g} s reaches no steady state to measure{need} (--duration)")
+    return grid >= start
 
 
-def measure(result, entries, cycle: float) -> list[float]:
-    """Each measurement entry's statistic from one solver's ``result`` (the calibration's model side)."""
+def measure(result, entries, cycle: float, settle: float | None = None) -> list[float]:
+    """Each measurement entry's statistic from one solver's ``result`` (the calibration's model side), over
+    its steady window (``cycle`` the slowest mesh period, ``settle`` the free vibration's decay time)."""
     fs = (result.t.size - 1) / (result.t[-1] - result.t[0])
     grid = uniform_grid(0.0, result.t[-1], fs)
     forces = resample(result.t, result.select("mesh_force"), grid)
-    window, _ = steady_window(grid, forces, cycle)
+    window = steady_window(grid, forces, cycle, settle)
     values = []
     for entry in entries:
         if entry["quantity"] not in result:

@@ -164,3 +164,42 @@ def mesh_stiffness(spec, cycles: int = 2) -> bytes:
     png = io.BytesIO()
     _save(fig, png)
     return png.getvalue()
+
+
+def campbell_diagram(result) -> bytes:
+    """PNG of a :class:`~gearcheck.compare.campbell.CampbellResult`: lumped curves, MuJoCo markers, mesh
+    lines, their crossings with the curves, instability zones shaded."""
+    fig, ax = _figure(figsize=(9, 6))
+    speeds = result.speeds_rpm
+    for solver, style in (("lumped", {"color": "tab:blue", "lw": 1.0}),
+                          ("mujoco", {"color": "tab:orange", "ls": "none", "marker": ".", "ms": 3})):
+        if solver not in result.results:
+            continue
+        f = result.frequencies(solver)
+        for mode in range(f.shape[1]):
+            ax.plot(speeds, f[:, mode], **style, label=("lumped" if solver == "lumped" else "MuJoCo")
+                    if mode == 0 else None)
+    top = max(float(np.max(result.frequencies(s))) for s in result.results) * 1.05
+    for line in result.mesh_lines:
+        ax.plot(speeds, line["hz_per_rpm"] * speeds, color="gray", lw=0.7, ls=":" if line["harmonic"] > 1 else "-")
+        end = min(speeds[-1], top / line["hz_per_rpm"]) if line["hz_per_rpm"] > 0 else speeds[-1]
+        ax.annotate(f"{line['harmonic']}x {line['meshes'][0].rsplit('.', 2)[0]}", (end, line["hz_per_rpm"] * end),
+                    fontsize=6, color="gray", ha="right", va="bottom")
+    if result.crossings:
+        ax.plot([c["speed_rpm"] for c in result.crossings], [c["frequency_hz"] for c in result.crossings], "kx",
+                ms=4, label="mesh harmonic = natural frequency")
+    for zone in result.zones:
+        ax.axvspan(zone["from_rpm"], zone["to_rpm"], color="red", alpha=0.15,
+                   label=f"unstable ({zone['solver']})" if zone is result.zones[0] else None)
+    ax.set_xlim(speeds[0], speeds[-1])
+    ax.set_ylim(0, top)
+    ax.set_xlabel("input speed [rpm]")
+    ax.set_ylabel("natural frequency [Hz]")
+    agreement = result.agreement
+    ax.set_title(f"{result.train}: Campbell diagram (gyroscopic modes at mean mesh stiffness)"
+                 + (f"; solvers agree to {agreement:.1e}" if agreement is not None else ""), fontsize=9)
+    ax.legend(loc="upper left", fontsize=7)
+    ax.grid(alpha=0.3)
+    png = io.BytesIO()
+    _save(fig, png)
+    return png.getvalue()

@@ -97,7 +97,8 @@ class LumpedModel:
     dofs: DofMap
     M: np.ndarray
     G: np.ndarray  # gyroscopic matrix, already multiplied by each frame's Omega
-    K_frame: np.ndarray  # rotating-frame stiffness terms (centripetal, geometric, circulatory)
+    K_centripetal: np.ndarray  # the centripetal potential's stiffness (symmetric, ~ Omega^2)
+    K_circulatory: np.ndarray  # the supports' damping seen from the rotating frame (skew, ~ c Omega)
     rows: list[Row]  # constant rows (bearings, supports, couplings, shaft)
     mesh_rows: np.ndarray  # (n_mesh, n) line-of-action rows
     mesh_damping: np.ndarray  # (n_mesh,)
@@ -111,6 +112,21 @@ class LumpedModel:
     @property
     def n(self) -> int:
         return len(self.dofs)
+
+    @property
+    def K_frame(self) -> np.ndarray:
+        """Every stiffness-like term of the rotating frame."""
+        return self.K_centripetal + self.K_circulatory
+
+    def at_speed(self, input_speed: float) -> "LumpedModel":
+        """The rotating-frame terms at another input speed (rad/s; 0 allowed): Coriolis and circulatory
+        terms scale with the speed, centripetal ones with its square; nothing else depends on it.  For
+        modal analysis (the excitation and the static loads stay those of the train's own speed)."""
+        from dataclasses import replace
+
+        r = input_speed / self.spec.operating.input_speed
+        return replace(self, G=r * self.G, K_centripetal=r * r * self.K_centripetal,
+                       K_circulatory=r * self.K_circulatory)
 
     @property
     def K_b(self) -> np.ndarray:
@@ -136,7 +152,8 @@ class LumpedModel:
         from dataclasses import replace
 
         zero = np.zeros_like(self.M)
-        return replace(self, G=zero, K_frame=zero, F_static=np.zeros(self.n), rotating_frame_terms=False)
+        return replace(self, G=zero, K_centripetal=zero, K_circulatory=zero, F_static=np.zeros(self.n),
+                       rotating_frame_terms=False)
 
 
 @dataclass(frozen=True)
@@ -198,7 +215,8 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     n = len(dofs)
     M = np.zeros((n, n))
     G = np.zeros((n, n))
-    K_frame = np.zeros((n, n))
+    K_cent = np.zeros((n, n))
+    K_circ = np.zeros((n, n))
     F = np.zeros(n)
     for mid, member in spec.members.items():
         u, v = (PLANET_DOFS if member.is_planet else CENTRAL_DOFS)[:2]
@@ -210,18 +228,18 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
         # Coriolis 2 m Omega k x q' and centripetal -m Omega^2 q of the translations (rotating frame)
         G[iu, iv] -= 2.0 * member.mass * omega
         G[iv, iu] += 2.0 * member.mass * omega
-        K_frame[iu, iu] = K_frame[iv, iv] = -member.mass * omega**2
+        K_cent[iu, iu] = K_cent[iv, iv] = -member.mass * omega**2
         if member.is_planet:
             F[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
             # m Omega^2 (r_c^2 theta_c^2 / 2 + r_c theta_c s_t): the potential in carrier coordinates
             e_c = _unit(n, (dofs(carrier, "theta"), 1.0))
             s_t = _pin_rows(spec, dofs, mid)[1]
-            K_frame += member.mass * omega**2 * member.radius * (
+            K_cent += member.mass * omega**2 * member.radius * (
                 member.radius * np.outer(e_c, e_c) + np.outer(e_c, s_t) + np.outer(s_t, e_c))
         else:
             c = member.support.radial_damping  # damping relative to the housing: -c (q' + Omega k x q)
-            K_frame[iu, iv] -= c * omega
-            K_frame[iv, iu] += c * omega
+            K_circ[iu, iv] -= c * omega
+            K_circ[iv, iu] += c * omega
             F[ith] -= member.support.torsional_damping * kin.speeds[mid]  # drag of a turning member
 
     rows, turning = _coupling_rows(spec, dofs, kin)
@@ -240,7 +258,7 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     b_in[dofs(spec.input, "theta")] = 1.0
     b_out = np.zeros(n)
     b_out[dofs(spec.output, "theta")] = 1.0
-    model = LumpedModel(spec, kin, dofs, M, G, K_frame, rows, mesh_rows, damping, F, b_in, b_out, excitation,
+    model = LumpedModel(spec, kin, dofs, M, G, K_cent, K_circ, rows, mesh_rows, damping, F, b_in, b_out, excitation,
                         turning=turning)
     return model if rotating_frame_terms else model.without_rotating_frame_terms()
 

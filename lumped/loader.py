@@ -35,7 +35,9 @@ def load_text(text: str, source: str) -> TrainSpec:
     mechanism that turns at a speed gears survive (:func:`gearcheck.lumped.kinematics.kinematics`)."""
     data = schema.parse(parse_toml(text, source), source)
     spec = build_spec(data, source, hashlib.sha256(text.encode("utf-8")).hexdigest())
-    kinematics(spec)
+    kin = kinematics(spec)
+    if spec.operating.input_torque is not None:  # the load that balances it: T_out = T_in |w_in / w_out|
+        spec = spec.with_operating(output_torque=spec.operating.input_torque * abs(kin.ratio))
     return spec
 
 

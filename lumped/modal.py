@@ -1,21 +1,37 @@
 """Natural frequencies of the reference lumped model at mean mesh stiffness.
 
-K_mean q = omega^2 M q without the rotating-frame terms (as in Lin & Parker 1999, section 3),
-classified by the central members' coordinates (:func:`gearcheck.shared.modal.mode_types`).
+* :func:`modes`: K_mean q = omega^2 M q without the rotating-frame terms (as in Lin & Parker 1999,
+  section 3), classified by the central members' coordinates (:func:`gearcheck.shared.modal.mode_types`);
+* :func:`modes_at_speed`: the gyroscopic eigenproblem (M s^2 + Omega G s + K_mean + K_Omega) x = 0 of the
+  train turning at a speed (Cooley & Parker 2012): complex s, frequency splitting of the degenerate
+  modes, divergence and flutter where the centripetal softening wins;
+* :func:`settling_time`: how long the damped free vibration of a start lasts.
 """
 
 from __future__ import annotations
 
 from gearcheck.shared import modal as shared
 from gearcheck.shared.modal import ModalResult, modal_result
+from gearcheck.shared.units import rad_s_to_rpm
+
+
+def _central(model) -> tuple[list[int], list[int]]:
+    central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
+               if not model.spec.members[member].is_planet]
+    return [i for i, d in central if d != "theta"], [i for i, d in central if d == "theta"]
 
 
 def modes(model) -> ModalResult:
     """Natural frequencies of a :class:`~gearcheck.lumped.assembly.LumpedModel` at mean mesh stiffness."""
-    central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
-               if not model.spec.members[member].is_planet]
-    return modal_result(model.spec.name, "lumped", model.K_mean, model.M, model.dofs.labels(),
-                        [i for i, d in central if d != "theta"], [i for i, d in central if d == "theta"])
+    return modal_result(model.spec.name, "lumped", model.K_mean, model.M, model.dofs.labels(), *_central(model))
+
+
+def modes_at_speed(model, input_speed: float) -> ModalResult:
+    """The undamped modes of the train turning with its input at ``input_speed`` (rad/s, 0 allowed: then
+    the modes of :func:`modes`), every mesh at its mean stiffness."""
+    at = model.at_speed(input_speed)
+    return shared.speed_modal_result(model.spec.name, "lumped", at.M, at.G, at.K_mean + at.K_centripetal,
+                                     model.dofs.labels(), *_central(model), rad_s_to_rpm(input_speed))
 
 
 def settling_time(model, fraction: float) -> float:

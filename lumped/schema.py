@@ -85,6 +85,7 @@ LIMITS = {
     "module": (0.1, "m: the coarsest gears made (mill girth gears) have modules of about 0.05 m"),
     "displacement": (0.01, "m: an eccentricity, error or backlash of a centimetre is no gear mesh"),
     "mass": (1e6, "kg: a thousand tonnes, beyond any geared machine's single part"),
+    "density": (3e4, "kg/m³: beyond the densest metal (osmium, 22 600)"),
     "inertia": (1e8, "kg·m²: a million kilograms at a 10 m radius"),
     "stiffness": (1e18, "N/m or N·m/rad: a steel block of 1 m² section and 0.2 µm length; 'rigid' is 1e16"),
     "damping": (1e12, "N·s/m or N·m·s/rad: critical damping of the stiffest part on the lightest one"),
@@ -308,11 +309,21 @@ GEOMETRY = {
 }
 
 BODY = {
-    "mass": Number("mass", "kg", REQUIRED, 1e-9, False, bound("mass")),
+    "mass": Number("mass; from `density` when not given", "kg", None, 1e-9, False, bound("mass")),
     "inertia": Number("polar moment of inertia about the rotation axis", "kg·m²", None, 1e-18, False,
                       bound("inertia")),
     "inertia_over_r2": Number("I/r² with r the base radius (carrier: carrier radius); give this or `inertia`", "kg",
                               None, 1e-9, False, bound("mass")),
+    "density": Positive("material density: mass and inertia of an annulus, m = rho pi (r_o² - r_i²) b, "
+                        "I = m (r_o² + r_i²)/2, wherever `mass` or `inertia` is not given (a given mass keeps "
+                        "the annulus's radius of gyration)", "kg/m³", None,
+                        bound("density")),
+    "inner_radius_mm": NonNegative("inner radius of that annulus: a gear's bore (default 0), a ring's default its "
+                                   "pitch radius", "mm", None, bound("length", MM)),
+    "outer_radius_mm": Positive("outer radius of that annulus: a gear's default its pitch radius; a ring and a "
+                                "carrier need it", "mm", None, bound("length", MM)),
+    "thickness_mm": Positive("axial length of that annulus: a gear's default its face width; a carrier needs it "
+                             "(its plates together)", "mm", None, bound("length", MM)),
 }
 
 SUPPORT = Table(
@@ -409,6 +420,9 @@ STAGE = Table(
     {
         "name": Text("stage name, used in member references (`stage1.sun`)", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
         "planets": Integer("number of planets", minimum=1, maximum=int(bound("planets"))),
+        "carrier_radius_mm": Positive("radius of the planet pins: checked against the operating centre distance "
+                                      "the gears mesh at, which it must be (to 1 µm)", "mm", None,
+                                      bound("length", MM)),
         "planet_angles_deg": ListOf(Number("angle", "deg", REQUIRED, -3600.0, False, 3600.0),
                                     "planet angles (default: equally spaced)", None,
                                     unit="deg"),
@@ -444,8 +458,10 @@ OPERATING = Table(
     {
         "input_speed_rpm": Positive("nominal input speed (positive = counter-clockwise seen from +z)", "rpm",
                                     REQUIRED, bound("speed", RAD_S_PER_RPM)),
-        "output_torque": NonNegative("load torque on the output member, opposing its rotation", "N·m", 0.0,
-                                     bound("torque")),
+        "output_torque": NonNegative("load torque on the output member, opposing its rotation (default 0, or "
+                                     "from `input_torque`)", "N·m", None, bound("torque")),
+        "input_torque": NonNegative("torque the input delivers, instead of `output_torque`: the load is this times "
+                                    "the ratio (losses aside)", "N·m", None, bound("torque")),
         "input_shaft_stiffness": Positive(
             "torsional stiffness of the input shaft to a reference turning at the nominal speed "
             "(omit for a torque-driven input with a rigid-body mode)", "N·m/rad", None, bound("stiffness")),

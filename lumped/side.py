@@ -12,7 +12,7 @@ from functools import cached_property
 
 from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.lumped.mesh_stiffness import MODELS
-from gearcheck.lumped.modal import modes
+from gearcheck.lumped.modal import modes, modes_at_speed
 from gearcheck.lumped.published import FourDofModel, four_dof_model, natural_frequencies
 from gearcheck.lumped.published import simulate as simulate_4dof
 from gearcheck.lumped.time_solver import simulate, stable_step
@@ -43,6 +43,9 @@ class LumpedSide:
 
     def modes(self) -> ModalResult:
         return modes(self.model)
+
+    def modes_at_speed(self, input_speed: float) -> ModalResult:
+        return modes_at_speed(self.model, input_speed)
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate(self.model, settings, method=self.method, progress=progress)

@@ -29,6 +29,7 @@ MAX_BACKLASH = 0.5  # modules: beyond, the backlash is more than the tooth space
 MAX_TOLERANCE = 1e6  # a relative error of a million is no tolerance
 MAX_ERROR = 0.1  # modules: a transmission error or an eccentricity that large is a broken or misplaced gear
 CENTRE_DISTANCE_TOLERANCE = 1e-6  # m: sun-planet and ring-planet operating centre distances must match
+CARRIER_RADIUS_TOLERANCE = 1e-6  # m: a stated carrier radius must be the operating centre distance
 
 
 @dataclass(frozen=True)
@@ -115,13 +116,14 @@ class Ripple:
 @dataclass(frozen=True)
 class Operating:
     input_speed: float  # rad/s
-    output_torque: float
+    output_torque: float  # N·m, from input_torque times the ratio when that was given
     input_shaft_stiffness: float | None
     input_shaft_damping: float
     ripple: tuple[Ripple, ...]
     torque_function: str | None
     torque_profile: tuple[tuple[float, ...], tuple[float, ...]] | None  # (times, torques) from torque_csv
     ramp: float
+    input_torque: float | None = None  # N·m, as the train file gave it
 
 
 @dataclass(frozen=True)
@@ -227,8 +229,11 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     if op["torque_function"] is not None:
         _check_torque_function(op["torque_function"], fail)
     profile = _torque_profile(op["torque_csv"], source, fail) if op["torque_csv"] is not None else None
-    operating = Operating(op["input_speed"], op["output_torque"], op["input_shaft_stiffness"],
-                          op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"])
+    if op["input_torque"] is not None and op["output_torque"] is not None:
+        raise fail("operating.input_torque", "give input_torque or output_torque, not both")
+    operating = Operating(op["input_speed"], op["output_torque"] or 0.0, op["input_shaft_stiffness"],
+                          op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
+                          op["input_torque"])
 
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,
@@ -369,10 +374,40 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
     )
 
 
-def _inertia(raw: dict, radius: float, path: str, fail) -> float:
-    if (raw["inertia"] is None) == (raw["inertia_over_r2"] is None):
-        raise fail(f"{path}.inertia", "give exactly one of inertia or inertia_over_r2")
-    return raw["inertia"] if raw["inertia"] is not None else raw["inertia_over_r2"] * radius**2
+def _body(raw: dict, radius: float, path: str, fail, gear: Gear | None = None) -> tuple[float, float]:
+    """(mass, inertia) of a member: as given, or from ``density`` as an annulus (a gear's default from its
+    bore to its pitch circle over its face width; a ring's from its pitch circle out); ``radius`` is the
+    one ``inertia_over_r2`` refers to."""
+    if raw["inertia"] is not None and raw["inertia_over_r2"] is not None:
+        raise fail(f"{path}.inertia", "give inertia or inertia_over_r2, not both")
+    mass = raw["mass"]
+    inertia = raw["inertia"] if raw["inertia_over_r2"] is None else raw["inertia_over_r2"] * radius**2
+    if mass is not None and inertia is not None:
+        return mass, inertia
+    if raw["density"] is None:
+        missing = "mass" if mass is None else "inertia"
+        raise fail(f"{path}.{missing}", f"missing: give {missing}"
+                   + (" (or inertia_over_r2)" if missing == "inertia" else "") + ", or a density to derive it from")
+    pitch = gear.pitch_radius if gear is not None else None
+    inner = raw["inner_radius"]
+    outer = raw["outer_radius"]
+    if gear is not None and gear.internal:
+        inner = pitch if inner is None else inner
+        if outer is None:
+            raise fail(f"{path}.outer_radius_mm", "a ring's mass from its density needs its outer radius")
+    elif gear is not None:
+        inner, outer = inner or 0.0, pitch if outer is None else outer
+    elif outer is None or raw["thickness"] is None:
+        raise fail(f"{path}.{'outer_radius_mm' if outer is None else 'thickness_mm'}",
+                   "a carrier's mass from its density needs its outer radius and thickness")
+    inner = inner or 0.0
+    if not inner < outer:
+        raise fail(f"{path}.inner_radius_mm", f"must be less than the outer radius {outer * 1e3:.6g} mm, got "
+                                              f"{inner * 1e3:.6g} mm")
+    width = raw["thickness"] if raw["thickness"] is not None else gear.face_width
+    annulus_mass = raw["density"] * math.pi * (outer**2 - inner**2) * width
+    mass = annulus_mass if mass is None else mass
+    return mass, inertia if inertia is not None else 0.5 * mass * (outer**2 + inner**2)
 
 
 def _support(raw: dict) -> Support:
@@ -475,27 +510,32 @@ def _build_stage(st: dict, path: str, fail):
         equally = max(abs(s) for s in spacing) < 1e-12
     _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
     carrier_radius = a0
+    stated = st["carrier_radius"]
+    if stated is not None and abs(stated - a0) > CARRIER_RADIUS_TOLERANCE:
+        raise fail(f"{path}.carrier_radius_mm", f"{stated * 1e3:.6g} mm, but the gears mesh at an operating centre "
+                                                f"distance of {a0 * 1e3:.6g} mm: the pins must sit there (change the "
+                                                "teeth or profile shifts, or the radius)")
     _check_collision(planet_gears, angles, carrier_radius, path, fail)
 
     # --- members
     members: dict[str, Member] = {}
     for key, (gear, _, raw) in centrals.items():
         mid = f"{name}.{key}"
-        members[mid] = Member(mid, name, "ring" if gear.internal else "sun", raw["mass"],
-                              _inertia(raw, gear.base_radius, f"{path}.{key}", fail), support=_support(raw["support"]),
+        members[mid] = Member(mid, name, "ring" if gear.internal else "sun",
+                              *_body(raw, gear.base_radius, f"{path}.{key}", fail, gear), support=_support(raw["support"]),
                               gears={key: gear})
     carrier_raw = st["carrier"]
     carrier_id = f"{name}.carrier"
-    members[carrier_id] = Member(carrier_id, name, "carrier", carrier_raw["mass"],
-                                 _inertia(carrier_raw, carrier_radius, f"{path}.carrier", fail),
+    members[carrier_id] = Member(carrier_id, name, "carrier", *_body(carrier_raw, carrier_radius, f"{path}.carrier", fail),
                                  support=_support(carrier_raw["support"]))
     first_planet_gear = next(iter(planet_gears.values()))
-    planet_inertia = _inertia(planet_raw, first_planet_gear.base_radius, f"{path}.planet", fail)
+    planet_mass, planet_inertia = _body(planet_raw, first_planet_gear.base_radius, f"{path}.planet", fail,
+                                        first_planet_gear)
     planet_ids = []
     for k, psi in enumerate(angles):
         pid = f"{name}.planet{k + 1}"
         planet_ids.append(pid)
-        members[pid] = Member(pid, name, "planet", planet_raw["mass"], planet_inertia,
+        members[pid] = Member(pid, name, "planet", planet_mass, planet_inertia,
                               bearing=_support(planet_raw["bearing"]), gears=dict(planet_gears), angle=psi,
                               radius=carrier_radius)
 

@@ -1,11 +1,20 @@
 """Linearisation of the MuJoCo model and its natural frequencies.
 
-M comes from ``mujoco.mj_fullM`` and K from central differences of the generalized
-spring forces MuJoCo computes (``qfrc_passive`` + ``qfrc_actuator``: the input shaft's
-position servo is a spring too) at the nominal configuration (every joint at its
-reference, carrier angle 0), at rest, with every mesh tendon at its mean stiffness.
-As in the lumped modal analysis (Lin & Parker 1999, section 3) no rotation terms
-enter: the model is linearised at qvel = 0.
+At rest (:func:`modes`): M comes from ``mujoco.mj_fullM`` and K from central differences of the
+generalized spring forces MuJoCo computes (``qfrc_passive`` + ``qfrc_actuator``: the input shaft's
+position servo is a spring too) at the nominal configuration (every joint at its reference, carrier
+angle 0), at rest, with every mesh tendon at its mean stiffness.  As in the lumped modal analysis
+(Lin & Parker 1999, section 3) no rotation terms enter: the model is linearised at qvel = 0.
+
+At speed (:func:`modes_at_speed`): central differences of the generalized forces MuJoCo computes,
+f = qfrc_passive + qfrc_actuator - qfrc_bias (its Coriolis and centrifugal terms as MuJoCo computes
+them), with respect to qpos and qvel at the nominal configuration with every body turning at its
+nominal speed (damping removed), and its mass matrix there: M q'' = A q + B q'.  (The mass matrix is
+held at the nominal configuration, as in the linear model: differentiating qacc = M(q)^-1 f instead
+would add dM^-1/dq times the centrifugal force the nominal configuration leaves unbalanced.)
+MuJoCo's central members translate along world axes, which turn under a rotating train; in the axes
+of their stage's carrier (x_w = R(Omega t) x_r) the system is time-invariant:
+M q_r'' = (A + B P - M P^2) q_r + (B - 2 M P) q_r', P = Omega J on those slides.
 
 Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions of the central
 members' slides (translation) and hinges (rotation), classified by
@@ -21,9 +30,11 @@ import mujoco
 import numpy as np
 
 from gearcheck.shared import stepping
-from gearcheck.shared.modal import ModalResult, modal_result
+from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
+from gearcheck.shared.units import rad_s_to_rpm
 
 FD_STEP = 1e-6  # m or rad; the spring forces are linear in qpos, so the step only sets rounding
+VELOCITY_STEP = 1e-3  # m/s or rad/s
 
 
 def _set_rest(mb, data: mujoco.MjData, qpos: np.ndarray) -> None:
@@ -109,6 +120,57 @@ def joint_labels(mb) -> list[str]:
 
 def modes(mb) -> ModalResult:
     """Natural frequencies and mode types of the MuJoCo model at mean mesh stiffness (solver "mujoco")."""
-    central = [mb.dadr[mid] for mid, member in mb.spec.members.items() if not member.is_planet]
     return modal_result(mb.spec.name, "mujoco", stiffness_matrix(mb, mb.excitation.mean_stiffness), mass_matrix(mb),
-                        joint_labels(mb), [i for x, y, _ in central for i in (x, y)], [rz for _, _, rz in central])
+                        joint_labels(mb), *_central(mb))
+
+
+def _central(mb) -> tuple[list[int], list[int]]:
+    central = [mb.dadr[mid] for mid, member in mb.spec.members.items() if not member.is_planet]
+    return [i for x, y, _ in central for i in (x, y)], [rz for _, _, rz in central]
+
+
+def modes_at_speed(mb, input_speed: float) -> ModalResult:
+    """The undamped modes of the twin turning with its input at ``input_speed`` (rad/s, 0 allowed), every
+    mesh at its mean stiffness (solver "mujoco"; see the module doc)."""
+    m = mb.model
+    ratio = input_speed / mb.spec.operating.input_speed
+    saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.tendon_damping.copy(), m.dof_damping.copy(),
+             m.actuator_gainprm.copy(), m.actuator_biasprm.copy(), m.wrap_prm.copy())
+    try:
+        m.tendon_stiffness[mb.mesh_tendon] = mb.excitation.mean_stiffness
+        m.tendon_lengthspring[mb.mesh_tendon] = 0.0  # a backlash band closed, as in :func:`stiffness_matrix`
+        m.tendon_damping[:] = 0.0
+        m.dof_damping[:] = 0.0
+        if "input_shaft_damper" in mb.actuator:
+            m.actuator_gainprm[mb.actuator["input_shaft_damper"], 0] = 0.0
+            m.actuator_biasprm[mb.actuator["input_shaft_damper"], 2] = 0.0
+        d = mujoco.MjData(m)
+        q0, v0 = m.qpos0.copy(), np.zeros(m.nv)
+        P = np.zeros((m.nv, m.nv))
+        for mid, member in mb.spec.members.items():
+            ix, iy, ir = mb.dadr[mid]
+            omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
+            v0[ir] = ratio * mb.kin.speeds[mid] - (omega if member.is_planet else 0.0)  # planet hinges: relative
+            if not member.is_planet:
+                P[ix, iy], P[iy, ix] = -omega, omega
+
+        def force(q, v):
+            d.qpos[:], d.qvel[:], d.act[:], d.ctrl[:] = q, v, 0.0, 0.0
+            mb.refresh(d.qpos)
+            mujoco.mj_forward(m, d)
+            return d.qfrc_passive + d.qfrc_actuator - d.qfrc_bias
+
+        A, B = np.zeros((m.nv, m.nv)), np.zeros((m.nv, m.nv))
+        for j in range(m.nv):  # hinge and slide joints only: qpos and dof addresses coincide
+            e = np.zeros(m.nv)
+            e[j] = FD_STEP
+            A[:, j] = (force(q0 + e, v0) - force(q0 - e, v0)) / (2 * FD_STEP)
+            e[j] = VELOCITY_STEP  # the bias forces are quadratic in qvel: central differences are exact
+            B[:, j] = (force(q0, v0 + e) - force(q0, v0 - e)) / (2 * VELOCITY_STEP)
+        M = mass_matrix(mb)
+    finally:
+        (m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.dof_damping[:],
+         m.actuator_gainprm[:], m.actuator_biasprm[:], m.wrap_prm[:]) = saved
+    # in the carriers' axes: M s^2 + D s + K with D = -(B - 2 M P), K = -(A + B P - M P^2)
+    return speed_modal_result(mb.spec.name, "mujoco", M, 2 * M @ P - B, M @ P @ P - A - B @ P,
+                              joint_labels(mb), *_central(mb), rad_s_to_rpm(input_speed))

@@ -14,9 +14,9 @@ from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.published_twin import PublishedTwin, build_twin, simulate_twin, twin_modes
 from gearcheck.mbd_models.runner import simulate_mujoco
 from gearcheck.mbd_models.twin import MbdModel, compile_train
+from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
-from gearcheck.shared import stepping
 from gearcheck.shared.settings import RunSettings
 
 
@@ -37,6 +37,9 @@ class MujocoSide:
 
     def modes(self) -> ModalResult:
         return linearise.modes(self.model)
+
+    def modes_at_speed(self, input_speed: float) -> ModalResult:
+        return linearise.modes_at_speed(self.model, input_speed)
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock)

@@ -27,7 +27,11 @@ def test_modes_json_schema(capsys):
     data = json.loads(capsys.readouterr().out)
     modes = data["solvers"][0]["modes"]
     assert data["unit"] == "Hz" and len(modes) == 21
-    assert set(modes[0]) == {"mode", "frequency_hz", "type", "multiplicity"}
+    assert set(modes[0]) == {"mode", "frequency_hz", "type", "multiplicity", "energy"}
+    for mode in modes:  # the shares add up, and a rotational mode has none in central translation
+        assert sum(mode["energy"].values()) == pytest.approx(1.0)
+        if mode["type"] == "rotational":
+            assert mode["energy"]["central_translation"] < 1e-8 < mode["energy"]["central_rotation"]
 
 
 def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from gearcheck.compare.campbell import CampbellResult
+from gearcheck.compare.campbell import campbell as campbell_diagram
 from gearcheck.compare.crosscheck import crosscheck
 from gearcheck.compare.report import write_report
 from gearcheck.lumped.loader import load_train, preset_names
@@ -20,8 +22,9 @@ from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.units import rpm_to_rad_s
 
-__all__ = ["SOLVERS", "crosscheck", "load", "mjcf", "modes", "presets", "simulate", "write_report"]
+__all__ = ["SOLVERS", "campbell", "crosscheck", "load", "mjcf", "modes", "presets", "simulate", "write_report"]
 
 SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
 
@@ -60,7 +63,7 @@ def _side(solver: str, spec: TrainSpec, method: str = "rk4"):
 
 
 def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalResult:
-    """Natural frequencies, mode shapes and Lin & Parker mode types at mean mesh stiffness.
+    """Natural frequencies, mode shapes, Lin & Parker mode types and energy shares at mean mesh stiffness.
 
     Parameters
     ----------
@@ -69,14 +72,56 @@ def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalRes
     solver : {"lumped", "mujoco"}
         The reference lumped model, or MuJoCo's linearisation of the twin.
     speed : float, optional
-        Input speed in rpm.
+        Input speed in rpm (0 allowed).  Without it, the modes of the train at rest (Lin & Parker
+        1999); with it, the gyroscopic modes of the train turning at that speed (Cooley & Parker
+        2012): complex eigenvalues, each mode's growth rate and stability.
 
     Returns
     -------
     ModalResult
-        ``frequencies`` (Hz), ``shapes``, ``types``, ``multiplicity``; ``to_dataframe()``.
+        ``frequencies`` (Hz), ``shapes``, ``types``, ``multiplicity``, ``fractions`` (kinetic energy in
+        central translation, central rotation, planets); at a speed also ``growth`` (1/s), ``stability``
+        and ``stable``; ``to_dataframe()``, ``to_dict()``.
     """
-    return _side(solver, load(train, speed)).modes()
+    side = _side(solver, load(train))
+    if speed is None:
+        return side.modes()
+    return side.modes_at_speed(rpm_to_rad_s(_speed(speed)))
+
+
+def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> CampbellResult:
+    """The Campbell diagram: the gyroscopic modes of both solvers (or one) over a range of input speeds.
+
+    Parameters
+    ----------
+    train : str, path or TrainSpec
+        The train.
+    speeds : sequence of float
+        Input speeds in rpm, ascending, >= 0.
+    solver : {"both", "lumped", "mujoco"}
+    harmonics : int
+        Mesh harmonics drawn as excitation lines.
+
+    Returns
+    -------
+    CampbellResult
+        ``frequencies(solver)`` (speeds x modes, Hz), ``crossings`` of mesh harmonics with modes,
+        instability ``zones``, ``agreement`` of the two solvers; ``to_dict()``; the figure from
+        :func:`gearcheck.compare.plots.campbell_diagram`.
+    """
+    spec = load(train)
+    solvers = tuple(SOLVERS) if solver == "both" else (solver,)
+    sides = {s: _side(s, spec) for s in solvers}
+    speeds = [_speed(v) for v in speeds]
+    if len(speeds) < 2 or any(b <= a for a, b in zip(speeds, speeds[1:])):
+        raise GearcheckError(f"speeds: give at least two speeds in ascending order, got {list(speeds)}")
+    return campbell_diagram(spec, speeds, lambda s, w: sides[s].modes_at_speed(w), solvers, harmonics)
+
+
+def _speed(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value >= 0 and value < float("inf")):
+        raise GearcheckError(f"speed must be a number of rpm >= 0, got {value!r}")
+    return float(value)
 
 
 def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: float | None = None,

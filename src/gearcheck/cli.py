@@ -70,20 +70,37 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGTERM, previous)
 
 
-def _number(kind: str, positive: bool = True):
-    """An argparse type: a finite number (positive unless told otherwise); ``kind`` says of what."""
+def _number(kind: str, positive: bool = True, minimum: float | None = None):
+    """An argparse type: a finite number (positive unless told otherwise, at least ``minimum`` when given);
+    ``kind`` says of what."""
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"must be a number of {kind}, got {text!r}") from None
-        if not math.isfinite(value) or (positive and value <= 0):
-            raise argparse.ArgumentTypeError(f"must be a positive number of {kind}, got {text}")
+        if not math.isfinite(value) or (positive and value <= 0) or (minimum is not None and value < minimum):
+            raise argparse.ArgumentTypeError(f"must be a {'positive ' if positive else ''}number of {kind}, "
+                                             f"got {text}")
         return value
     return parse
 
 
 SECONDS, RPM, HZ = _number("seconds"), _number("rpm"), _number("Hz")
+RPM_OR_ZERO = _number("rpm >= 0", positive=False, minimum=0.0)
+
+
+def SPEED_RANGE(text: str) -> list[float]:  # noqa: N802 - an argparse type, named like the others
+    """A:B:N -> N speeds from A to B rpm."""
+    parts = text.split(":")
+    try:
+        low, high, count = float(parts[0]), float(parts[1]), int(parts[2])
+        if len(parts) != 3:
+            raise ValueError
+    except (ValueError, IndexError):
+        raise argparse.ArgumentTypeError(f"must be A:B:N (rpm, rpm, count), got {text!r}") from None
+    if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high and 2 <= count <= 10000):
+        raise argparse.ArgumentTypeError(f"needs 0 <= A < B and 2 <= N <= 10000, got {text!r}")
+    return [low + (high - low) * i / (count - 1) for i in range(count)]
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -100,11 +117,23 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="machine-readable output")
     s.set_defaults(func=cmd_show)
 
-    s = sub.add_parser("modes", help="natural frequencies and mode types")
+    s = sub.add_parser("modes", help="natural frequencies and mode types (at rest, or turning at --speed)")
     _train_arg(s)
     s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="lumped")
+    s.add_argument("--speed", type=RPM_OR_ZERO, metavar="RPM",
+                   help="the gyroscopic modes of the train turning at this input speed (0 allowed)")
     s.add_argument("--json", action="store_true", help="machine-readable output")
     s.set_defaults(func=cmd_modes)
+
+    s = sub.add_parser("campbell", help="Campbell diagram: gyroscopic modes over a speed range (PNG and JSON)")
+    _train_arg(s)
+    s.add_argument("--speeds", type=SPEED_RANGE, required=True, metavar="A:B:N",
+                   help="N input speeds from A to B rpm (0 <= A < B, N >= 2)")
+    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both")
+    s.add_argument("--harmonics", type=int, default=3, metavar="H", help="mesh harmonics drawn (default 3)")
+    s.add_argument("--out", type=Path, default=Path("out/campbell"), metavar="DIR",
+                   help="writes campbell.png and campbell.json (default out/campbell)")
+    s.set_defaults(func=cmd_campbell)
 
     s = sub.add_parser("run", help="time response at the operating point")
     _train_arg(s)
@@ -214,22 +243,49 @@ def cmd_show(args) -> int:
 def cmd_modes(args) -> int:
     spec = gearcheck.load(args.train)
     solvers = list(gearcheck.SOLVERS) if args.solver == "both" else [args.solver]
-    results = [gearcheck.modes(spec, solver) for solver in solvers]
+    results = [gearcheck.modes(spec, solver, speed=args.speed) for solver in solvers]
     if args.json:
-        print(json.dumps({"train": spec.name, "unit": "Hz", "solvers": [r.to_dict() for r in results]}, indent=2))
+        out = {"train": spec.name, "unit": "Hz", "solvers": [r.to_dict() for r in results]}
+        if args.speed is not None:
+            out["speed_rpm"] = args.speed
+        print(json.dumps(out, indent=2))
         return 0
-    header = f"{'mode':>4}  " + "  ".join(f"{r.solver + ' (Hz)':>16}  {'type':<13} {'mult':>4}" for r in results)
+    at_speed = args.speed is not None
+    extra = "  growth [1/s]  stability " if at_speed else ""
+    header = f"{'mode':>4}  " + "  ".join(f"{r.solver + ' (Hz)':>16}  {'type':<13} {'mult':>4}{extra}" for r in results)
     if len(results) == 2:
         header += f"  {'rel. diff':>10}"
-    print(f"{spec.name}: natural frequencies at mean mesh stiffness")
+    print(f"{spec.name}: natural frequencies at mean mesh stiffness, "
+          + (f"turning at {args.speed:g} rpm (gyroscopic)" if at_speed else "at rest"))
     print(header)
     for i in range(len(results[0])):
         line = f"{i + 1:>4}  " + "  ".join(
-            f"{r.frequencies[i]:>16.6f}  {r.types[i]:<13} {r.multiplicity[i]:>4}" for r in results)
+            f"{r.frequencies[i]:>16.6f}  {r.types[i]:<13} {r.multiplicity[i]:>4}"
+            + (f"  {r.growth[i]:>12.4g}  {r.stability[i]:<10}" if at_speed else "") for r in results)
         if len(results) == 2:
             a, b = results[0].frequencies[i], results[1].frequencies[i]
             line += f"  {abs(a - b) / max(abs(a), 1e-300):>10.2e}"
         print(line)
+    if at_speed and not all(r.stable for r in results):
+        print("UNSTABLE: " + "; ".join(f"{r.solver}: {r.stability.count('divergence')} divergent, "
+                                      f"{r.stability.count('flutter')} flutter modes" for r in results))
+    return 0
+
+
+def cmd_campbell(args) -> int:
+    from gearcheck.compare.plots import campbell_diagram
+
+    with OutputDirectory(args.out) as place:
+        result = gearcheck.campbell(args.train, args.speeds, solver=args.solver, harmonics=args.harmonics)
+        write_file(place.path / "campbell.png", campbell_diagram(result))
+        write_file(place.path / "campbell.json", json.dumps(result.to_dict(), indent=2) + "\n")
+    print(f"{result.train}: {len(result.speeds_rpm)} speeds from {result.speeds_rpm[0]:g} to "
+          f"{result.speeds_rpm[-1]:g} rpm, {len(result.crossings)} crossings of mesh harmonics with modes")
+    if result.agreement is not None:
+        print(f"  lumped and MuJoCo frequencies agree to {result.agreement:.2e} (relative, worst over all speeds)")
+    for zone in result.zones:
+        print(f"  UNSTABLE ({zone['solver']}) from {zone['from_rpm']:g} to {zone['to_rpm']:g} rpm")
+    print(f"  wrote {args.out / 'campbell.png'} and {args.out / 'campbell.json'}")
     return 0
 
 

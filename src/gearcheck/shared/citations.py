@@ -45,6 +45,9 @@ REFERENCES: dict[str, Reference] = {
     "kiracofe-parker-2007": Reference(
         "Kiracofe D. R., Parker R. G.", 2007, "Structured vibration modes of general compound planetary gear "
         "systems", "Journal of Vibration and Acoustics 129(1), 1-16"),
+    "cooley-parker-2012": Reference(
+        "Cooley C. G., Parker R. G.", 2012, "Vibration properties of high-speed planetary gears with gyroscopic "
+        "effects", "Journal of Vibration and Acoustics 134(6), 061014"),
     "weber-1949": Reference(
         "Weber C.", 1949, "The deformation of loaded gears and the effect on their load-carrying capacity",
         "Sponsored Research (Germany), British Department of Scientific and Industrial Research, Report No. 3"),

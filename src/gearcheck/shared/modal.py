@@ -30,9 +30,17 @@ DEGENERACY_TOLERANCE = 1e-7  # relative frequency difference grouped as one mult
 RIGID_TOLERANCE = 1e-9  # omega^2 below this times the largest one is a rigid-body mode
 
 
+STABILITY_TOLERANCE = 1e-8  # a growth rate below this times the largest |s| counts as none (round-off)
+GROUPS = ("central_translation", "central_rotation", "planets")
+
+
 @dataclass
 class ModalResult:
-    """Natural frequencies (Hz), mass-normalised mode shapes and their types."""
+    """Natural frequencies (Hz), mode shapes, their types and where their kinetic energy lies.
+
+    At speed (``speed_rpm`` set: the gyroscopic eigenproblem) the shapes are complex, ``growth`` holds
+    each mode's Re(s) (1/s; > 0 grows) and ``stability`` "stable", "rigid", "divergence" (s real and
+    positive) or "flutter" (s complex with a positive real part)."""
 
     train: str
     frequencies: np.ndarray
@@ -41,20 +49,40 @@ class ModalResult:
     multiplicity: list[int]
     dof_labels: list[str]
     solver: str = "lumped"
+    fractions: np.ndarray | None = None  # (n_modes, 3): kinetic energy shares of GROUPS
+    speed_rpm: float | None = None
+    growth: np.ndarray | None = None
+    stability: list[str] | None = None
 
     def __len__(self) -> int:
         return len(self.frequencies)
 
+    @property
+    def stable(self) -> bool:
+        return self.stability is None or not any(s in ("divergence", "flutter") for s in self.stability)
+
     def to_dataframe(self) -> pd.DataFrame:
-        return pd.DataFrame({"mode": np.arange(1, len(self) + 1), "frequency_hz": self.frequencies,
-                             "type": self.types, "multiplicity": self.multiplicity})
+        columns = {"mode": np.arange(1, len(self) + 1), "frequency_hz": self.frequencies, "type": self.types,
+                   "multiplicity": self.multiplicity}
+        if self.growth is not None:
+            columns.update(growth_rate_1_s=self.growth, stability=self.stability)
+        if self.fractions is not None:
+            columns.update({f"energy_{g}": self.fractions[:, j] for j, g in enumerate(GROUPS)})
+        return pd.DataFrame(columns)
 
     def to_dict(self) -> dict:
-        return {
-            "train": self.train, "solver": self.solver, "unit": "Hz",
-            "modes": [{"mode": i + 1, "frequency_hz": float(f), "type": t, "multiplicity": m}
-                      for i, (f, t, m) in enumerate(zip(self.frequencies, self.types, self.multiplicity))],
-        }
+        modes = []
+        for i, (f, t, m) in enumerate(zip(self.frequencies, self.types, self.multiplicity)):
+            mode = {"mode": i + 1, "frequency_hz": float(f), "type": t, "multiplicity": m}
+            if self.growth is not None:
+                mode.update(growth_rate_1_s=float(self.growth[i]), stability=self.stability[i])
+            if self.fractions is not None:
+                mode["energy"] = {g: float(x) for g, x in zip(GROUPS, self.fractions[i])}
+            modes.append(mode)
+        out = {"train": self.train, "solver": self.solver, "unit": "Hz", "modes": modes}
+        if self.speed_rpm is not None:
+            out.update(speed_rpm=self.speed_rpm, stable=self.stable)
+        return out
 
 
 def generalized_modes(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -101,20 +129,29 @@ def _same(a: float, b: float) -> bool:
     return abs(a - b) <= DEGENERACY_TOLERANCE * max(abs(a), abs(b)) or (a == 0.0 and b == 0.0)
 
 
-def mode_types(M: np.ndarray, shapes: np.ndarray, frequencies: np.ndarray, translation, rotation) -> list[str]:
-    """Lin & Parker types from each mode's kinetic-energy fractions phi_g' M_gg phi_g / phi' M phi
-    in the central members' translations and rotations (index lists over the coordinates)."""
+def energy_fractions(M: np.ndarray, shapes: np.ndarray, translation, rotation) -> np.ndarray:
+    """(n_modes, 3): each mode's kinetic-energy shares phi_g^H M_gg phi_g / phi^H M phi in the central members'
+    translations, their rotations, and the rest (planets); complex shapes allowed."""
     translation, rotation = list(translation), list(rotation)
+    out = np.zeros((shapes.shape[1], 3))
+    for j in range(shapes.shape[1]):
+        phi = shapes[:, j]
+        total = float(np.real(np.conj(phi) @ M @ phi))
+        for k, idx in enumerate((translation, rotation)):
+            out[j, k] = float(np.real(np.conj(phi[idx]) @ M[np.ix_(idx, idx)] @ phi[idx])) / total
+        out[j, 2] = max(0.0, 1.0 - out[j, 0] - out[j, 1])
+    return out
+
+
+def mode_types(fractions: np.ndarray, frequencies: np.ndarray) -> list[str]:
+    """Lin & Parker types from each mode's energy fractions (:func:`energy_fractions`): a share below
+    ``ENERGY_TOLERANCE`` counts as zero, and a mode whose energy both the central translations and the
+    central rotations hold is mixed."""
     types = []
-    for j, f in enumerate(frequencies):
+    for (trans, rot, _), f in zip(fractions, frequencies):
         if f == 0.0:
             types.append("rigid")
-            continue
-        phi = shapes[:, j]
-        total = phi @ M @ phi
-        trans = phi[translation] @ M[np.ix_(translation, translation)] @ phi[translation] / total
-        rot = phi[rotation] @ M[np.ix_(rotation, rotation)] @ phi[rotation] / total
-        if trans < ENERGY_TOLERANCE and rot < ENERGY_TOLERANCE:
+        elif trans < ENERGY_TOLERANCE and rot < ENERGY_TOLERANCE:
             types.append("planet")
         elif trans < ENERGY_TOLERANCE:
             types.append("rotational")
@@ -135,6 +172,34 @@ def modal_result(train: str, solver: str, K: np.ndarray, M: np.ndarray, dof_labe
     """Solve K x = w^2 M x and classify: Lin & Parker types over the central members' translation and
     rotation coordinates when they are given, rigid/elastic otherwise."""
     frequencies, shapes = generalized_modes(K, M)
-    types = (rigid_or_elastic(frequencies) if translation is None
-             else mode_types(M, shapes, frequencies, translation, rotation))
-    return ModalResult(train, frequencies, shapes, types, multiplicities(frequencies), list(dof_labels), solver)
+    if translation is None:
+        return ModalResult(train, frequencies, shapes, rigid_or_elastic(frequencies), multiplicities(frequencies),
+                           list(dof_labels), solver)
+    fractions = energy_fractions(M, shapes, translation, rotation)
+    return ModalResult(train, frequencies, shapes, mode_types(fractions, frequencies), multiplicities(frequencies),
+                       list(dof_labels), solver, fractions)
+
+
+def speed_modal_result(train: str, solver: str, M: np.ndarray, D: np.ndarray, K: np.ndarray, dof_labels,
+                       translation, rotation, speed_rpm: float) -> ModalResult:
+    """The modes of M q'' + D q' + K q = 0 at a speed (D gyroscopic, K with the centripetal terms): one mode
+    per conjugate pair s = sigma +/- i omega (a divergence's real pair +/- sigma counts once, by its growing
+    root; a flutter quadruple twice), ordered by frequency; rigid modes (|s| below RIGID_TOLERANCE of the
+    largest, in the square) have frequency and growth 0."""
+    s, x = quadratic_eigenvalues(M, D, K)
+    scale = np.max(np.abs(s))
+    rigid = np.abs(s) ** 2 <= RIGID_TOLERANCE * scale**2
+    real = np.abs(s.imag) <= STABILITY_TOLERANCE * scale
+    keep = np.where(~rigid & ((s.imag > STABILITY_TOLERANCE * scale) | (real & (s.real > 0))))[0]
+    n_rigid = (int(np.sum(rigid)) + 1) // 2
+    s_kept = np.concatenate([np.zeros(n_rigid), s[keep]])
+    shapes = np.concatenate([x[:, np.where(rigid)[0][:n_rigid]], x[:, keep]], axis=1)
+    frequencies = np.abs(s_kept.imag) / (2.0 * np.pi)
+    growth = np.where(np.abs(s_kept.real) <= STABILITY_TOLERANCE * scale, 0.0, s_kept.real)
+    order = np.lexsort((growth, frequencies))
+    frequencies, growth, shapes = frequencies[order], growth[order], shapes[:, order]
+    stability = ["rigid" if f == 0 and g == 0 else "stable" if g <= 0 else "divergence" if f == 0 else "flutter"
+                 for f, g in zip(frequencies, growth)]
+    fractions = energy_fractions(M, shapes, translation, rotation)
+    return ModalResult(train, frequencies, shapes, mode_types(fractions, frequencies), multiplicities(frequencies),
+                       list(dof_labels), solver, fractions, speed_rpm, growth, stability)

@@ -166,7 +166,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
         attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress)
         needed = plan.needed_duration() if plan.detect_steady else None
-        if attempt.how is None and not extended and needed is not None and duration < needed <= EXTENSION_FACTOR * asked:
+        reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked
+        if attempt.how is None and not extended and reachable:
             notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
                          f"the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s, plus "
                          f"{STEADY_WINDOW_CYCLES} mesh cycles to compare.")
@@ -174,7 +175,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
             continue
         if best is not None and attempt.worst >= best.worst:
             notes.append(f"Halving the steps did not lower the integration error bound ({best.worst:.2g} -> "
-                         f"{attempt.worst:.2g} of a tolerance: round-off, not truncation); the coarser run is reported.")
+                         f"{attempt.worst:.2g} of a tolerance: round-off, not truncation); the coarser run is "
+                         "reported.")
             break
         best = attempt
         if attempt.worst > TARGET_FRACTION and refinements < MAX_REFINEMENTS and any(adjustable):

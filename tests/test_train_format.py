@@ -45,7 +45,8 @@ def test_masses_and_inertias_from_a_density():
         member = spec.members[mid]
         assert member.mass == pytest.approx(mass, rel=1e-12) and member.inertia == pytest.approx(inertia, rel=1e-12)
         assert member.mass == pytest.approx(printed.members[mid].mass, rel=2e-4)
-        assert member.inertia == pytest.approx(printed.members[mid].inertia, rel=5e-4)  # the sun's printed 5.802e-4: 5.800e-4
+        # the sun's printed 5.802e-4 is 5.800e-4
+        assert member.inertia == pytest.approx(printed.members[mid].inertia, rel=5e-4)
 
 
 def test_a_given_mass_wins_over_the_density():

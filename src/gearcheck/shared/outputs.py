@@ -10,8 +10,8 @@
 * ``.path`` is a temporary folder beside ``out``, made (with any missing parents) when first asked for;
 * on a clean exit the temporary folder replaces ``out``; on an error or an interruption it is removed,
   with any parents it made, and ``out`` stays as it was: the previous complete output, or nothing.
-  Ctrl-C and SIGTERM wait while the folders are swapped or removed (a few milliseconds), so neither
-  can leave a half-removed folder behind; they take effect right after.
+  Ctrl-C and SIGTERM wait while the folders are made, swapped or removed (a few milliseconds), so
+  neither can leave an unrecorded or half-removed folder behind; they take effect right after.
 
 :func:`write_file` does the same for one file.
 """
@@ -100,14 +100,16 @@ class OutputDirectory:
     def path(self) -> Path:
         """The temporary folder to write into (made when first asked for)."""
         if self._tmp is None:
-            try:
-                self._made = _make_parents(self.out)
-                self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.", suffix=".partial",
-                                                  dir=self.out.parent))
-                (self._tmp / MARKER).write_text("gearcheck output: the next gearcheck run into this folder replaces "
-                                                "it whole\n", encoding="utf-8")
-            except OSError as exc:
-                raise GearcheckError(f"{self.what} {self.given}: cannot be written ({exc.strerror or exc})") from None
+            with _signals_deferred():  # a folder made is a folder recorded, so an interruption removes it
+                try:
+                    self._made = _make_parents(self.out)
+                    self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.", suffix=".partial",
+                                                      dir=self.out.parent))
+                    (self._tmp / MARKER).write_text("gearcheck output: the next gearcheck run into this folder "
+                                                    "replaces it whole\n", encoding="utf-8")
+                except OSError as exc:
+                    raise GearcheckError(f"{self.what} {self.given}: cannot be written ({exc.strerror or exc})"
+                                         ) from None
         return self._tmp
 
     def __exit__(self, kind, error, trace) -> None:
@@ -159,20 +161,22 @@ def _signals_deferred():
 
 
 def write_file(path, data: bytes | str, what: str = "-o") -> None:
-    """Write ``data`` to ``path`` whole or not at all: through a temporary file in the same folder."""
+    """Write ``data`` to ``path`` whole or not at all: through a temporary file in the same folder (signals
+    wait the milliseconds this takes, so an interruption leaves the previous file or the new one)."""
     path = Path(path)
     check_place(path, what, folder=False)
-    try:
-        made = _make_parents(path)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
-    except OSError as exc:
-        raise GearcheckError(f"{what} {path}: cannot be written ({exc.strerror or exc})") from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data.encode("utf-8") if isinstance(data, str) else data)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        for folder in reversed(made):
-            folder.rmdir()
-        raise
+    with _signals_deferred():
+        try:
+            made = _make_parents(path)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+        except OSError as exc:
+            raise GearcheckError(f"{what} {path}: cannot be written ({exc.strerror or exc})") from None
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data.encode("utf-8") if isinstance(data, str) else data)
+            os.replace(tmp, path)
+        except BaseException:
+            os.unlink(tmp)
+            for folder in reversed(made):
+                folder.rmdir()
+            raise

@@ -50,6 +50,13 @@ from gearcheck.lumped.spec import TrainSpec
 
 CENTRAL_DOFS = ("x", "y", "theta")
 PLANET_DOFS = ("radial", "tangential", "theta")
+AXIAL_DOF = "z"  # members of a helical stage: translation along the stage axis (absolute, like the others)
+
+
+def member_dofs(spec: TrainSpec, member) -> tuple[str, ...]:
+    """The coordinates of ``member``: two translations and a rotation, and z in a helical stage."""
+    planar = PLANET_DOFS if member.is_planet else CENTRAL_DOFS
+    return planar + (AXIAL_DOF,) if spec.stage_of(member.id).helical else planar
 
 
 @dataclass(frozen=True)
@@ -211,7 +218,7 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     kin = kinematics(spec)
     dofs = DofMap()
     for mid, member in spec.members.items():
-        dofs.add(mid, PLANET_DOFS if member.is_planet else CENTRAL_DOFS)
+        dofs.add(mid, member_dofs(spec, member))
     n = len(dofs)
     M = np.zeros((n, n))
     G = np.zeros((n, n))
@@ -223,6 +230,8 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
         iu, iv, ith = dofs(mid, u), dofs(mid, v), dofs(mid, "theta")
         M[iu, iu] = M[iv, iv] = member.mass
         M[ith, ith] = member.inertia
+        if AXIAL_DOF in member_dofs(spec, member):  # along the axis of rotation: no frame terms
+            M[dofs(mid, AXIAL_DOF), dofs(mid, AXIAL_DOF)] = member.mass
         carrier = f"{member.stage}.carrier"
         omega = kin.speeds[carrier]
         # Coriolis 2 m Omega k x q' and centripetal -m Omega^2 q of the translations (rotating frame)
@@ -284,6 +293,9 @@ def _support_rows(spec, dofs) -> list[Row]:
         if s.torsional_stiffness or s.torsional_damping:
             rows.append(Row(f"{mid}.support_theta", "support", _unit(n, (dofs(mid, "theta"), 1.0)),
                             s.torsional_stiffness, s.torsional_damping))
+        if AXIAL_DOF in member_dofs(spec, m):
+            rows.append(Row(f"{mid}.support_z", "support", _unit(n, (dofs(mid, AXIAL_DOF), 1.0)), s.axial_stiffness,
+                            s.axial_damping))
     return rows
 
 
@@ -309,6 +321,9 @@ def _bearing_rows(spec, dofs) -> list[Row]:
             rows.append(Row(f"{pid}.bearing_radial", "bearing", radial, b.radial_stiffness, b.radial_damping))
             rows.append(Row(f"{pid}.bearing_tangential", "bearing", tangential, b.radial_stiffness,
                             b.radial_damping))
+            if stage.helical:
+                axial = _unit(len(dofs), (dofs(pid, AXIAL_DOF), 1.0), (dofs(stage.carrier, AXIAL_DOF), -1.0))
+                rows.append(Row(f"{pid}.bearing_axial", "bearing", axial, b.axial_stiffness, b.axial_damping))
     return rows
 
 
@@ -334,7 +349,7 @@ def _coupling_rows(spec, dofs, kin) -> tuple[list[Row], list[TurningCoupling]]:
 
 
 def _mesh_row(spec, dofs, kin, mesh) -> np.ndarray:
-    """delta = (u_central(p) - u_planet(p)) . d with u(p) = translation + theta k x (p - centre)."""
+    """delta = (u_central(p) - u_planet(p)) . d with u(p) = translation + theta k x (p - centre) (+ z e_z)."""
     stage = spec.stage_of(mesh.planet)
     planet = spec.members[mesh.planet]
     loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
@@ -350,6 +365,9 @@ def _mesh_row(spec, dofs, kin, mesh) -> np.ndarray:
     a[dofs(p, "radial")] -= float(d @ e_r)
     a[dofs(p, "tangential")] -= float(d @ e_t)
     a[dofs(p, "theta")] -= lever(loa.pitch_point, loa.planet_centre, d)
+    if stage.helical:  # the normal line of action's axial part (Eritenel & Parker 2009)
+        a[dofs(c, AXIAL_DOF)] += loa.axial
+        a[dofs(p, AXIAL_DOF)] -= loa.axial
     return a
 
 

@@ -1,5 +1,5 @@
-"""Derived quantities of a train, as ``gearcheck show`` prints them: ratio, speeds, gear geometry,
-contact ratios, operating pressure angles, mesh frequencies and phases, loaded flanks, mesh stiffness
+"""Derived quantities of a train, as ``gearcheck show`` prints them: ratio, speeds, gear geometry
+(helix angles), contact ratios (transverse and face), operating pressure angles, mesh frequencies and phases, loaded flanks, mesh stiffness
 and damping."""
 
 from __future__ import annotations
@@ -29,13 +29,15 @@ def describe(spec) -> dict:
             "planet_angles_deg": [math.degrees(a) for a in stage.planet_angles],
             "gears": {_gear_label(spec.members[mid], g): {
                 "teeth": g.teeth, "pitch_radius_m": g.pitch_radius, "base_radius_m": g.base_radius,
-                "tip_radius_m": g.tip_radius, "profile_shift": g.profile_shift}
+                "tip_radius_m": g.tip_radius, "profile_shift": g.profile_shift,
+                "helix_angle_deg": math.degrees(g.helix_angle), "normal_module_m": g.normal_module}
                 for mid in stage.centrals + stage.planets[:1] for g in spec.members[mid].gears.values()},
         })
     for j, mesh in enumerate(spec.meshes):
         g = mesh.geometry
         out["meshes"].append({
-            "mesh": mesh.id, "contact_ratio": g.contact_ratio, "operating_pressure_angle_deg":
+            "mesh": mesh.id, "contact_ratio": g.contact_ratio, "face_contact_ratio": g.face_contact_ratio,
+            "base_helix_angle_deg": math.degrees(g.base_helix_angle), "operating_pressure_angle_deg":
                 math.degrees(g.pressure_angle), "mesh_frequency_hz": kin.mesh_frequency[mesh.id],
             "phase_cycles": kin.mesh_phase[mesh.id], "loaded_flank": kin.flanks[mesh.id],
             "mean_stiffness_n_per_m": float(model.excitation.mean_stiffness[j]),

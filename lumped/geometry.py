@@ -1,4 +1,11 @@
-"""Involute spur-gear geometry (ISO 21771 conventions, transverse plane).
+"""Involute gear geometry (ISO 21771 conventions), worked in the transverse plane.
+
+A helical gear is described by its normal module m_n, normal pressure angle alpha_n and signed
+helix angle beta (positive: right hand); the transverse plane sees a spur gear of module
+m_t = m_n / cos(beta) and pressure angle tan(alpha_t) = tan(alpha_n) / cos(beta), while addenda,
+dedenda and profile shifts stay in normal modules (x m_n) and the profile shift's effect on tooth
+thickness and operating pressure angle goes with tan(alpha_n) (ISO 21771, clauses 4-5).  With
+beta = 0 every formula is the spur one.
 
 Internal gears (rings) use positive teeth counts with ``internal=True``; a positive
 profile shift of a ring moves its teeth outward (larger tip radius, larger operating
@@ -42,6 +49,31 @@ class Gear:
     base_radius: float
     eccentricity: float = 0.0
     eccentricity_phase: float = 0.0
+    helix_angle: float = 0.0  # signed: positive a right-hand helix
+
+    @property
+    def normal_module(self) -> float:
+        """m_n = m_t cos(beta): the unit of addenda, dedenda and profile shifts."""
+        return self.module * math.cos(self.helix_angle)
+
+    @property
+    def normal_pressure_angle(self) -> float:
+        return self.pressure_angle if self.helix_angle == 0.0 else math.atan(self.tan_normal_pressure_angle)
+
+    @property
+    def tan_normal_pressure_angle(self) -> float:
+        """tan(alpha_n) = tan(alpha_t) cos(beta)."""
+        return math.tan(self.pressure_angle) * math.cos(self.helix_angle)
+
+    @property
+    def base_helix_angle(self) -> float:
+        """|beta_b|: tan(beta_b) = tan(beta) cos(alpha_t)."""
+        return math.atan(abs(math.tan(self.helix_angle)) * math.cos(self.pressure_angle))
+
+    @property
+    def hand(self) -> int:
+        """+1 right hand, -1 left hand, 0 spur."""
+        return (self.helix_angle > 0) - (self.helix_angle < 0)
 
     @property
     def pitch_radius(self) -> float:
@@ -50,14 +82,14 @@ class Gear:
     @property
     def tip_radius(self) -> float:
         """Addendum circle; for a ring the inner (tooth tip) circle."""
-        m, x = self.module, self.profile_shift
+        m, x = self.normal_module, self.profile_shift
         if self.internal:
             return self.pitch_radius - m * (self.addendum - x)
         return self.pitch_radius + m * (self.addendum + x)
 
     @property
     def root_radius(self) -> float:
-        m, x = self.module, self.profile_shift
+        m, x = self.normal_module, self.profile_shift
         if self.internal:
             return self.pitch_radius + m * (self.dedendum + x)
         return self.pitch_radius - m * (self.dedendum - x)
@@ -77,29 +109,37 @@ class MeshGeometry:
 
     pressure_angle: float
     centre_distance: float
-    contact_ratio: float
-    base_pitch: float
+    contact_ratio: float  # transverse, eps_alpha
+    base_pitch: float  # transverse
     central_pitch_radius: float
     planet_pitch_radius: float
+    base_helix_angle: float = 0.0  # |beta_b|
+    face_contact_ratio: float = 0.0  # eps_beta = b sin|beta| / (pi m_n), b the narrower face
+    face_width: float = 0.0  # the narrower face: the length of contact across the face
+
+    @property
+    def total_contact_ratio(self) -> float:
+        return self.contact_ratio + self.face_contact_ratio
 
 
 def mesh_geometry(central: Gear, planet: Gear) -> MeshGeometry:
     """Operating pressure angle, centre distance and transverse contact ratio of a pair.
 
-    External pair (sun-planet):  inv a' = inv a + 2 tan a (x1 + x2)/(z1 + z2),
-    internal pair (ring-planet): inv a' = inv a + 2 tan a (x_r - x_p)/(z_r - z_p);
-    a' = a0 cos a / cos a', eps_a = (g_a)/p_b with the path of contact
+    External pair (sun-planet):  inv a' = inv a_t + 2 tan a_n (x1 + x2)/(z1 + z2),
+    internal pair (ring-planet): inv a' = inv a_t + 2 tan a_n (x_r - x_p)/(z_r - z_p);
+    a' = a0 cos a_t / cos a', eps_a = (g_a)/p_bt with the path of contact
     g_a = sqrt(ra1^2 - rb1^2) + sqrt(ra2^2 - rb2^2) - a' sin a' (external) or
-    g_a = sqrt(ra_p^2 - rb_p^2) - sqrt(ra_r^2 - rb_r^2) + a' sin a' (internal).
+    g_a = sqrt(ra_p^2 - rb_p^2) - sqrt(ra_r^2 - rb_r^2) + a' sin a' (internal);
+    eps_b = b sin|beta| / (pi m_n) with b the narrower face width.
     """
-    alpha = central.pressure_angle
+    alpha, tan_n = central.pressure_angle, central.tan_normal_pressure_angle
     zc, zp = central.teeth, planet.teeth
     base_pitch = central.base_pitch
     if central.internal:
-        inv_op = involute(alpha) + 2.0 * math.tan(alpha) * (central.profile_shift - planet.profile_shift) / (zc - zp)
+        inv_op = involute(alpha) + 2.0 * tan_n * (central.profile_shift - planet.profile_shift) / (zc - zp)
         a_ref = central.base_radius - planet.base_radius
     else:
-        inv_op = involute(alpha) + 2.0 * math.tan(alpha) * (central.profile_shift + planet.profile_shift) / (zc + zp)
+        inv_op = involute(alpha) + 2.0 * tan_n * (central.profile_shift + planet.profile_shift) / (zc + zp)
         a_ref = central.base_radius + planet.base_radius
     alpha_op = inverse_involute(inv_op)
     centre = a_ref / math.cos(alpha_op)
@@ -110,6 +150,7 @@ def mesh_geometry(central: Gear, planet: Gear) -> MeshGeometry:
         path = along_planet - along_central + centre * math.sin(alpha_op)
     else:
         path = along_central + along_planet - centre * math.sin(alpha_op)
+    width = min(central.face_width, planet.face_width)
     return MeshGeometry(
         pressure_angle=alpha_op,
         centre_distance=centre,
@@ -117,12 +158,20 @@ def mesh_geometry(central: Gear, planet: Gear) -> MeshGeometry:
         base_pitch=base_pitch,
         central_pitch_radius=central.base_radius / math.cos(alpha_op),
         planet_pitch_radius=planet.base_radius / math.cos(alpha_op),
+        base_helix_angle=central.base_helix_angle,
+        face_contact_ratio=width * abs(math.sin(central.helix_angle)) / (math.pi * central.normal_module),
+        face_width=width,
     )
 
 
+def reference_tooth_thickness(gear: Gear) -> float:
+    """Transverse arc tooth thickness on the reference circle, s_t = m_t (pi/2 + 2 x tan a_n)."""
+    return gear.module * (math.pi / 2 + 2 * gear.profile_shift * gear.tan_normal_pressure_angle)
+
+
 def base_tooth_thickness(gear: Gear) -> float:
-    """Arc tooth thickness on the base circle, s_b = r_b (s/r + 2 inv a), s = m (pi/2 + 2 x tan a)."""
-    s = gear.module * (math.pi / 2 + 2 * gear.profile_shift * math.tan(gear.pressure_angle))
+    """Arc tooth thickness on the base circle, s_b = r_b (s_t/r + 2 inv a_t)."""
+    s = reference_tooth_thickness(gear)
     return gear.base_radius * (s / gear.pitch_radius + 2 * involute(gear.pressure_angle))
 
 
@@ -137,16 +186,16 @@ point: the edge break every tooth tip carries (drawings specify about 0.05 m) ta
 
 def tip_thickness(gear: Gear) -> float:
     """Arc tooth thickness on the tip circle of an external gear (ISO 21771):
-    s_a = d_a (s/d + inv a - inv a_a), a_a = arccos(r_b / r_a), s = m (pi/2 + 2 x tan a)."""
-    s = gear.module * (math.pi / 2 + 2 * gear.profile_shift * math.tan(gear.pressure_angle))
+    s_a = d_a (s_t/d + inv a_t - inv a_a), a_a = arccos(r_b / r_a) (transverse)."""
+    s = reference_tooth_thickness(gear)
     alpha_tip = math.acos(min(gear.base_radius / gear.tip_radius, 1.0))
     return 2 * gear.tip_radius * (s / (2 * gear.pitch_radius) + involute(gear.pressure_angle) - involute(alpha_tip))
 
 
 def undercut_limit(gear: Gear) -> float:
     """The smallest profile shift of an external gear generated by a rack without undercut,
-    x_min = h_a* - z sin^2(a) / 2 (ISO 21771; the tool's addendum taken as the gear's own)."""
-    return gear.addendum - 0.5 * gear.teeth * math.sin(gear.pressure_angle) ** 2
+    x_min = h_a* - z sin^2(a_t) / (2 cos beta) (ISO 21771; the tool's addendum taken as the gear's own)."""
+    return gear.addendum - 0.5 * gear.teeth * math.sin(gear.pressure_angle) ** 2 / math.cos(gear.helix_angle)
 
 
 def along_line(gear: Gear) -> float:
@@ -156,7 +205,7 @@ def along_line(gear: Gear) -> float:
 
 def gear_problem(gear: Gear) -> tuple[str, str] | None:
     """(field, message) of the first thing that makes ``gear`` an impossible involute gear, or None."""
-    m = gear.module
+    m = gear.normal_module
     if gear.tip_radius <= gear.base_radius:
         return "addendum_coefficient", (f"tip circle r_a = {gear.tip_radius * 1e3:.4g} mm lies inside the base circle "
                                         f"r_b = {gear.base_radius * 1e3:.4g} mm: there is no involute flank there")
@@ -180,8 +229,14 @@ def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[s
     """(which gear: "central" or "planet", message) of the first thing that stops the pair meshing as
     involutes, or None: tips meeting the mate below its base circle (involute interference), tips
     hitting the mate's root circle, a transverse contact ratio below ``MIN_CONTACT_RATIO``."""
+    same_hand = central.internal  # an internal pair's helices run the same way, an external pair's opposite
+    if central.helix_angle != (planet.helix_angle if same_hand else -planet.helix_angle):
+        return "central", (f"helix angle {math.degrees(central.helix_angle):.6g} deg cannot mesh with "
+                           f"{planet.name}'s {math.degrees(planet.helix_angle):.6g} deg: an "
+                           f"{'internal' if same_hand else 'external'} pair needs equal helix angles of "
+                           f"{'the same' if same_hand else 'opposite'} hand (positive = right hand)")
     line = geometry.centre_distance * math.sin(geometry.pressure_angle)  # between the tangent points
-    a, m = geometry.centre_distance, central.module
+    a, m = geometry.centre_distance, central.normal_module
     if central.internal:  # the ring's tip contact must lie beyond the planet's tangent point
         reach = {"central": line - along_line(central)}
         clearance = {"central": central.tip_radius - (a + planet.root_radius),

@@ -1,4 +1,4 @@
-"""Tooth stiffness of spur gears by ISO 6336-1:2006, method B (clause 9).
+"""Tooth stiffness of spur and helical gears by ISO 6336-1:2006, method B (clause 9).
 
 A quick, empirical estimate to set a train's ``mean`` mesh stiffness or to check a computed
 one.  ISO works in N/(mm·µm) per unit face width; here everything is SI: stiffness per unit
@@ -11,7 +11,9 @@ face width in N/m², so 1 N/(mm·µm) = 1e9 N/m².
 * single stiffness c' = c'_th C_M C_R C_B (E/E_st), C_M = 0.8 the correction between
   theory and measurement, C_R = 1 (solid gear blanks), C_B = [1 + 0.5 (1.2 - h_fP/m)]
   [1 - 0.02 (20° - alpha_P)] the basic rack factor (the mean of both gears');
-* mean mesh stiffness per face width c_gamma_alpha = c' (0.75 eps_alpha + 0.25).
+* mean mesh stiffness per face width c_gamma_alpha = c' (0.75 eps_alpha + 0.25);
+* helical gears: q' with the virtual teeth numbers z_n = z / (cos^2(beta_b) cos(beta)), and c' times
+  cos(beta); the basic rack factor with the normal pressure angle.
 
 The values hold for a line load F_t K_A / b >= 100 N/mm.  For an internal pair the ring is
 gear 2 with z_n2 -> infinity.  With ISO 21771's signed teeth count (z2 < 0,
@@ -39,29 +41,61 @@ def _pair(mesh):
     return pinion.teeth, pinion.profile_shift, wheel.teeth, wheel.profile_shift
 
 
-def theoretical_single_stiffness(mesh) -> float:
-    """c'_th = 1/q' in N/m² (N/m of line of action per m of face width)."""
+def theoretical_single_stiffness_of(z1: float, x1: float, z2: float, x2: float, beta: float = 0.0,
+                                    normal_pressure_angle: float = math.radians(20.0)) -> float:
+    """c'_th = 1/q' in N/m² (N/m of line of action per m of face width) of a pair with z1 <= z2 teeth
+    (z2 = inf: an internal wheel), profile shifts x1, x2, helix angle beta (virtual teeth numbers)."""
+    if beta:
+        cos_bb2 = 1.0 - (math.sin(beta) * math.cos(normal_pressure_angle)) ** 2
+        z1, z2 = (z / (cos_bb2 * math.cos(beta)) for z in (z1, z2))
     c1, c2, c3, c4, c5, c6, c7, c8, c9 = Q_COEFFICIENTS
-    z1, x1, z2, x2 = _pair(mesh)
     q = c1 + c2 / z1 + c3 / z2 + c4 * x1 + c5 * x1 / z1 + c6 * x2 + c7 * x2 / z2 + c8 * x1**2 + c9 * x2**2
     return UNIT / q
 
 
-def basic_rack_factor(mesh) -> float:
-    """C_B, the mean over both gears of [1 + 0.5 (1.2 - h_fP/m)] [1 - 0.02 (20 - alpha_P/deg)]."""
-    def factor(gear):
-        return (1 + 0.5 * (1.2 - gear.dedendum)) * (1 - 0.02 * (20.0 - math.degrees(gear.pressure_angle)))
+def rack_factor(dedendum: float, normal_pressure_angle: float) -> float:
+    """C_B of one basic rack: [1 + 0.5 (1.2 - h_fP/m)] [1 - 0.02 (20 - alpha_P/deg)]."""
+    return (1 + 0.5 * (1.2 - dedendum)) * (1 - 0.02 * (20.0 - math.degrees(normal_pressure_angle)))
 
-    return 0.5 * (factor(mesh.central_gear) + factor(mesh.planet_gear))
+
+def single_stiffness_of(z1: float, x1: float, z2: float, x2: float, beta: float = 0.0,
+                        normal_pressure_angle: float = math.radians(20.0), rack: float | None = None,
+                        youngs_modulus: float = STEEL_MODULUS, correction: float = CORRECTION_FACTOR) -> float:
+    """c' = c'_th C_M C_R C_B cos(beta) (E/E_st) in N/m²; ``rack`` C_B (default: h_fP = 1.25 m at the
+    pressure angle); ``correction=1`` gives the theoretical value without C_M."""
+    rack = rack_factor(1.25, normal_pressure_angle) if rack is None else rack
+    return (theoretical_single_stiffness_of(z1, x1, z2, x2, beta, normal_pressure_angle) * correction * rack
+            * math.cos(beta) * youngs_modulus / STEEL_MODULUS)
+
+
+def mean_stiffness_of(single: float, contact_ratio: float, face_width: float) -> float:
+    """c_gamma_alpha b = c' (0.75 eps_alpha + 0.25) b in N/m, from c' (N/m²)."""
+    return single * (0.75 * contact_ratio + 0.25) * face_width
+
+
+def theoretical_single_stiffness(mesh) -> float:
+    """c'_th = 1/q' in N/m² of a mesh (:class:`~gearcheck.lumped.spec.MeshSpec`)."""
+    return theoretical_single_stiffness_of(*_pair(mesh), *_helix(mesh))
+
+
+def _helix(mesh) -> tuple[float, float]:
+    """(|beta|, alpha_n) of the pair."""
+    gear = mesh.central_gear
+    return abs(gear.helix_angle), gear.normal_pressure_angle
+
+
+def basic_rack_factor(mesh) -> float:
+    """C_B, the mean over both gears' basic racks."""
+    return 0.5 * sum(rack_factor(g.dedendum, g.normal_pressure_angle) for g in (mesh.central_gear, mesh.planet_gear))
 
 
 def single_stiffness(mesh, youngs_modulus: float = STEEL_MODULUS, correction: float = CORRECTION_FACTOR) -> float:
-    """c' in N/m²; ``correction=1`` gives the theoretical value c'_th C_B (no C_M)."""
-    return theoretical_single_stiffness(mesh) * correction * basic_rack_factor(mesh) * youngs_modulus / STEEL_MODULUS
+    """c' in N/m²; ``correction=1`` gives the theoretical value c'_th C_B cos(beta) (no C_M)."""
+    return single_stiffness_of(*_pair(mesh), *_helix(mesh), basic_rack_factor(mesh), youngs_modulus, correction)
 
 
 def mean_mesh_stiffness(mesh, youngs_modulus: float = STEEL_MODULUS, correction: float = CORRECTION_FACTOR) -> float:
     """c_gamma_alpha times the face width: the mean mesh stiffness of the pair in N/m."""
-    width = min(mesh.central_gear.face_width, mesh.planet_gear.face_width)
-    eps = mesh.geometry.contact_ratio
-    return single_stiffness(mesh, youngs_modulus, correction) * (0.75 * eps + 0.25) * width
+    g = mesh.geometry
+    return mean_stiffness_of(single_stiffness(mesh, youngs_modulus, correction), g.contact_ratio,
+                             min(mesh.central_gear.face_width, mesh.planet_gear.face_width))

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from gearcheck.lumped import tooth_stiffness
+from gearcheck.lumped import helical_mesh, tooth_stiffness
 from gearcheck.lumped.schema import REQUIRED, Context, Integer, Number, Positive, Table, bound
 
 
@@ -141,8 +141,38 @@ class EnergyMethodStiffness(MeshStiffness):
         return float(max(np.max(k) for k in self.values))
 
 
+class ContactLineStiffness(MeshStiffness):
+    """k(xi) = k_mean L(xi) / L_m: a stiffness per unit length of the lines of contact times their total
+    length (Maatar & Velex 1996), for helical gears from the transverse and face contact ratios; for
+    spur gears (eps_b = 0) the rectangular wave.  L is continuous and piecewise linear for a helical
+    pair, with kinks where a line's end reaches a corner of the plane of action."""
+
+    name = "contact-line"
+    references = ("maatar-velex-1996",)
+
+    def __init__(self, params: dict, mesh):
+        super().__init__(params, mesh)
+        g = mesh.geometry
+        self.face_contact_ratio = g.face_contact_ratio
+        self._line = (g.contact_ratio, g.face_contact_ratio, g.face_width, g.base_helix_angle)
+        self._mean_length = helical_mesh.mean_contact_line_length(g.contact_ratio, g.face_width, g.base_helix_angle)
+
+    def __call__(self, xi):
+        return self.mean / self._mean_length * helical_mesh.contact_line_length(xi, *self._line)
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Where a line's end reaches a corner: frac of 0, eps_a, eps_b and eps_a + eps_b."""
+        eps_a, eps_b = self.contact_ratio, self.face_contact_ratio
+        return tuple(sorted({round(math.fmod(x, 1.0), 15) for x in (0.0, eps_a, eps_b, eps_a + eps_b)}))
+
+    @property
+    def maximum(self) -> float:
+        return float(np.max(self(np.array(self.breaks))))
+
+
 MODELS: dict[str, type[MeshStiffness]] = {
-    cls.name: cls for cls in (ConstantStiffness, RectangularStiffness, EnergyMethodStiffness)}
+    cls.name: cls for cls in (ConstantStiffness, RectangularStiffness, EnergyMethodStiffness, ContactLineStiffness)}
 
 
 def stiffness_model(mesh) -> MeshStiffness:

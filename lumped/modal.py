@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+from gearcheck.lumped.assembly import AXIAL_DOF
 from gearcheck.shared import modal as shared
 from gearcheck.shared.modal import ModalResult, modal_result
 from gearcheck.shared.units import rad_s_to_rpm
@@ -18,7 +19,8 @@ from gearcheck.shared.units import rad_s_to_rpm
 def _central(model) -> tuple[list[int], list[int]]:
     central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
                if not model.spec.members[member].is_planet]
-    return [i for i, d in central if d != "theta"], [i for i, d in central if d == "theta"]
+    turning = ("theta", AXIAL_DOF)  # a helical mesh's axial force goes with its torque (Eritenel & Parker 2009)
+    return [i for i, d in central if d not in turning], [i for i, d in central if d in turning]
 
 
 def modes(model) -> ModalResult:

@@ -289,13 +289,13 @@ def _did_you_mean(word: str, candidates) -> str:
 
 GEOMETRY = {
     "teeth": Integer("number of teeth (ring: internal teeth)", minimum=1, maximum=int(bound("teeth"))),
-    "module_mm": Number("transverse module; defaults to the stage's module", "mm", None, MIN_MODULE_MM, False,
-                        bound("module", MM)),
-    "pressure_angle_deg": Number("standard pressure angle; defaults to the stage's", "deg", None, 0.0, True, 45.0),
+    "module_mm": Number("normal module m_n (a spur gear's module); defaults to the stage's module", "mm", None,
+                        MIN_MODULE_MM, False, bound("module", MM)),
+    "pressure_angle_deg": Number("normal pressure angle; defaults to the stage's", "deg", None, 0.0, True, 45.0),
     "face_width_mm": Number("face width; defaults to the stage's", "mm", None, MIN_MODULE_MM, False,
                             bound("length", MM)),
-    "helix_angle_deg": Number("helix angle (reserved for helical gears: must be 0 for now)", "deg", 0.0,
-                              -89.0, False, 89.0),
+    "helix_angle_deg": Number("signed helix angle (positive: right hand); defaults to the stage's planets' angle, "
+                              "negated for a sun", "deg", None, -45.0, False, 45.0),
     "addendum_coefficient": NonNegative("addendum h_a* in modules; defaults to the stage's", "-", None, 3.0),
     "dedendum_coefficient": NonNegative("dedendum h_f* in modules; defaults to the stage's", "-", None, 3.0),
     "profile_shift": Number("profile shift coefficient x (ring: positive moves the teeth outward)", "-", 0.0,
@@ -334,6 +334,9 @@ SUPPORT = Table(
         "torsional_stiffness": NonNegative("torsional stiffness to the housing (0 = free rotation)", "N·m/rad", 0.0,
                                            bound("stiffness")),
         "torsional_damping": NonNegative("torsional damping to the housing", "N·m·s/rad", 0.0, bound("damping")),
+        "axial_stiffness": NonNegative("axial stiffness to the housing (helical stages need it)", "N/m", 0.0,
+                                       bound("stiffness")),
+        "axial_damping": NonNegative("axial damping to the housing", "N·s/m", 0.0, bound("damping")),
     },
     "support of a central member (sun, ring, carrier) on the housing",
 )
@@ -343,6 +346,9 @@ PLANET_BEARING = Table(
         "radial_stiffness": Positive("stiffness of the planet bearing, radial and tangential", "N/m", REQUIRED,
                                      bound("stiffness")),
         "radial_damping": NonNegative("damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
+        "axial_stiffness": NonNegative("axial stiffness of the planet on its pin (helical stages need it)", "N/m",
+                                       0.0, bound("stiffness")),
+        "axial_damping": NonNegative("axial damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
     },
     "planet bearing on the carrier pin",
 )
@@ -426,9 +432,12 @@ STAGE = Table(
         "planet_angles_deg": ListOf(Number("angle", "deg", REQUIRED, -3600.0, False, 3600.0),
                                     "planet angles (default: equally spaced)", None,
                                     unit="deg"),
-        "module_mm": Number("default transverse module of the stage's gears", "mm", None, MIN_MODULE_MM, False,
+        "module_mm": Number("default normal module of the stage's gears", "mm", None, MIN_MODULE_MM, False,
                             bound("module", MM)),
-        "pressure_angle_deg": Number("default pressure angle", "deg", 20.0, 0.0, True, 45.0),
+        "pressure_angle_deg": Number("default normal pressure angle", "deg", 20.0, 0.0, True, 45.0),
+        "helix_angle_deg": Number("signed helix angle of the planets (positive: right hand); suns get its negative, "
+                                  "rings the same; each member gains an axial degree of freedom", "deg", 0.0, -45.0,
+                                  False, 45.0),
         "face_width_mm": Number("default face width", "mm", None, MIN_MODULE_MM, False, bound("length", MM)),
         "addendum_coefficient": NonNegative("default addendum coefficient h_a*", "-", 1.0, 3.0),
         "dedendum_coefficient": NonNegative("default dedendum coefficient h_f*", "-", 1.25, 3.0),

@@ -38,6 +38,8 @@ class Support:
     radial_damping: float = 0.0
     torsional_stiffness: float = 0.0
     torsional_damping: float = 0.0
+    axial_stiffness: float = 0.0
+    axial_damping: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -135,6 +137,7 @@ class Stage:
     centrals: tuple[str, ...]  # member ids of sun/ring gears
     planets: tuple[str, ...]
     carrier: str
+    helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
 
 
 @dataclass(frozen=True)
@@ -355,11 +358,14 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
     teeth = raw["teeth"]
     if teeth < MIN_TEETH:
         raise fail(f"{path}.teeth", f"an involute gear needs at least {MIN_TEETH} teeth, got {teeth}")
-    if raw["helix_angle"] != 0.0:
-        raise fail(f"{path}.helix_angle_deg", "helical gears are not supported yet; helix angle must be 0")
-    module = pick("module", "module_mm")
-    alpha = pick("pressure_angle", "pressure_angle_deg")
-    _check_small(raw["eccentricity"], MAX_ERROR, module, f"{path}.eccentricity_um", "eccentricity", fail)
+    beta = raw["helix_angle"]
+    if beta is None:  # the stage's angle is the planets'; a sun's helix runs the other way
+        beta = -stage["helix_angle"] if not internal and name.startswith("sun") else stage["helix_angle"]
+    normal_module = pick("module", "module_mm")
+    normal_alpha = pick("pressure_angle", "pressure_angle_deg")
+    module = normal_module / math.cos(beta)  # transverse (ISO 21771): m_t = m_n / cos(beta)
+    alpha = normal_alpha if beta == 0.0 else math.atan(math.tan(normal_alpha) / math.cos(beta))
+    _check_small(raw["eccentricity"], MAX_ERROR, normal_module, f"{path}.eccentricity_um", "eccentricity", fail)
     base = raw["base_radius"] if raw["base_radius"] is not None else 0.5 * module * teeth * math.cos(alpha)
     pitch = 0.5 * module * teeth
     if not 0.5 * pitch < base < pitch:  # cos a between 0.5 and 1: pressure angles of 0 to 60 deg
@@ -370,7 +376,7 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
         addendum=pick("addendum_coefficient", "addendum_coefficient"),
         dedendum=pick("dedendum_coefficient", "dedendum_coefficient"),
         profile_shift=raw["profile_shift"], internal=internal, base_radius=base,
-        eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"],
+        eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"], helix_angle=beta,
     )
 
 
@@ -412,7 +418,7 @@ def _body(raw: dict, radius: float, path: str, fail, gear: Gear | None = None) -
 
 def _support(raw: dict) -> Support:
     return Support(raw["radial_stiffness"], raw["radial_damping"], raw.get("torsional_stiffness", 0.0),
-                   raw.get("torsional_damping", 0.0))
+                   raw.get("torsional_damping", 0.0), raw["axial_stiffness"], raw["axial_damping"])
 
 
 def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:
@@ -564,9 +570,35 @@ def _build_stage(st: dict, path: str, fail):
                 damping_ratio=damping["ratio"], damping_coefficient=damping["coefficient"],
                 backlash=mesh["backlash"] or 0.0, ste=ste, planet_index=k,
             ))
+    helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
+    if helical:
+        _check_helical(st, centrals, meshes, path, fail)
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in central_keys),
-                  tuple(planet_ids), carrier_id)
+                  tuple(planet_ids), carrier_id, helical)
     return members, stage, meshes
+
+
+SPUR_ONLY_STIFFNESS = {"rectangular": "its wave counts tooth pairs from the transverse contact ratio alone",
+                       "energy": "its energy method slices spur teeth"}
+
+
+def _check_helical(st: dict, centrals, meshes, path: str, fail) -> None:
+    """A helical stage's members move axially: each needs an axial support (else its axial motion is free and
+    the meshes' axial forces push it away), and its meshes a stiffness model that sees the helix."""
+    for key in list(centrals) + ["carrier"]:
+        if not st[key]["support"]["axial_stiffness"]:
+            raise fail(f"{path}.{key}.support.axial_stiffness", "a helical stage needs it > 0: the meshes' axial "
+                                                                "forces act on every member")
+    if not st["planet"]["bearing"]["axial_stiffness"]:
+        raise fail(f"{path}.planet.bearing.axial_stiffness", "a helical stage needs it > 0: the sun and ring meshes "
+                                                             "push each planet axially")
+    for mesh in meshes:
+        model = mesh.stiffness["model"]
+        if model in SPUR_ONLY_STIFFNESS:
+            key = mesh.central.split(".")[-1]
+            raise fail(f"{path}.{key}.mesh.stiffness.model", f"{model!r} is for spur gears "
+                                                            f"({SPUR_ONLY_STIFFNESS[model]}); a helical mesh "
+                                                            "needs 'contact-line' or 'constant'")
 
 
 def _check_small(value: float, limit: float, module: float, path: str, what: str, fail) -> None:

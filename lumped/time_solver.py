@@ -313,7 +313,7 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     angle = np.empty((t.size, len(members)))
     for j, mid in enumerate(members):
         member = spec.members[mid]
-        iu, iv, ith = dofs.of_member(mid)
+        iu, iv, ith = dofs.of_member(mid)[:3]
         omega = model.kin.speeds[f"{member.stage}.carrier"] if model.rotating_frame_terms else 0.0
         # inertial acceleration in rotating axes: q'' + 2 Omega k x q' + Omega k x (Omega k x (q + r0))
         acc[:, j, 0] = qdd[:, iu] - 2 * omega * v[:, iv] - omega**2 * (q[:, iu] + member.radius)

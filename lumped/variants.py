@@ -61,3 +61,14 @@ def wide_stage(n_planets: int, teeth: tuple[int, int, int] = (30, 24, 78), torqu
         pairs.append((r"^input_shaft_.*\n", ""))
     return edited("demo-3p", pairs, f"{n_planets} planets, z = {z_s}/{z_p}/{z_r}"
                   + (", torque-driven" if torque_driven else ""))
+
+
+def helical_stage(helix_deg: float = 15.0, axial_stiffness: float = 5.0e8, stiffness: str = "constant") -> TrainSpec:
+    """demo-3p with helical gears (planets ``helix_deg``, positive = right hand; the sun the other hand), every
+    member held axially by ``axial_stiffness`` (N/m, damping as its radial support's) and the mesh stiffness
+    model ``stiffness`` at demo-3p's mean."""
+    axial = f"axial_stiffness = {axial_stiffness!r}, axial_damping = 500.0"
+    pairs = [(r"^face_width_mm = 40.0$", f"face_width_mm = 40.0\nhelix_angle_deg = {helix_deg!r}"),
+             (r'model = "rectangular"', f'model = "{stiffness}"'),
+             (r"^(support|bearing) = \{ (.*) \}$", rf"\1 = {{ \2, {axial} }}")]
+    return edited("demo-3p", pairs, f"helical {helix_deg:g} deg")

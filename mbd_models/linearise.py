@@ -125,8 +125,13 @@ def modes(mb) -> ModalResult:
 
 
 def _central(mb) -> tuple[list[int], list[int]]:
-    central = [mb.dadr[mid] for mid, member in mb.spec.members.items() if not member.is_planet]
-    return [i for x, y, _ in central for i in (x, y)], [rz for _, _, rz in central]
+    """(translation, rotation) dofs of the central members; an axial slide goes with the rotation (a helical
+    mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes)."""
+    m = mb.model
+    central = [mid for mid, member in mb.spec.members.items() if not member.is_planet]
+    axial = [int(m.jnt_dofadr[j]) for mid in central
+             if (j := mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, mb.spec.members[mid].label + "_z")) >= 0]
+    return [i for mid in central for i in mb.dadr[mid][:2]], [mb.dadr[mid][2] for mid in central] + axial
 
 
 def modes_at_speed(mb, input_speed: float) -> ModalResult:

@@ -11,6 +11,9 @@ Bodies and joints (all planar, gravity off):
   along the carrier's radial and tangential axes and a hinge ``<label>_rz`` (rotation
   relative to the carrier); its bearing is the slides' stiffness and damping.
   A compound planet is one body;
+* in a helical stage every member also slides along the stage axis: ``<label>_z`` (central members
+  along the world's z, with the support's axial stiffness; planets relative to their carrier, with
+  the bearing's axial stiffness);
 * interstage couplings are fixed tendons (torsion, and x/y when radial stiffness is given);
 * the input shaft is an ``intvelocity`` actuator (kp = shaft stiffness) on the input hinge:
   its activation, the reference angle, integrates the control w_in inside MuJoCo's RK4
@@ -21,7 +24,8 @@ Bodies and joints (all planar, gravity off):
   load and input torques are ``motor`` actuators with gear 1.
 
 Meshes: each mesh is a ``<fixed>`` tendon over the nine joints that move its pitch point (the
-central member's and the carrier's slides and hinges, the planet's slides and hinge), whose length
+central member's and the carrier's slides and hinges, the planet's slides and hinge; twelve with the
+axial slides of a helical stage), whose length
 is the mesh deflection.  The coefficients are not written from a formula here: they are given,
 taken by :func:`gearcheck.mbd_models.twin.compile_train` from MuJoCo's own Jacobians.  A backlash
 b = backlash/2 is the two-valued spring length "-b b" (a dead band).
@@ -36,7 +40,7 @@ import math
 
 from gearcheck.lumped.spec import TrainSpec
 
-STAGE_SPACING = 0.12  # m along z between stages (visual only: all motion is planar)
+STAGE_SPACING = 0.12  # m along z between stages (visual only: stages do not touch)
 RGBA = {
     "sun": "0.95 0.6 0.1 1",
     "ring": "0.6 0.6 0.65 0.35",
@@ -45,6 +49,12 @@ RGBA = {
 }
 CENTRAL_AXES = ("x", "y")
 PLANET_AXES = ("radial", "tangential")
+AXIAL = "z"
+
+
+def axial(spec: TrainSpec, member) -> bool:
+    """Whether ``member`` slides along its stage's axis (every member of a helical stage does)."""
+    return spec.stage_of(member.id).helical
 
 
 def num(x) -> str:
@@ -96,13 +106,19 @@ def _geom(spec: TrainSpec, member, z: float = 0.0) -> str:
             f'rgba="{RGBA[member.kind]}" contype="0" conaffinity="0" group="1"/>')
 
 
+def _joints(spec, member, support, joints, indent: str) -> list[str]:
+    """The body's joints, (suffix, type, axis, stiffness, damping) each, and its axial slide in a helical stage."""
+    if axial(spec, member):
+        joints = joints + [(AXIAL, "slide", (0, 0, 1), support.axial_stiffness, support.axial_damping)]
+    return [f"{indent}  {_joint(f'{member.label}_{name}', kind, axis, k, c)}" for name, kind, axis, k, c in joints]
+
+
 def _central_body(spec, member, z_stage: float, indent: str, children: list[str]) -> list[str]:
     s = member.support
-    lines = [f'{indent}<body name="{member.label}" pos="{vec(0, 0, z_stage)}">',
-             f"{indent}  {_inertial(member)}",
-             f"{indent}  {_joint(member.label + '_x', 'slide', (1, 0, 0), s.radial_stiffness, s.radial_damping)}",
-             f"{indent}  {_joint(member.label + '_y', 'slide', (0, 1, 0), s.radial_stiffness, s.radial_damping)}",
-             f"{indent}  {_joint(member.label + '_rz', 'hinge', (0, 0, 1), s.torsional_stiffness, s.torsional_damping)}"]
+    lines = [f'{indent}<body name="{member.label}" pos="{vec(0, 0, z_stage)}">', f"{indent}  {_inertial(member)}"]
+    lines += _joints(spec, member, s, [("x", "slide", (1, 0, 0), s.radial_stiffness, s.radial_damping),
+                                       ("y", "slide", (0, 1, 0), s.radial_stiffness, s.radial_damping),
+                                       ("rz", "hinge", (0, 0, 1), s.torsional_stiffness, s.torsional_damping)], indent)
     z_geom = -2.0 * max((_visual_halfwidth(spec.members[p]) for p in spec.stage_of(member.id).planets),
                         default=0.01) if member.kind == "carrier" else 0.0
     lines.append(f"{indent}  {_geom(spec, member, z_geom)}")
@@ -114,13 +130,12 @@ def _central_body(spec, member, z_stage: float, indent: str, children: list[str]
 def _planet_body(spec, member, indent: str) -> list[str]:
     b = member.bearing
     c, s = math.cos(member.angle), math.sin(member.angle)
-    return [f'{indent}<body name="{member.label}" pos="{vec(member.radius * c, member.radius * s, 0)}">',
-            f"{indent}  {_inertial(member)}",
-            f"{indent}  {_joint(member.label + '_radial', 'slide', (c, s, 0), b.radial_stiffness, b.radial_damping)}",
-            f"{indent}  {_joint(member.label + '_tangential', 'slide', (-s, c, 0), b.radial_stiffness, b.radial_damping)}",
-            f"{indent}  {_joint(member.label + '_rz', 'hinge', (0, 0, 1))}",
-            f"{indent}  {_geom(spec, member)}",
-            f"{indent}</body>"]
+    lines = [f'{indent}<body name="{member.label}" pos="{vec(member.radius * c, member.radius * s, 0)}">',
+             f"{indent}  {_inertial(member)}"]
+    lines += _joints(spec, member, b, [("radial", "slide", (c, s, 0), b.radial_stiffness, b.radial_damping),
+                                       ("tangential", "slide", (-s, c, 0), b.radial_stiffness, b.radial_damping),
+                                       ("rz", "hinge", (0, 0, 1), 0.0, 0.0)], indent)
+    return lines + [f"{indent}  {_geom(spec, member)}", f"{indent}</body>"]
 
 
 def _worldbody(spec: TrainSpec) -> list[str]:
@@ -170,11 +185,11 @@ def mesh_joints(spec: TrainSpec, mesh) -> list[str]:
     """The joints whose motion moves ``mesh``'s pitch point on either gear: the central member's slides
     and hinge, the carrier's (which carries the planet), the planet's slides and hinge."""
     joints = []
-    for mid in (mesh.central, spec.stage_of(mesh.planet).carrier):
-        label = spec.members[mid].label
-        joints += [f"{label}_{axis}" for axis in CENTRAL_AXES + ("rz",)]
-    label = spec.members[mesh.planet].label
-    return joints + [f"{label}_{axis}" for axis in PLANET_AXES + ("rz",)]
+    for mid in (mesh.central, spec.stage_of(mesh.planet).carrier, mesh.planet):
+        member = spec.members[mid]
+        axes = (PLANET_AXES if member.is_planet else CENTRAL_AXES) + ("rz",) + ((AXIAL,) if axial(spec, member) else ())
+        joints += [f"{member.label}_{a}" for a in axes]
+    return joints
 
 
 def mesh_tendons(spec: TrainSpec, coefficients, stiffness, damping) -> list[str]:

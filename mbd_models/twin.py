@@ -152,7 +152,7 @@ def mesh_jacobian_row(spec: TrainSpec, kin: Kinematics, model: mujoco.MjModel, d
     jy = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_y")
     origin = data.xpos[carrier] - np.array([data.qpos[model.jnt_qposadr[jx]], data.qpos[model.jnt_qposadr[jy]], 0.0])
     point = origin + R @ np.array([loa.pitch_point[0], loa.pitch_point[1], 0.0])
-    direction = R @ np.array([loa.direction[0], loa.direction[1], 0.0])
+    direction = R @ np.array([loa.direction[0], loa.direction[1], loa.axial])
     jac_c = np.zeros((3, model.nv))
     jac_p = np.zeros((3, model.nv))
     mujoco.mj_jac(model, data, jac_c, None, point, central)

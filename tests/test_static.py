@@ -16,7 +16,9 @@ def input_torque_through_meshes(spec, static):
     if not spec.members[sun].gears:
         return -static.row_forces[static.row_names.index("input_shaft")]
     r_b = next(iter(spec.members[sun].gears.values())).base_radius
-    return sum(f for m, f in zip(spec.meshes, static.mesh_force) if m.central == sun) * r_b
+    # a helical mesh's force is tilted by the base helix angle: its transverse part turns the gear
+    return sum(f * np.cos(m.geometry.base_helix_angle) for m, f in zip(spec.meshes, static.mesh_force)
+               if m.central == sun) * r_b
 
 
 def rigid_turn(model):

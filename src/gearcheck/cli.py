@@ -230,11 +230,14 @@ def cmd_show(args) -> int:
               f"{', '.join(f'{a:.6g}' for a in st['planet_angles_deg'])} deg, carrier radius "
               f"{st['carrier_radius_m'] * 1e3:.6g} mm")
         for name, g in st["gears"].items():
+            helix = f"  beta={g['helix_angle_deg']:+.6g} deg" if g["helix_angle_deg"] else ""
             print(f"    {name:<16} z={g['teeth']:<4d} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
-                  f"r_base={g['base_radius_m'] * 1e3:.6g} mm  r_tip={g['tip_radius_m'] * 1e3:.6g} mm")
+                  f"r_base={g['base_radius_m'] * 1e3:.6g} mm  r_tip={g['tip_radius_m'] * 1e3:.6g} mm{helix}")
     print("  meshes:")
     for m in info["meshes"]:
-        print(f"    {m['mesh']:<24} eps={m['contact_ratio']:.4f}  alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
+        face = f"+{m['face_contact_ratio']:.4f}" if m["face_contact_ratio"] else ""
+        print(f"    {m['mesh']:<24} eps={m['contact_ratio']:.4f}{face}  "
+              f"alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
               f"f_mesh={m['mesh_frequency_hz']:.6g} Hz  phase={m['phase_cycles']:.4f}  "
               f"k={m['mean_stiffness_n_per_m']:.4g} N/m ({m['stiffness_model']})  c={m['damping_n_s_per_m']:.4g} N·s/m")
     return 0

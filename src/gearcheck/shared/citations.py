@@ -48,6 +48,16 @@ REFERENCES: dict[str, Reference] = {
     "cooley-parker-2012": Reference(
         "Cooley C. G., Parker R. G.", 2012, "Vibration properties of high-speed planetary gears with gyroscopic "
         "effects", "Journal of Vibration and Acoustics 134(6), 061014"),
+    "eritenel-parker-2009": Reference(
+        "Eritenel T., Parker R. G.", 2009, "Modal properties of three-dimensional helical planetary gears",
+        "Journal of Sound and Vibration 325(1-2), 397-420"),
+    "maatar-velex-1996": Reference(
+        "Maatar M., Velex P.", 1996, "An analytical expression for the time-varying contact length in perfect "
+        "cylindrical gears: some possible applications in gear dynamics", "Journal of Mechanical Design 118(4), "
+        "586-589"),
+    "mo-2024": Reference(
+        "Mo S., Liu Z., Luo B., Cen G., Xu J.", 2024, "Dynamic characteristics of planetary gear transmission "
+        "system with tooth profile modification", "Journal of Vibration Engineering 37(2), 191-199 (in Chinese)"),
     "weber-1949": Reference(
         "Weber C.", 1949, "The deformation of loaded gears and the effect on their load-carrying capacity",
         "Sponsored Research (Germany), British Department of Scientific and Industrial Research, Report No. 3"),

@@ -3,8 +3,9 @@ mode types and multiplicities, and the result both solvers return.
 
 K q = omega^2 M q.  Mode types (Lin & Parker 1999, 2000):
 
-* rotational: the central members only rotate and all planets move alike;
-* translational: the central members only translate (degenerate pairs);
+* rotational: the central members only rotate (in a helical train: and move axially, Eritenel & Parker's
+  2009 rotational-axial modes) and all planets move alike;
+* translational: the central members only translate in the transverse plane (degenerate pairs);
 * planet: the central members do not move (multiplicity N - 3);
 * rigid: zero frequency (a free rotation);
 * mixed: none of these (unequal spacing, couplings between stages ...);

@@ -203,3 +203,44 @@ def campbell_diagram(result) -> bytes:
     png = io.BytesIO()
     _save(fig, png)
     return png.getvalue()
+
+
+def static_transmission_error(curves, train: str) -> bytes:
+    """PNG of the unloaded and loaded static TE over one mesh cycle of the first planet's meshes
+    (:func:`gearcheck.lumped.transmission_error.static_transmission_error`)."""
+    first = [c for c in curves if c.mesh.split(".")[1] in ("planet1",)] or curves[:1]
+    fig, axes = _figure(len(first), 1, figsize=(9, 2.4 * len(first)), sharex=True, squeeze=False)
+    for ax, c in zip(axes[:, 0], first):
+        ax.plot(c.xi, c.loaded * 1e6, color="tab:blue", lw=1.2, label=f"loaded ({c.load:.4g} N)")
+        ax.plot(c.xi, c.unloaded * 1e6, color="tab:orange", lw=1.0, label="unloaded")
+        ax.axhline(c.mean_deflection * 1e6, color="gray", ls="--", lw=0.8,
+                   label=f"F / k_mean = {c.mean_deflection * 1e6:.3g} um")
+        ax.set_ylabel("STE [um]")
+        ax.set_title(f"{c.mesh}: loaded peak-to-peak {np.ptp(c.loaded) * 1e6:.4g} um", fontsize=9)
+        ax.legend(loc="upper right", fontsize=7)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
+    fig.suptitle(f"{train}: static transmission error (mesh approach along the line of action)", fontsize=9)
+    png = io.BytesIO()
+    _save(fig, png)
+    return png.getvalue()
+
+
+def relief_sweep(sweep: dict, train: str) -> bytes:
+    """PNG of the loaded static TE peak-to-peak against the tip relief amount, per mesh of the first planet,
+    the load's mean deflection F / k_mean marked (:func:`gearcheck.lumped.transmission_error.relief_sweep`)."""
+    fig, ax = _figure(figsize=(9, 5))
+    amounts = np.array(sweep["amounts_m"]) * 1e6
+    for j, (mesh, data) in enumerate((m, d) for m, d in sweep["meshes"].items() if ".planet1." in m):
+        color = f"C{j}"
+        ax.plot(amounts, np.array(data["loaded_peak_to_peak_m"]) * 1e6, color=color, marker=".", label=mesh)
+        ax.axvline(data["mean_deflection_m"] * 1e6, color=color, ls="--", lw=0.8,
+                   label=f"{mesh}: F / k_mean = {data['mean_deflection_m'] * 1e6:.3g} um")
+    ax.set_xlabel("tip relief amount C_a [um]")
+    ax.set_ylabel("loaded STE peak-to-peak [um]")
+    ax.set_title(f"{train}: loaded static transmission error against the tip relief", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    png = io.BytesIO()
+    _save(fig, png)
+    return png.getvalue()

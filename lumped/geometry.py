@@ -50,6 +50,9 @@ class Gear:
     eccentricity: float = 0.0
     eccentricity_phase: float = 0.0
     helix_angle: float = 0.0  # signed: positive a right-hand helix
+    relief_amount: float = 0.0  # tip relief C_a, m
+    relief_length: float = 0.0  # its roll length L_a along the line of action, m
+    relief_power: int = 1  # 1 linear, 2 parabolic
 
     @property
     def normal_module(self) -> float:
@@ -209,6 +212,9 @@ def gear_problem(gear: Gear) -> tuple[str, str] | None:
     if gear.tip_radius <= gear.base_radius:
         return "addendum_coefficient", (f"tip circle r_a = {gear.tip_radius * 1e3:.4g} mm lies inside the base circle "
                                         f"r_b = {gear.base_radius * 1e3:.4g} mm: there is no involute flank there")
+    if gear.relief_length > along_line(gear):
+        return "tip_relief.length_mm", (f"{gear.relief_length * 1e3:.4g} mm reaches below the base circle: the flank's "
+                                        f"roll length from base to tip is {along_line(gear) * 1e3:.4g} mm")
     if gear.root_radius <= 0:
         return "dedendum_coefficient", f"root circle radius {gear.root_radius * 1e3:.4g} mm is not positive"
     if gear.internal:

@@ -306,6 +306,17 @@ GEOMETRY = {
                                    bound("displacement", UM)),
     "eccentricity_phase_deg": Number("angle of the eccentricity at t = 0, in the member's own frame", "deg", 0.0,
                                      -3600.0, False, 3600.0),
+    "tip_relief": Table(
+        {
+            "amount_um": NonNegative("material removed at the tip, normal to the flank (C_a)", "µm", REQUIRED,
+                                     bound("displacement", UM)),
+            "length_mm": Positive("roll length of the relief along the line of action, from the tip inward (L_a)",
+                                  "mm", REQUIRED, bound("length", MM)),
+            "shape": Text("how the relief grows towards the tip: (d/L_a)^1 or ^2", "linear", ("linear", "parabolic")),
+        },
+        "tip relief (profile modification) of the gear's teeth",
+        default=None,
+    ),
 }
 
 BODY = {

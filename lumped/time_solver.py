@@ -173,6 +173,7 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
         raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
     if drive not in ("steps", "stages"):
         raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
+    model.spec.check_time_run()
     limits = step_limits(model)
     dt = stepping.default_step(limits, model.excitation.frequency) if settings.dt is None else settings.dt
     what = f"lumped model of {model.spec.name}"

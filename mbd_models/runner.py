@@ -389,6 +389,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     the static start.  record_energy: enable ``mjENBL_ENERGY`` and return MuJoCo's kinetic and
     potential energy in ``raw``.
     """
+    mb.spec.check_time_run()
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
     spec, m = mb.spec, mb.model

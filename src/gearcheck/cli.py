@@ -18,6 +18,8 @@ import signal
 import sys
 from pathlib import Path
 
+import numpy as np
+
 import gearcheck
 from gearcheck.compare.crosscheck import MODELS
 from gearcheck.compare.progress import ProgressBar
@@ -89,18 +91,23 @@ SECONDS, RPM, HZ = _number("seconds"), _number("rpm"), _number("Hz")
 RPM_OR_ZERO = _number("rpm >= 0", positive=False, minimum=0.0)
 
 
-def SPEED_RANGE(text: str) -> list[float]:  # noqa: N802 - an argparse type, named like the others
-    """A:B:N -> N speeds from A to B rpm."""
-    parts = text.split(":")
-    try:
-        low, high, count = float(parts[0]), float(parts[1]), int(parts[2])
-        if len(parts) != 3:
-            raise ValueError
-    except (ValueError, IndexError):
-        raise argparse.ArgumentTypeError(f"must be A:B:N (rpm, rpm, count), got {text!r}") from None
-    if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high and 2 <= count <= 10000):
-        raise argparse.ArgumentTypeError(f"needs 0 <= A < B and 2 <= N <= 10000, got {text!r}")
-    return [low + (high - low) * i / (count - 1) for i in range(count)]
+def _range(unit: str):
+    """An argparse type: A:B:N -> N values from A to B (``unit``), 0 <= A < B."""
+    def parse(text: str) -> list[float]:
+        parts = text.split(":")
+        try:
+            low, high, count = float(parts[0]), float(parts[1]), int(parts[2])
+            if len(parts) != 3:
+                raise ValueError
+        except (ValueError, IndexError):
+            raise argparse.ArgumentTypeError(f"must be A:B:N ({unit}, {unit}, count), got {text!r}") from None
+        if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high and 2 <= count <= 10000):
+            raise argparse.ArgumentTypeError(f"needs 0 <= A < B and 2 <= N <= 10000, got {text!r}")
+        return [low + (high - low) * i / (count - 1) for i in range(count)]
+    return parse
+
+
+SPEED_RANGE, MICROMETRE_RANGE = _range("rpm"), _range("um")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -134,6 +141,17 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", type=Path, default=Path("out/campbell"), metavar="DIR",
                    help="writes campbell.png and campbell.json (default out/campbell)")
     s.set_defaults(func=cmd_campbell)
+
+    s = sub.add_parser("ste", help="static transmission error of every mesh, unloaded and loaded, with its tip "
+                                   "reliefs (PNG and JSON)")
+    _train_arg(s)
+    s.add_argument("--relief-sweep", type=MICROMETRE_RANGE, metavar="A:B:N",
+                   help="also the loaded STE peak-to-peak for N tip relief amounts from A to B um (every tip "
+                        "relief of the train, lengths as given)")
+    s.add_argument("--slices", type=int, metavar="N", help="slices across a helical face (default 400)")
+    s.add_argument("--out", type=Path, default=Path("out/ste"), metavar="DIR",
+                   help="writes ste.png, ste.json (and relief_sweep.png) (default out/ste)")
+    s.set_defaults(func=cmd_ste)
 
     s = sub.add_parser("run", help="time response at the operating point")
     _train_arg(s)
@@ -289,6 +307,33 @@ def cmd_campbell(args) -> int:
     for zone in result.zones:
         print(f"  UNSTABLE ({zone['solver']}) from {zone['from_rpm']:g} to {zone['to_rpm']:g} rpm")
     print(f"  wrote {args.out / 'campbell.png'} and {args.out / 'campbell.json'}")
+    return 0
+
+
+def cmd_ste(args) -> int:
+    from gearcheck.compare import plots
+    from gearcheck.lumped.transmission_error import relief_sweep, static_transmission_error
+
+    if args.slices is not None and not 1 <= args.slices <= 1000:
+        raise GearcheckError(f"--slices {args.slices}: must be between 1 and 1000")
+    spec = gearcheck.load(args.train)
+    with OutputDirectory(args.out) as place:
+        curves = static_transmission_error(spec, slices=args.slices)
+        report = {"train": spec.name, "meshes": [c.to_dict() for c in curves]}
+        write_file(place.path / "ste.png", plots.static_transmission_error(curves, spec.name))
+        if args.relief_sweep:
+            report["relief_sweep"] = relief_sweep(spec, [a * 1e-6 for a in args.relief_sweep], slices=args.slices)
+            write_file(place.path / "relief_sweep.png", plots.relief_sweep(report["relief_sweep"], spec.name))
+        write_file(place.path / "ste.json", json.dumps(report, indent=2) + "\n")
+    for c in curves:
+        if ".planet1." in c.mesh or len(curves) == 1:
+            print(f"{c.mesh}: load {c.load:.6g} N, loaded STE peak-to-peak {np.ptp(c.loaded) * 1e6:.4g} um "
+                  f"(mean {np.mean(c.loaded) * 1e6:.4g} um, F/k_mean {c.mean_deflection * 1e6:.4g} um), unloaded "
+                  f"peak-to-peak {np.ptp(c.unloaded) * 1e6:.4g} um")
+    for mesh, data in report.get("relief_sweep", {}).get("meshes", {}).items():
+        if ".planet1." in mesh:
+            print(f"  {mesh}: smallest loaded peak-to-peak at {data['best_amount_m'] * 1e6:.4g} um of relief")
+    print(f"  wrote {args.out}")
     return 0
 
 

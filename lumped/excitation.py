@@ -2,7 +2,8 @@
 
 All functions of time here follow the nominal kinematics (the "nominal clock"), so the lumped
 solver and the MuJoCo runner evaluate exactly the same excitation.  Signs: a static transmission
-error e > 0 compresses the mesh, so the mesh force is k(t) f(delta - e) + c (d delta/dt - de/dt).
+error e > 0 compresses the mesh, so the mesh force is k(t) f(delta - e) + c (d delta/dt - de/dt); a mesh
+with tip relief sums its tooth pairs instead of k(t) (:meth:`Excitation.tooth_pairs`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 from gearcheck.lumped.kinematics import Kinematics
 from gearcheck.lumped.line_of_action import line_of_action
 from gearcheck.lumped.mesh_stiffness import stiffness_model
+from gearcheck.lumped.tooth_pairs import ToothPairs, relieved
 
 
 def smooth_ramp(t, duration: float):
@@ -40,6 +42,9 @@ class Excitation:
         self.mean_stiffness = np.array([model.mean for model in self.models])
         self.max_stiffness = np.array([model.maximum for model in self.models])
         self.backlash = np.array([m.backlash for m in meshes])
+        # meshes whose gears carry a tip relief: their force is the sum over their tooth pairs
+        self.relieved = np.array([j for j, m in enumerate(meshes) if relieved(m)], dtype=int)
+        self._pairs = [ToothPairs(meshes[j], self.mean_stiffness[j]) for j in self.relieved]
         self._ste = [(i, h, a, p) for i, m in enumerate(meshes) for (h, a, p) in m.ste]
         self._eccentric = list(self._eccentric_terms(spec, kin))
         op = spec.operating
@@ -63,6 +68,21 @@ class Excitation:
         for j, model in enumerate(self.models):
             k[..., j] = model(xi[..., j])
         return k
+
+    def tooth_pairs(self, t):
+        """(k_j, e_j) of the relieved meshes' tooth pairs (:class:`~gearcheck.lumped.tooth_pairs.ToothPairs`):
+        shape (..., n_relieved, pairs) for t of shape (...), each mesh's pairs padded to the largest count
+        with k = 0, e = inf; (None, None) when no mesh is relieved.  The mesh force is
+        sum_j k_j max(0, delta - e(t) - e_j) + c (d delta/dt - de/dt)."""
+        if not self._pairs:
+            return None, None
+        xi = self.mesh_position(t)[..., self.relieved]
+        size = max(p.size for p in self._pairs)
+        k = np.zeros(xi.shape + (size,))
+        e = np.full(xi.shape + (size,), np.inf)
+        for r, pairs in enumerate(self._pairs):
+            k[..., r, :pairs.size], e[..., r, :pairs.size] = pairs(xi[..., r])
+        return k, e
 
     def switch_times(self, t0: float, t1: float) -> np.ndarray:
         """Sorted times in (t0, t1) at which some mesh's stiffness jumps (its model's ``breaks``)."""
@@ -96,8 +116,9 @@ class Excitation:
 
     @staticmethod
     def _eccentric_terms(spec, kin):
-        """Eccentricity of a gear: its pitch-circle centre offset, turning with the gear
-        relative to the carrier frame, projected on the line of action (+ for the
+        """Eccentricity and installation error of a gear: its pitch-circle centre offset, turning with the
+        gear (eccentricity) or with its mount (installation error: the housing for a central gear, the
+        carrier for a planet) relative to the carrier frame, projected on the line of action (+ for the
         central gear, - for the planet)."""
         for i, mesh in enumerate(spec.meshes):
             stage = spec.stage_of(mesh.planet)
@@ -106,10 +127,12 @@ class Excitation:
             w_c = kin.speeds[stage.carrier]
             for gear, member, sign, base in ((mesh.central_gear, mesh.central, 1.0, 0.0),
                                              (mesh.planet_gear, mesh.planet, -1.0, planet.angle)):
-                if gear.eccentricity > 0.0:
-                    omega = kin.speeds[member] - w_c
-                    dx, dy = sign * loa.direction
-                    yield i, gear.eccentricity, omega, base + gear.eccentricity_phase, dx, dy
+                mount = w_c if member == mesh.planet else 0.0
+                dx, dy = sign * loa.direction
+                for amplitude, omega, phase in ((gear.eccentricity, kin.speeds[member] - w_c, gear.eccentricity_phase),
+                                                (gear.installation_error, mount - w_c, gear.installation_error_phase)):
+                    if amplitude > 0.0:
+                        yield i, amplitude, omega, base + phase, dx, dy
 
     # ------------------------------------------------------------------ torques
     def _ripple_omega(self, ripple) -> float:

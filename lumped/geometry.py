@@ -50,6 +50,8 @@ class Gear:
     eccentricity: float = 0.0
     eccentricity_phase: float = 0.0
     helix_angle: float = 0.0  # signed: positive a right-hand helix
+    installation_error: float = 0.0  # centre offset fixed to the gear's mount, m
+    installation_error_phase: float = 0.0
     relief_amount: float = 0.0  # tip relief C_a, m
     relief_length: float = 0.0  # its roll length L_a along the line of action, m
     relief_power: int = 1  # 1 linear, 2 parabolic

@@ -79,38 +79,47 @@ def contact_line_fourier(eps_a: float, eps_b: float, harmonics: int):
 
 def contact_pairs(xi, eps_a: float, eps_b: float, base_pitch: float, face_width: float,
                   pair_stiffness_per_width: Callable, slices: int = 1, separation: Callable | None = None):
-    """(k_j, e_j) of every slice-and-pair j at each mesh position: shape xi.shape + (slices * ceil(eps_a),).
+    """(k_j, e_j) of every slice-and-pair j at each mesh position: shape xi.shape + (slices * ceil(eps_a + eps_b),).
 
-    Thin-slice model (Velex & Maatar 1996; Eritenel & Parker 2012): the face is cut into ``slices`` spur
-    slices of width b/n; slice i sits at z/b = (i + 0.5)/n, so it meshes at xi - (i + 0.5) eps_b / n.
-    Its pair p is at s = (frac + p) p_bt from the start of contact, in contact while s < eps_a p_bt,
-    with stiffness (b/n) k_pair(s): k_pair is per unit face width, ISO 6336-1's convention (per unit
-    contact-line length that is k_pair cos(beta_b)).  ``separation(s)`` (m, e.g. a partial of
-    :func:`relief_separation`) gives e_j, zero if None.  Pairs out of contact: k_j = 0, e_j = inf.
-    Both callables get arrays of s (m).
+    Thin-slice model (Velex & Maatar 1996; Eritenel & Parker 2012): the face is cut into ``slices`` slices
+    of width b/n.  A tooth's contact line, entered u cycles ago, covers the face points t = z/b with
+    0 <= u - eps_b t < eps_a; its part inside slice i, a fraction f of the slice's width (exact, so k is
+    continuous in xi and the slices add up to the contact-line model), sits at the middle of that part,
+    t_m, which is s = (u - eps_b t_m) p_bt from the start of contact.  The pair's stiffness is
+    f (b/n) k_pair(s), k_pair per unit face width (ISO 6336-1's convention; per unit contact-line length
+    that is k_pair cos(beta_b)), and its gap ``separation(s)`` (m, e.g. a partial of
+    :func:`relief_separation`; zero if None).  Pairs out of contact: k_j = 0, e_j = inf.  Spur gears
+    (eps_b = 0): whole slices, the rectangular wave.  Both callables get arrays of s (m).
     """
     _check_ratios(eps_a, eps_b)
     _require(base_pitch > 0.0 and face_width > 0.0, f"base pitch {base_pitch} m, face width {face_width} m: "
              "both must be positive")
     _require(int(slices) == slices and slices >= 1, f"slices = {slices}: need a positive whole number")
     xi = np.asarray(xi, dtype=float)
-    lag = (np.arange(slices) + 0.5) / slices * eps_b
-    u = np.mod(xi[..., None] - lag, 1.0)[..., None] + np.arange(math.ceil(eps_a))
-    inside = u < eps_a
-    s = u[inside] * base_pitch
-    k = np.zeros(u.shape)
-    k[inside] = face_width / slices * np.asarray(pair_stiffness_per_width(s), dtype=float)
-    e = np.full(u.shape, np.inf)
+    u = np.mod(xi, 1.0)[..., None, None] + np.arange(math.ceil(eps_a + eps_b))  # (..., 1, teeth)
+    lo, hi = np.arange(slices)[:, None] / slices, (np.arange(slices)[:, None] + 1) / slices  # slice edges in t
+    if eps_b > 0.0:
+        first, last = np.maximum((u - eps_a) / eps_b, lo), np.minimum(u / eps_b, hi)
+    else:
+        inside = (u >= 0) & (u < eps_a)
+        first, last = np.where(inside, lo, 1.0), np.where(inside, hi, 0.0)
+    fraction = np.clip((last - first) * slices, 0.0, 1.0)
+    inside = fraction > 0.0
+    s = (u - eps_b * 0.5 * (first + last))[inside] * base_pitch
+    shape = xi.shape + (slices * u.shape[-1],)
+    k = np.zeros(np.broadcast_shapes(u.shape, lo.shape))
+    k[inside] = fraction[inside] * face_width / slices * np.asarray(pair_stiffness_per_width(s), dtype=float)
+    e = np.full(k.shape, np.inf)
     e[inside] = 0.0 if separation is None else np.asarray(separation(s), dtype=float)
-    return k.reshape(*xi.shape, -1), e.reshape(*xi.shape, -1)
+    return k.reshape(shape), e.reshape(shape)
 
 
 def slice_stiffness(xi, eps_a: float, eps_b: float, base_pitch: float, face_width: float,
                     pair_stiffness_per_width: Callable, slices: int):
-    """Mesh stiffness k(xi) = sum over slices and pairs of (b/n) k_pair(s), N/m (thin-slice model).
+    """Mesh stiffness k(xi) = sum over slices and pairs of f (b/n) k_pair(s), N/m (thin-slice model).
 
-    With constant k_pair it tends to k_pair cos(beta_b) L(xi), the contact-line model; the error is
-    O(1/n) (midpoint rule on the line's clipped ends), and nil for spur gears.
+    With constant k_pair it is k_pair cos(beta_b) L(xi), the contact-line model, for any n (the slices'
+    parts of each line add up to the line); otherwise the midpoint rule within each slice, O(1/n^2).
     """
     return contact_pairs(xi, eps_a, eps_b, base_pitch, face_width, pair_stiffness_per_width, slices)[0].sum(axis=-1)
 

@@ -306,6 +306,11 @@ GEOMETRY = {
                                    bound("displacement", UM)),
     "eccentricity_phase_deg": Number("angle of the eccentricity at t = 0, in the member's own frame", "deg", 0.0,
                                      -3600.0, False, 3600.0),
+    "installation_error_um": NonNegative("installation (position) error: offset of the gear's centre from its "
+                                         "nominal place, fixed to its mount (the housing for a sun or ring, the "
+                                         "carrier for a planet)", "µm", 0.0, bound("displacement", UM)),
+    "installation_error_phase_deg": Number("direction of the installation error at t = 0, like the eccentricity's",
+                                           "deg", 0.0, -3600.0, False, 3600.0),
     "tip_relief": Table(
         {
             "amount_um": NonNegative("material removed at the tip, normal to the flank (C_a)", "µm", REQUIRED,

@@ -168,15 +168,6 @@ class TrainSpec:
         name = self.members[member_id].stage
         return next(s for s in self.stages if s.name == name)
 
-    def check_time_run(self) -> None:
-        """Refuse a time run of a train whose gears carry a tip relief: it acts in the static transmission
-        error (``gearcheck ste``) and not yet in the time solvers, which would ignore it."""
-        relieved = sorted({mesh.central for mesh in self.meshes if mesh.central_gear.relief_amount}
-                          | {f"{mesh.stage}.planet" for mesh in self.meshes if mesh.planet_gear.relief_amount})
-        if relieved:
-            raise GearcheckError(f"{self.path}: tip relief on {', '.join(relieved)}: time runs do not model tip "
-                                 "relief yet (its static effect: `gearcheck ste`); set amount_um = 0 to run")
-
     def with_operating(self, **changes) -> "TrainSpec":
         """A copy with operating-point fields replaced (e.g. ``input_speed``)."""
         return replace(self, operating=replace(self.operating, **changes))
@@ -375,6 +366,8 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
     module = normal_module / math.cos(beta)  # transverse (ISO 21771): m_t = m_n / cos(beta)
     alpha = normal_alpha if beta == 0.0 else math.atan(math.tan(normal_alpha) / math.cos(beta))
     _check_small(raw["eccentricity"], MAX_ERROR, normal_module, f"{path}.eccentricity_um", "eccentricity", fail)
+    _check_small(raw["installation_error"], MAX_ERROR, normal_module, f"{path}.installation_error_um",
+                 "installation error", fail)
     relief = raw["tip_relief"] or {"amount": 0.0, "length": 0.0, "shape": "linear"}
     _check_small(relief["amount"], MAX_ERROR, normal_module, f"{path}.tip_relief.amount_um", "tip relief", fail)
     base = raw["base_radius"] if raw["base_radius"] is not None else 0.5 * module * teeth * math.cos(alpha)
@@ -388,6 +381,7 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
         dedendum=pick("dedendum_coefficient", "dedendum_coefficient"),
         profile_shift=raw["profile_shift"], internal=internal, base_radius=base,
         eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"], helix_angle=beta,
+        installation_error=raw["installation_error"], installation_error_phase=raw["installation_error_phase"],
         relief_amount=relief["amount"], relief_length=relief["length"],
         relief_power=2 if relief["shape"] == "parabolic" else 1,
     )
@@ -573,6 +567,9 @@ def _build_stage(st: dict, path: str, fail):
             raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")
         ste = tuple((s["harmonic"], s["amplitude"], s["phase"]) for s in mesh["ste"])
         _check_small(mesh["backlash"] or 0.0, MAX_BACKLASH, gear.module, f"{mpath}.backlash_um", "backlash", fail)
+        if mesh["backlash"] and (gear.relief_amount or planet_gears[pg].relief_amount):
+            raise fail(f"{mpath}.backlash_um", "a mesh with tip relief is modelled on its drive flanks only: give "
+                                               "it no backlash")
         for j, (_, amplitude, _) in enumerate(ste):
             _check_small(amplitude, MAX_ERROR, gear.module, f"{mpath}.ste[{j}].amplitude_um",
                          "transmission error amplitude", fail)

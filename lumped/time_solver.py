@@ -32,7 +32,7 @@ from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
+from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
 CHUNK = 20000
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
@@ -73,25 +73,43 @@ class _System:
         self.c = model.mesh_damping
         self.b = 0.5 * self.exc.backlash
         self.has_backlash = bool(np.any(self.b > 0))
+        self.relieved = self.exc.relieved
+        self.has_relief = bool(self.relieved.size)
         self.F0 = model.F_static
         self.b_in, self.b_out = model.b_input, model.b_output
 
     def drive(self, t):
-        """Excitation at times t: (k, e, de, T_in, T_out), arrays with time along axis 0."""
+        """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``
+        the relieved meshes' tooth pairs (k_j, e_j), or None."""
         k = self.exc.stiffness(t)
         e, de = self.exc.transmission_error(t)
         t_in, t_out = self.exc.torques(t)
-        return k, e, de, t_in, t_out
+        kp, ep = self.exc.tooth_pairs(t)
+        return k, e, de, t_in, t_out, None if kp is None else np.stack([kp, ep], axis=-1)
 
-    def mesh_force(self, q, v, k, e, de):
-        """Mesh deflections and forces for one state (1-D) or many (time along axis 0)."""
+    def mesh_force(self, q, v, k, e, de, pairs=None):
+        """Mesh deflections and forces for one state (1-D) or many (time along axis 0); a relieved mesh's
+        elastic force is that of its tooth pairs, sum_j k_j max(0, delta - e - e_j)."""
         delta = q @ self.A.T
-        elastic = deadzone(delta - e, self.b) if self.has_backlash else delta - e
-        return delta, k * elastic + self.c * (v @ self.A.T - de)
+        elastic = k * (deadzone(delta - e, self.b) if self.has_backlash else delta - e)
+        if pairs is not None:
+            r = self.relieved
+            gap = (delta - e)[..., r, None] - pairs[..., 1]
+            elastic[..., r] = np.sum(pairs[..., 0] * np.maximum(gap, 0.0), axis=-1)
+        return delta, elastic + self.c * (v @ self.A.T - de)
 
-    def acceleration(self, q, v, k, e, de, t_in, t_out, t=0.0):
+    def contact_stiffness(self, q, k, e, pairs):
+        """The mesh stiffness in effect: k, or for a relieved mesh the sum over its pairs in contact."""
+        if pairs is None:
+            return k
+        k = k.copy()
+        gap = (q @ self.A.T - e)[..., self.relieved, None] - pairs[..., 1]
+        k[..., self.relieved] = np.sum(pairs[..., 0] * (gap > 0.0), axis=-1)
+        return k
+
+    def acceleration(self, q, v, k, e, de, t_in, t_out, t=0.0, pairs=None):
         """q'' for one state (1-D) or many (time along axis 0, the torques then as columns)."""
-        _, f = self.mesh_force(q, v, k, e, de)
+        _, f = self.mesh_force(q, v, k, e, de, pairs)
         force = self.F0 + self.b_in * t_in + self.b_out * t_out - v @ self.D.T - q @ self.Kc.T - f @ self.A
         for coupling in self.turning:
             force = force + coupling.forces(t, q, v)
@@ -173,7 +191,6 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
         raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
     if drive not in ("steps", "stages"):
         raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
-    model.spec.check_time_run()
     limits = step_limits(model)
     dt = stepping.default_step(limits, model.excitation.frequency) if settings.dt is None else settings.dt
     what = f"lumped model of {model.spec.name}"
@@ -212,16 +229,19 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
     v_out = np.empty((n_out, n))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     acc = sys.acceleration
-    linear = None if stage_by_stage or sys.turning else _LinearStep(sys, h)  # turning couplings: periodic
+    # turning couplings (periodic) and tooth pairs (a force that depends on the contacts) are not linear
+    linear = None if stage_by_stage or sys.turning or sys.has_relief else _LinearStep(sys, h)
     stages = np.array(STAGE_OFFSETS)
     y = np.concatenate([q, v])
     j = j0 = 1
-    for start in range(0, n_steps, CHUNK):
-        stop = min(start + CHUNK, n_steps)
+    chunk = CHUNK // 10 if sys.has_relief else CHUNK  # the pairs' drive is (steps, 3, meshes, pairs, 2)
+    for start in range(0, n_steps, chunk):
+        stop = min(start + chunk, n_steps)
         times = (np.arange(start, stop)[:, None] + stages[None, :]) * h
-        k, e, de, tin, tout = sys.drive(times)
+        k, e, de, tin, tout, pairs = sys.drive(times)
         if drive == "steps":  # stages 2-4 all see the step's weighted drive (as MuJoCo's model fields)
             k, e, de, tin, tout = (per_step_drive(x) for x in (k, e, de, tin, tout))
+            pairs = None if pairs is None else per_step_pairs(pairs)
         if linear is not None:
             load = sys.load(k, e, de, tin, tout)
             smooth = np.all(k[:, 0, :] == k[:, 1, :], axis=1) & np.all(k[:, 1, :] == k[:, 2, :], axis=1)
@@ -245,7 +265,8 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
                 t0 = (start + i) * h
 
                 def stage(s, q, v, i=i, t0=t0):
-                    return acc(q, v, k[i, s], e[i, s], de[i, s], tin[i, s], tout[i, s], t0 + 0.5 * s * h)
+                    return acc(q, v, k[i, s], e[i, s], de[i, s], tin[i, s], tout[i, s], t0 + 0.5 * s * h,
+                               None if pairs is None else pairs[i, s])
 
                 y = np.concatenate(rk4_step(stage, y[:n], y[n:], h))
             step = start + i + 1
@@ -264,12 +285,15 @@ def _split_step(sys, y, t0, h, inner, drive):
     n = y.size // 2
     q, v = y[:n], y[n:]
     for a, length in zip(*stepping.sub_steps(t0, h, inner)):
-        k, e, de, tin, tout = sys.drive(a + length * np.array(STAGE_OFFSETS)[None, :])
+        k, e, de, tin, tout, pairs = sys.drive(a + length * np.array(STAGE_OFFSETS)[None, :])
         if drive == "steps":
             k, e, de, tin, tout = (per_step_drive(x) for x in (k, e, de, tin, tout))
+            pairs = None if pairs is None else per_step_pairs(pairs)
 
-        def stage(s, q, v, a=a, length=length, k=k[0], e=e[0], de=de[0], tin=tin[0], tout=tout[0]):
-            return sys.acceleration(q, v, k[s], e[s], de[s], tin[s], tout[s], a + 0.5 * s * length)
+        def stage(s, q, v, a=a, length=length, k=k[0], e=e[0], de=de[0], tin=tin[0], tout=tout[0],
+                  pairs=None if pairs is None else pairs[0]):
+            return sys.acceleration(q, v, k[s], e[s], de[s], tin[s], tout[s], a + 0.5 * s * length,
+                                    None if pairs is None else pairs[s])
 
         q, v = rk4_step(stage, q, v, length)
     return np.concatenate([q, v])
@@ -292,8 +316,8 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
     n = q0.size
 
     def rhs(t, y):
-        k, e, de, tin, tout = sys.drive(t)
-        return np.concatenate([y[n:], sys.acceleration(y[:n], y[n:], k, e, de, tin, tout, t)])
+        k, e, de, tin, tout, pairs = sys.drive(t)
+        return np.concatenate([y[n:], sys.acceleration(y[:n], y[n:], k, e, de, tin, tout, t, pairs)])
 
     t_eval = h * np.arange(0, n_steps + 1, every)
     sol = solve_ivp(rhs, (0.0, n_steps * h), np.concatenate([q0, v0]), method=method, t_eval=t_eval,
@@ -305,9 +329,10 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
 
 def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
-    k, e, de, tin, tout = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
-    qdd = sys.acceleration(q, v, k, e, de, tin[:, None], tout[:, None], t)
-    delta, force = sys.mesh_force(q, v, k, e, de)
+    k, e, de, tin, tout, pairs = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
+    qdd = sys.acceleration(q, v, k, e, de, tin[:, None], tout[:, None], t, pairs)
+    delta, force = sys.mesh_force(q, v, k, e, de, pairs)
+    k = sys.contact_stiffness(q, k, e, pairs)
     spec, dofs = model.spec, model.dofs
     members = list(spec.members)
     acc = np.empty((t.size, len(members), 3))

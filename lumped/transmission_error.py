@@ -1,17 +1,12 @@
 """Static transmission error of every mesh, unloaded and loaded, from its tooth pairs and their tip relief.
 
-Each mesh is cut into thin spur slices across its face (one for spur gears), each slice's tooth pairs
-placed along the path of contact (Velex & Maatar 1996; :func:`gearcheck.lumped.helical_mesh.contact_pairs`).
-A pair has the stiffness per unit face width that makes the mesh's mean stiffness k_mean, k_mean /
-(eps_a b), and the gap its gears' tip reliefs open at its place on the path.  Then over one mesh cycle:
+Over one mesh cycle, with the pairs of :class:`gearcheck.lumped.tooth_pairs.ToothPairs` on thin slices
+across the face (one for spur gears):
 
 * the unloaded static transmission error is the smallest gap (the pair that touches first);
 * the loaded static transmission error is the mesh approach delta under the mesh's static load F,
   sum_j k_j max(0, delta - e_j) = F (Harris 1958), pairs in a relief zone taking less of the load;
 * the loaded mesh stiffness is the sum of the stiffnesses of the pairs in contact.
-
-Along the path of contact the planet's tip enters a sun mesh and the ring's tip a ring mesh (the
-convention of :mod:`gearcheck.lumped.kinematics` and :mod:`gearcheck.lumped.tooth_stiffness`).
 """
 
 from __future__ import annotations
@@ -23,6 +18,7 @@ import numpy as np
 from gearcheck.lumped import helical_mesh
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.static import static_solution
+from gearcheck.lumped.tooth_pairs import ToothPairs
 from gearcheck.shared.errors import GearcheckError
 
 HELICAL_SLICES = 400  # slices across a helical face: the slice model's TE error is O(1/n), 1 % of its ripple here
@@ -53,32 +49,12 @@ class StaticTransmissionError:
                 "stiffness_n_per_m": self.stiffness.tolist()}
 
 
-def mesh_relief(mesh):
-    """e(s): the gap both gears' tip reliefs open at s from the start of contact (m)."""
-    first, last = (mesh.central_gear, mesh.planet_gear) if mesh.internal else (mesh.planet_gear, mesh.central_gear)
-    path = mesh.geometry.contact_ratio * mesh.geometry.base_pitch
-
-    def tip(gear, at_start: bool):
-        shape = "parabolic" if gear.relief_power == 2 else "linear"
-        amount, length = gear.relief_amount, gear.relief_length
-        if at_start:
-            return lambda s: helical_mesh.relief_separation(s, path, 0.0, 0.0, amount, length, shape)
-        return lambda s: helical_mesh.relief_separation(s, path, amount, length, 0.0, 0.0, shape)
-
-    start, end = tip(first, True), tip(last, False)
-    return lambda s: start(s) + end(s)
-
-
 def mesh_static_transmission_error(mesh, load: float, mean_stiffness: float, points: int = 401,
                                    slices: int | None = None) -> StaticTransmissionError:
     """The unloaded and loaded static TE of ``mesh`` under ``load`` (N) over one mesh cycle."""
-    g = mesh.geometry
-    slices = slices or (HELICAL_SLICES if g.face_contact_ratio else 1)
-    per_width = mean_stiffness / (g.contact_ratio * g.face_width)
+    slices = slices or (HELICAL_SLICES if mesh.geometry.face_contact_ratio else 1)
     xi = np.linspace(0.0, 1.0, points)
-    k, e = helical_mesh.contact_pairs(xi, g.contact_ratio, g.face_contact_ratio, g.base_pitch, g.face_width,
-                                      lambda s: np.full(np.shape(s), per_width), slices, mesh_relief(mesh))
-    contact = helical_mesh.loaded_transmission_error(load, k, e)
+    contact = helical_mesh.loaded_transmission_error(load, *ToothPairs(mesh, mean_stiffness, slices)(xi))
     return StaticTransmissionError(mesh.id, float(load), float(mean_stiffness), xi, contact.unloaded,
                                    contact.approach, contact.stiffness)
 

@@ -4,7 +4,9 @@ Per step (fixed step h, MuJoCo's RK4 integrator):
 
 * mesh stiffness k(t) from :meth:`gearcheck.lumped.excitation.Excitation.stiffness` (the nominal
   clock, as the lumped solver) into ``m.tendon_stiffness``; a static transmission error
-  e(t) shifts the tendons' spring length (``m.tendon_lengthspring`` = e -/+ b);
+  e(t) shifts the tendons' spring length (``m.tendon_lengthspring`` = e -/+ b); a mesh with tip relief
+  gets the stiffness and spring length of its tooth pairs in contact at the tendon's length
+  (:class:`_ToothContacts`);
 * the input speed w_in into the ``input_shaft`` integrated-velocity servo (whose activation
   is the reference angle, 0 at t = 0) and its ``input_shaft_damper``, the load torque T_out(t) and
   any input torque into the ``output_load`` / ``input_torque`` motors;
@@ -58,7 +60,7 @@ from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
+from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
 CHUNK = 10000
 
@@ -88,15 +90,44 @@ class _Drive:
         return u
 
     def at(self, t: np.ndarray):
-        """(k, u, e, de) at times t (e, de None without a transmission error)."""
+        """(k, u, e, de, pairs) at times t (e, de None without a transmission error; pairs, the relieved meshes'
+        tooth pairs (k_j, e_j) along the last axis, None without tip relief)."""
         e, de = self.exc.transmission_error(t) if self.has_te else (None, None)
-        return self.exc.stiffness(t), self.controls(t), e, de
+        kp, ep = self.exc.tooth_pairs(t)
+        pairs = None if kp is None else np.stack([kp, ep], axis=-1)
+        return self.exc.stiffness(t), self.controls(t), e, de, pairs
 
     def steps(self, t0: np.ndarray, h: float):
-        """For steps starting at t0: each of (k, u, e, de) as (stage-1 rows, stages-2..4 rows), sampled at
-        t0 + h STAGE_OFFSETS and weighted as the lumped RK4 drives its steps."""
-        values = self.at(t0[:, None] + h * np.array(STAGE_OFFSETS)[None, :])
-        return [(None, None) if x is None else tuple(per_step_drive(x)[:, :2].swapaxes(0, 1)) for x in values]
+        """For steps starting at t0: each of (k, u, e, de, pairs) as (stage-1 rows, stages-2..4 rows), sampled
+        at t0 + h STAGE_OFFSETS and weighted as the lumped RK4 drives its steps."""
+        *values, pairs = self.at(t0[:, None] + h * np.array(STAGE_OFFSETS)[None, :])
+        out = [(None, None) if x is None else tuple(per_step_drive(x)[:, :2].swapaxes(0, 1)) for x in values]
+        return out + [(None, None) if pairs is None else tuple(per_step_pairs(pairs)[:, :2].swapaxes(0, 1))]
+
+
+class _ToothContacts:
+    """The relieved meshes' tooth pairs on MuJoCo's tendons: at each drive the pairs in contact at the tendon's
+    present length L (a fixed tendon's sum of coefficient times joint position) set its stiffness, their sum
+    K, and its spring length, e + S/K with S the sum of k_j e_j, so that MuJoCo's spring force over the step
+    is sum_j k_j (L - e - e_j) over those pairs; none in contact: no spring."""
+
+    def __init__(self, mb: MbdModel):
+        m = mb.model
+        self.relieved = mb.excitation.relieved
+        self.tendons = mb.mesh_tendon[self.relieved]
+        self.wraps = [np.arange(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t]) for t in self.tendons]
+        self.qadr = [m.jnt_qposadr[m.wrap_objid[w]] for w in self.wraps]
+
+    def apply(self, m: mujoco.MjModel, d: mujoco.MjData, e, pairs) -> None:
+        offset = 0.0 if e is None else e[self.relieved]
+        length = np.array([m.wrap_prm[w] @ d.qpos[a] for w, a in zip(self.wraps, self.qadr)]) - offset
+        k, gap = pairs[..., 0], pairs[..., 1]
+        touching = length[:, None] > gap
+        total = np.sum(k * touching, axis=-1)
+        moment = np.sum(k * np.where(touching, gap, 0.0), axis=-1)
+        m.tendon_stiffness[self.tendons] = total
+        m.tendon_lengthspring[self.tendons] = (offset + np.divide(moment, total, out=np.zeros_like(total),
+                                                                  where=total > 0))[:, None]
 
 
 # --------------------------------------------------------------------------- damping correction
@@ -255,18 +286,22 @@ class _Stepper:
         self.correction = _DampingCorrection(mb, d)
         self.lo_hi = np.stack([-mb.half_backlash, mb.half_backlash], axis=1)
         self.clock = _body_clock(mb) if bodies else None
+        self.contacts = _ToothContacts(mb) if mb.excitation.relieved.size else None
         self.sensors = np.empty((n_samples, m.nsensordata))
         self.forces = np.empty((n_samples, self.reader.width))
-        self.stiffness = np.empty((n_samples, self.n_mesh)) if bodies else None
+        self.stiffness = np.empty((n_samples, self.n_mesh)) if bodies or self.contacts else None
         self.energy = np.empty((n_samples, 2)) if energy else None
         self.j = 0
 
-    def set_stage(self, k, u, e, de) -> None:
-        """Drive values for the coming stage(s): stiffness, controls, spring lengths, damping correction."""
+    def set_stage(self, k, u, e, de, pairs=None) -> None:
+        """Drive values for the coming stage(s): stiffness, controls, spring lengths, tooth contacts, damping
+        correction."""
         self.m.tendon_stiffness[:self.n_mesh] = k
         self.d.ctrl[:] = u
         if e is not None:
             self.m.tendon_lengthspring[:self.n_mesh] = e[:, None] + self.lo_hi
+        if pairs is not None:
+            self.contacts.apply(self.m, self.d, e, pairs)
         self.correction.apply(de)
 
     def sample(self) -> None:
@@ -283,8 +318,12 @@ class _Stepper:
     def run(self, start: int, stop: int, every: int, values, split) -> None:
         """Steps start..stop-1, sampling the steps that begin on a multiple of ``every``; the steps in
         ``split`` (:func:`gearcheck.shared.stepping.split_steps`) end sub-steps at their stiffness jumps."""
-        (k1, k2), (u1, u2), (e1, e2), (de1, de2) = values
+        (k1, k2), (u1, u2), (e1, e2), (de1, de2), (p1, p2) = values
         m, d = self.m, self.d
+
+        def row(x, i):
+            return None if x is None else x[i]
+
         for i in range(stop - start):
             if start + i in split:
                 self.split_step(start + i, split[start + i], (start + i) % every == 0)
@@ -294,11 +333,11 @@ class _Stepper:
                 k_now, k_later = _body_stiffness(self.mb, self.clock, d.qpos, d.qvel, self.h)
             else:
                 k_now, k_later = k1[i], k2[i]
-            self.set_stage(k_now, u1[i], None if e1 is None else e1[i], None if de1 is None else de1[i])
+            self.set_stage(k_now, u1[i], row(e1, i), row(de1, i), row(p1, i))
             mujoco.mj_forward(m, d)
             if (start + i) % every == 0:
                 self.sample()
-            self.set_stage(k_later, u2[i], None if e2 is None else e2[i], None if de2 is None else de2[i])
+            self.set_stage(k_later, u2[i], row(e2, i), row(de2, i), row(p2, i))
             mujoco.mj_RungeKutta(m, d, 4)
 
     def split_step(self, step: int, inner, sample: bool) -> None:
@@ -307,23 +346,23 @@ class _Stepper:
         m, d = self.m, self.d
         for j, (a, length) in enumerate(zip(*stepping.sub_steps(step * self.h, self.h, inner))):
             m.opt.timestep = length
-            (k1, k2), (u1, u2), (e1, e2), (de1, de2) = self.drive.steps(np.array([a]), length)
+            first, later = zip(*self.drive.steps(np.array([a]), length))
             self.mb.refresh(d.qpos)
-            self.set_stage(k1[0], u1[0], None if e1 is None else e1[0], None if de1 is None else de1[0])
+            self.set_stage(*(None if x is None else x[0] for x in first))
             mujoco.mj_forward(m, d)
             if sample and j == 0:
                 self.sample()
-            self.set_stage(k2[0], u2[0], None if e2 is None else e2[0], None if de2 is None else de2[0])
+            self.set_stage(*(None if x is None else x[0] for x in later))
             mujoco.mj_RungeKutta(m, d, 4)
         m.opt.timestep = self.h
 
     def finish(self, t_end: float) -> None:
         """Sample the final state (the drive of the step that would start there)."""
         self.mb.refresh(self.d.qpos)
-        k, u, e, de = self.drive.at(np.array([t_end + STAGE_OFFSETS[0] * self.h]))
+        k, u, e, de, pairs = self.drive.at(np.array([t_end + STAGE_OFFSETS[0] * self.h]))
         if self.clock is not None:
             k = _body_stiffness(self.mb, self.clock, self.d.qpos, self.d.qvel, self.h)[0][None]
-        self.set_stage(k[0], u[0], None if e is None else e[0], None if de is None else de[0])
+        self.set_stage(*(None if x is None else x[0] for x in (k, u, e, de, pairs)))
         mujoco.mj_forward(self.m, self.d)
         self.sample()
 
@@ -343,7 +382,7 @@ class _LeanStepper(_Stepper):
         self.rate = np.zeros(len(tc.wraps))
 
     def run(self, start, stop, every, values, split) -> None:
-        (k1, k2), (u1, u2), _, _ = values
+        (k1, k2), (u1, u2), _, _, _ = values
         m, d, n = self.m, self.d, self.n_mesh
         tc, corr = self.mb.turning, self.correction
         prm, J, c_wrap, applied = m.wrap_prm, corr.J, corr.c_wrap, d.qfrc_applied
@@ -389,7 +428,6 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     the static start.  record_energy: enable ``mjENBL_ENERGY`` and return MuJoCo's kinetic and
     potential energy in ``raw``.
     """
-    mb.spec.check_time_run()
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
     spec, m = mb.spec, mb.model
@@ -413,7 +451,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     d.qpos[:], d.qvel[:] = qpos0, qvel0
     lean = (mb.turning.single is not None and not mb.excitation.has_transmission_error
-            and stiffness_clock == "nominal" and not record_energy)
+            and not mb.excitation.relieved.size and stiffness_clock == "nominal" and not record_energy)
     stepper = (_LeanStepper if lean else _Stepper)(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies",
                                                    record_energy)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)

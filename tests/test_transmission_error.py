@@ -2,9 +2,8 @@
 
 Closed forms:
 
-* no relief: the loaded TE is F / k(xi); for a helical mesh the thin-slice model tends to the contact-line
-  model k_mean L(xi) / L_m (Maatar & Velex 1996) with an error of at most ceil(eps_b) slices' share of a
-  pair, k_mean / (eps_a n) (both line ends inside the face cost half a slice each);
+* no relief: the loaded TE is F / k(xi); for a helical mesh the thin slices add up to the contact-line
+  model k_mean L(xi) / L_m (Maatar & Velex 1996) exactly;
 * a spur mesh (1 < eps_a < 2) with equal linear long reliefs C on both tips, reaching the points of single
   contact, (eps_a - 1) p_b: in the single-pair zone delta = F / k_pair; in the double zone the two gaps sum
   to C, so delta = (F / k_pair + C) / 2, and for C > F / k_pair the entering pair opens at its start, where
@@ -21,8 +20,10 @@ import pytest
 import gearcheck
 from gearcheck.cli import main
 from gearcheck.lumped import helical_mesh
+from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.tooth_pairs import DYNAMIC_SLICES, mesh_relief
 from gearcheck.lumped.tooth_stiffness import path_of_contact
-from gearcheck.lumped.transmission_error import mesh_relief, mesh_static_transmission_error, static_transmission_error
+from gearcheck.lumped.transmission_error import mesh_static_transmission_error, static_transmission_error
 from gearcheck.lumped.variants import edited
 
 
@@ -41,8 +42,7 @@ def test_without_relief_a_helical_mesh_has_the_contact_line_models_te():
                                                 g.base_helix_angle)
         k_line = curve.mean_stiffness * line / helical_mesh.mean_contact_line_length(g.contact_ratio, g.face_width,
                                                                                      g.base_helix_angle)
-        bound = math.ceil(g.face_contact_ratio) / (g.contact_ratio * 400) * curve.mean_stiffness / k_line.min()
-        assert np.max(np.abs(curve.loaded * k_line / curve.load - 1.0)) <= bound
+        np.testing.assert_allclose(curve.loaded, curve.load / k_line, rtol=1e-12)
         assert np.all(curve.unloaded == 0.0)
 
 
@@ -91,11 +91,40 @@ def test_the_ste_command_and_its_sweep(tmp_path, capsys):
     assert not (tmp_path / "none").exists()
 
 
-def test_a_time_run_with_tip_relief_is_refused_in_one_line(tmp_path, capsys):
-    train = tmp_path / "relieved.toml"
-    from gearcheck.lumped.variants import edited_text
-    train.write_text(edited_text("helical-planetary", [(r"amount_um = 0.0", "amount_um = 15.0")]), encoding="utf-8")
-    assert main(["run", str(train), "--duration", "0.01", "--out", str(tmp_path / "run")]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "time runs do not model tip relief yet" in err
-    assert not (tmp_path / "run").exists()
+def relieved_helical(amount_um: float, rpm: float = 3000.0):
+    spec = edited("helical-planetary", [(r"amount_um = 0.0", f"amount_um = {amount_um!r}")], f"{amount_um} um")
+    return spec.with_operating(input_speed=rpm * math.pi / 30.0)
+
+
+def test_tip_relief_in_both_time_solvers():
+    """MuJoCo's tendons take the stiffness and spring length of the pairs in contact at their own length each
+    step; the lumped solver sums the pairs at every stage: they agree, and a 15 um relief on the planets'
+    tips takes the relieved pairs out of the load (the mean stiffness in effect falls below k_mean)."""
+    result = gearcheck.crosscheck(relieved_helical(15.0), duration=0.03)
+    assert result.verdict == "PASS", result.failures
+    lumped, mujoco = result.results
+    window = lumped.t >= result.steady_start_s
+    for mesh in result.spec.meshes[:1] + result.spec.meshes[3:4]:
+        k_mean = gearcheck.load("helical-planetary").meshes[mesh.planet_index].stiffness["mean"]
+        k = lumped[f"{mesh.id}.stiffness"][window]
+        assert k.mean() < 0.95 * k_mean
+        np.testing.assert_allclose(mujoco[f"{mesh.id}.stiffness"][window], k, rtol=1e-6)
+
+
+def test_at_low_speed_the_dynamic_te_is_the_loaded_static_te():
+    """At 300 rpm the mesh frequency (112.5 Hz) is 1/16 of the lowest mode (1788 Hz): the time solver's mesh
+    approach follows the quasi-static contact solution (sorted gaps, exact; another algorithm) to a few
+    per cent of its peak-to-peak (measured 4.3 % sun, 1.3 % ring: the response of the relief's sharp
+    corners' higher harmonics)."""
+    spec = relieved_helical(15.0, rpm=300.0)
+    run = gearcheck.simulate(spec, solver="lumped", duration=0.12)
+    exc = build_model(spec).excitation
+    window = run.t > 0.06
+    for j in (0, 3):
+        mesh = spec.meshes[j]
+        curve = mesh_static_transmission_error(mesh, run.static[f"{mesh.id}.force"], exc.mean_stiffness[j],
+                                               points=2001, slices=DYNAMIC_SLICES)
+        xi = np.mod(exc.mesh_position(run.t[window])[:, j], 1.0)
+        quasi_static = np.interp(xi, curve.xi, curve.loaded)
+        error = np.max(np.abs(run[f"{mesh.id}.dte"][window] - quasi_static)) / np.ptp(curve.loaded)
+        assert error < 0.06, (mesh.id, error)

@@ -162,6 +162,22 @@ def per_step_drive(x: np.ndarray) -> np.ndarray:
     return out
 
 
+def per_step_pairs(pairs: np.ndarray) -> np.ndarray:
+    """:func:`per_step_drive` of tooth-pair contacts, (steps, 3 stage times, ..., 2) holding each pair's
+    stiffness k and gap e (inf out of contact): stages 2-4 get the weighted stiffness and the gap that keeps
+    the weighted force, sum_w w k_w (delta - e_w) = (sum_w w k_w)(delta - e), over the times the pair is in
+    contact."""
+    out = pairs.copy()
+    k = [STEP_WEIGHTS[i] * pairs[:, s, ..., 0] for i, s in enumerate((1, 2))]
+    e = [np.where(np.isfinite(pairs[:, s, ..., 1]), pairs[:, s, ..., 1], 0.0) for s in (1, 2)]
+    stiffness = k[0] + k[1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gap = np.where(stiffness > 0, (k[0] * e[0] + k[1] * e[1]) / stiffness, np.inf)
+    out[:, 1, ..., 0] = out[:, 2, ..., 0] = stiffness
+    out[:, 1, ..., 1] = out[:, 2, ..., 1] = gap
+    return out
+
+
 TRANSIENT_POINTS_PER_PERIOD = 40.0
 
 

@@ -1,8 +1,8 @@
 """Benchmark of the lumped reference solver (not a test): how its cost grows.
 
 Prints wall time per simulated second and per step, at the default step, as the
-simulated duration, the number of planets and the number of stages grow, with the
-ratios to the first row measured in the same run.
+simulated duration, the number of planets and the number of stages grow, and with tip relief, with
+the ratios to the first row measured in the same run.
 
 Run:  python bench/bench_lumped.py
 """
@@ -15,7 +15,7 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.loader import load_train
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.time_solver import simulate
-from gearcheck.lumped.variants import chained, wide_stage
+from gearcheck.lumped.variants import chained, edited, wide_stage
 from gearcheck.shared.settings import RunSettings
 
 
@@ -50,6 +50,10 @@ def main():
     table("planets (z = 30/24/78, 0.1 s)", "planets", [(f"{n}", wide_stage(n), 0.1) for n in (3, 4, 6)])
     table("stages (demo-3p stage chained, 0.1 s)", "stages",
           [(f"{n}", load_train("demo-3p") if n == 1 else chained(n), 0.1) for n in (1, 2, 3)])
+    helical = [(f"{a:g} um", edited("helical-planetary", [(r"amount_um = 0.0", f"amount_um = {a!r}")], "relief"), 0.02)
+               for a in (0.0, 15.0)]
+    table("tip relief (helical-planetary, 0.02 s: the relieved meshes' tooth pairs take the stage-by-stage path)",
+          "relief", helical)
 
 
 if __name__ == "__main__":

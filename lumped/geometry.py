@@ -236,7 +236,8 @@ def gear_problem(gear: Gear) -> tuple[str, str] | None:
 def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[str, str] | None:
     """(which gear: "central" or "planet", message) of the first thing that stops the pair meshing as
     involutes, or None: tips meeting the mate below its base circle (involute interference), tips
-    hitting the mate's root circle, a transverse contact ratio below ``MIN_CONTACT_RATIO``."""
+    hitting the mate's root circle, a contact ratio below ``MIN_CONTACT_RATIO`` (transverse and face together
+    for a helical pair)."""
     same_hand = central.internal  # an internal pair's helices run the same way, an external pair's opposite
     if central.helix_angle != (planet.helix_angle if same_hand else -planet.helix_angle):
         return "central", (f"helix angle {math.degrees(central.helix_angle):.6g} deg cannot mesh with "
@@ -263,7 +264,9 @@ def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[s
     for who, gap in clearance.items():
         if gap < -1e-12:
             return who, f"the {names[who]} tip hits the mate's root circle ({gap * 1e3:.4g} mm of clearance)"
-    if geometry.contact_ratio < MIN_CONTACT_RATIO:
-        return "central", (f"transverse contact ratio {geometry.contact_ratio:.3f} < {MIN_CONTACT_RATIO:g} with "
-                           f"{names['planet']}: the mesh cannot keep a tooth pair in contact")
+    if geometry.total_contact_ratio < MIN_CONTACT_RATIO:  # a helical pair's overlap keeps contact too
+        ratio = (f"transverse contact ratio {geometry.contact_ratio:.3f}" if not geometry.face_contact_ratio else
+                 f"total contact ratio {geometry.contact_ratio:.3f} + {geometry.face_contact_ratio:.3f}")
+        return "central", (f"{ratio} < {MIN_CONTACT_RATIO:g} with {names['planet']}: the mesh cannot keep a tooth "
+                           "pair in contact")
     return None

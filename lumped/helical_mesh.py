@@ -24,7 +24,9 @@ def _require(condition: bool, message: str) -> None:
 
 
 def _check_ratios(eps_a: float, eps_b: float) -> None:
-    _require(eps_a >= 1.0, f"transverse contact ratio eps_a = {eps_a} is below 1: the teeth lose contact")
+    _require(eps_a > 0.0, f"transverse contact ratio eps_a = {eps_a} is not positive")
+    _require(eps_a + eps_b >= 1.0, f"total contact ratio eps_a + eps_b = {eps_a + eps_b} is below 1: the teeth "
+                                   "lose contact")
     _require(eps_b >= 0.0, f"overlap ratio eps_b = {eps_b} is negative")
 
 
@@ -55,7 +57,7 @@ def contact_line_length(xi, eps_a: float, eps_b: float, face_width: float, base_
 
 def mean_contact_line_length(eps_a: float, face_width: float, base_helix_angle: float) -> float:
     """L_m = eps_a b / cos(beta_b), m: each trapezoid has area eps_a (Maatar & Velex 1996)."""
-    _check_ratios(eps_a, 0.0)
+    _require(eps_a > 0.0, f"transverse contact ratio eps_a = {eps_a} is not positive")
     _require(face_width > 0.0, f"face width {face_width} m is not positive")
     _require(0.0 <= base_helix_angle < math.pi / 2, f"base helix angle {base_helix_angle} rad is not in [0, pi/2)")
     return eps_a * face_width / math.cos(base_helix_angle)

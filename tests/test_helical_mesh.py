@@ -289,7 +289,7 @@ def test_contact_force_on_many_approach_position_pairs_matches_the_sum():
 
 
 @pytest.mark.parametrize("call, message", [
-    (lambda: contact_line_length(0.0, 0.9, 0.5, WIDTH, helix(0.5)), "below 1"),
+    (lambda: contact_line_length(0.0, 0.4, 0.5, WIDTH, helix(0.5)), "below 1"),
     (lambda: contact_line_length(0.0, 1.5, -0.1, WIDTH, 0.1), "negative"),
     (lambda: contact_line_length(0.0, 1.5, 0.5, -WIDTH, helix(0.5)), "face width"),
     (lambda: contact_line_length(0.0, 1.5, 0.5, WIDTH, 0.0), "disagree"),

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from functools import cached_property
 
+import numpy as np
+
 from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.lumped.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed
@@ -46,6 +48,10 @@ class LumpedSide:
 
     def modes_at_speed(self, input_speed: float) -> ModalResult:
         return modes_at_speed(self.model, input_speed)
+
+    def physical_modes(self) -> tuple[list[str], np.ndarray, np.ndarray]:
+        """(coordinate labels, mass matrix, mode shapes) in the train's physical coordinates (the model's own)."""
+        return self.model.dofs.labels(), self.model.M, self.modes().shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate(self.model, settings, method=self.method, progress=progress)

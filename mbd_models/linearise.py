@@ -124,6 +124,34 @@ def modes(mb) -> ModalResult:
                         joint_labels(mb), *_central(mb))
 
 
+def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
+    """(labels, T): the train's physical coordinates as MuJoCo moves them, T (n, nv) mapping a small joint
+    motion to them, read from MuJoCo's own Jacobians at rest: each member's centre moves along x, y (a
+    planet: along its radial and tangential axes), it turns about z, and in a helical stage it moves
+    along z.  The labels are ``member.x`` ... as the lumped model names its coordinates."""
+    m = mb.model
+    d = mujoco.MjData(m)
+    _set_rest(mb, d, m.qpos0)
+    mujoco.mj_forward(m, d)
+    labels, rows = [], []
+    for mid, member in mb.spec.members.items():
+        body = mb.body[mid]
+        jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        mujoco.mj_jac(m, d, jp, jr, d.xipos[body], body)
+        if member.is_planet:
+            c, s = np.cos(member.angle), np.sin(member.angle)
+            axes = {"radial": np.array([c, s, 0.0]), "tangential": np.array([-s, c, 0.0])}
+        else:
+            axes = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0])}
+        moves = [(f"{mid}.{name}", axis @ jp) for name, axis in axes.items()] + [(f"{mid}.theta", jr[2])]
+        if mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, member.label + "_z") >= 0:
+            moves.append((f"{mid}.z", jp[2]))
+        for label, row in moves:
+            labels.append(label)
+            rows.append(row)
+    return labels, np.array(rows)
+
+
 def _central(mb) -> tuple[list[int], list[int]]:
     """(translation, rotation) dofs of the central members; an axial slide goes with the rotation (a helical
     mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes)."""

@@ -21,7 +21,18 @@ Packages: :mod:`gearcheck.lumped` (train description and reference solver),
 
 from importlib import metadata
 
-from gearcheck.api import SOLVERS, campbell, crosscheck, load, mjcf, modes, presets, simulate, write_report
+from gearcheck.api import (
+                           SOLVERS,
+                           campbell,
+                           crosscheck,
+                           load,
+                           mjcf,
+                           mode_pairing,
+                           modes,
+                           presets,
+                           simulate,
+                           write_report,
+)
 from gearcheck.compare.engine import CrosscheckResult
 from gearcheck.lumped.spec import TrainSpec
 from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
@@ -31,5 +42,5 @@ from gearcheck.shared.results import TimeResult
 __version__ = metadata.version("gearcheck")
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "ModalResult", "SolverError",
-           "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell", "crosscheck", "load", "mjcf", "modes",
-           "presets", "simulate", "write_report"]
+           "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell", "crosscheck", "load", "mjcf",
+           "mode_pairing", "modes", "presets", "simulate", "write_report"]

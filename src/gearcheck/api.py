@@ -12,6 +12,7 @@ from pathlib import Path
 from gearcheck.compare.campbell import CampbellResult
 from gearcheck.compare.campbell import campbell as campbell_diagram
 from gearcheck.compare.crosscheck import crosscheck
+from gearcheck.compare.mode_pairing import ModePairing, pair_modes
 from gearcheck.compare.report import write_report
 from gearcheck.lumped.loader import load_train, preset_names
 from gearcheck.lumped.side import LumpedSide
@@ -116,6 +117,20 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
     if len(speeds) < 2 or any(b <= a for a, b in zip(speeds, speeds[1:])):
         raise GearcheckError(f"speeds: give at least two speeds in ascending order, got {list(speeds)}")
     return campbell_diagram(spec, speeds, lambda s, w: sides[s].modes_at_speed(w), solvers, harmonics)
+
+
+def mode_pairing(train) -> ModePairing:
+    """The lumped model's and the MuJoCo twin's mode shapes paired by the modal assurance criterion.
+
+    Returns
+    -------
+    ModePairing
+        ``mac`` (reference modes x twin modes), ``paired`` (each mode's share in its frequency group's twin
+        modes: 1 is the same shape), ``findings`` (swapped, missing, spurious modes), ``to_dict()``; the
+        figure from :func:`gearcheck.compare.plots.mac_heatmap`.
+    """
+    spec = load(train)
+    return pair_modes(spec.name, _side("lumped", spec), _side("mujoco", spec))
 
 
 def _speed(value) -> float:

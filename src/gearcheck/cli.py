@@ -142,6 +142,13 @@ def _parser() -> argparse.ArgumentParser:
                    help="writes campbell.png and campbell.json (default out/campbell)")
     s.set_defaults(func=cmd_campbell)
 
+    s = sub.add_parser("mac", help="mode shapes of the lumped model and the MuJoCo twin paired by the modal "
+                                   "assurance criterion (PNG heat map and JSON)")
+    _train_arg(s)
+    s.add_argument("--out", type=Path, default=Path("out/mac"), metavar="DIR",
+                   help="writes mac.png and mac.json (default out/mac)")
+    s.set_defaults(func=cmd_mac)
+
     s = sub.add_parser("ste", help="static transmission error of every mesh, unloaded and loaded, with its tip "
                                    "reliefs (PNG and JSON)")
     _train_arg(s)
@@ -308,6 +315,21 @@ def cmd_campbell(args) -> int:
         print(f"  UNSTABLE ({zone['solver']}) from {zone['from_rpm']:g} to {zone['to_rpm']:g} rpm")
     print(f"  wrote {args.out / 'campbell.png'} and {args.out / 'campbell.json'}")
     return 0
+
+
+def cmd_mac(args) -> int:
+    from gearcheck.compare.plots import mac_heatmap
+
+    with OutputDirectory(args.out) as place:
+        pairing = gearcheck.mode_pairing(args.train)
+        write_file(place.path / "mac.png", mac_heatmap(pairing))
+        write_file(place.path / "mac.json", json.dumps(pairing.to_dict(), indent=2) + "\n")
+    print(f"{pairing.train}: {len(pairing.paired)} modes; each lumped mode lies in its frequency group's MuJoCo "
+          f"modes to {1.0 - pairing.paired.min():.1e} (worst)")
+    for line in pairing.findings:
+        print(f"  {line}")
+    print(f"  wrote {args.out / 'mac.png'} and {args.out / 'mac.json'}")
+    return 0 if not pairing.findings else 1
 
 
 def cmd_ste(args) -> int:

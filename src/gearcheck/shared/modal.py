@@ -112,17 +112,43 @@ def settling_time(M: np.ndarray, D: np.ndarray, K: np.ndarray, fraction: float) 
     return math.log(1.0 / fraction) / rate if rate > 0 else math.inf
 
 
-def multiplicities(frequencies: np.ndarray) -> list[int]:
+def frequency_groups(frequencies: np.ndarray) -> list[list[int]]:
+    """Indices of the modes sharing one (multiple) frequency, in order."""
     groups: list[list[int]] = []
     for i, f in enumerate(frequencies):
         if groups and _same(frequencies[groups[-1][0]], f):
             groups[-1].append(i)
         else:
             groups.append([i])
+    return groups
+
+
+def multiplicities(frequencies: np.ndarray) -> list[int]:
     out = [0] * len(frequencies)
-    for g in groups:
+    for g in frequency_groups(frequencies):
         for i in g:
             out[i] = len(g)
+    return out
+
+
+def modal_assurance(M: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Mass-weighted modal assurance criterion (Allemang & Brown 1982), MAC_ij =
+    |a_i^H M b_j|^2 / ((a_i^H M a_i)(b_j^H M b_j)), for shapes A (n, p) and B (n, q) in the same coordinates:
+    1 for the same shape, 0 for M-orthogonal ones.  The mass weighting makes it independent of the units
+    (m or rad) and of the choice of coordinates."""
+    cross = np.abs(np.conj(A).T @ M @ B) ** 2
+    norm_a = np.real(np.einsum("ip,ij,jp->p", np.conj(A), M, A))
+    norm_b = np.real(np.einsum("iq,ij,jq->q", np.conj(B), M, B))
+    return cross / np.outer(norm_a, norm_b)
+
+
+def paired_assurance(mac: np.ndarray, groups: list[list[int]]) -> np.ndarray:
+    """Per mode i of A, the share of its shape in the span of B's modes of the same frequency group (B's
+    shapes M-orthogonal): sum of MAC_ij over j in i's group.  A multiple frequency's shapes are any basis
+    of their space, so only this sum is defined; 1 means the pair spans the same modes."""
+    out = np.zeros(mac.shape[0])
+    for g in groups:
+        out[g] = mac[np.ix_(g, g)].sum(axis=1)
     return out
 
 

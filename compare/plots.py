@@ -27,6 +27,13 @@ def _save(fig, path):
     fig.savefig(path, dpi=110, metadata={"Software": None}, format="png")
 
 
+def _png(fig) -> bytes:
+    """The figure as PNG bytes (for :func:`gearcheck.shared.outputs.write_file`)."""
+    png = io.BytesIO()
+    _save(fig, png)
+    return png.getvalue()
+
+
 def headline_quantities(result) -> list[str]:
     """Carrier and ring accelerations (world y, as the accelerometers see them) and the first
     sun-planet and ring-planet mesh forces of every stage; the first four quantities when none
@@ -161,9 +168,7 @@ def mesh_stiffness(spec, cycles: int = 2) -> bytes:
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
     fig.suptitle(f"{spec.name}: time-varying mesh stiffness", fontsize=9)
-    png = io.BytesIO()
-    _save(fig, png)
-    return png.getvalue()
+    return _png(fig)
 
 
 def campbell_diagram(result) -> bytes:
@@ -200,9 +205,7 @@ def campbell_diagram(result) -> bytes:
                  + (f"; solvers agree to {agreement:.1e}" if agreement is not None else ""), fontsize=9)
     ax.legend(loc="upper left", fontsize=7)
     ax.grid(alpha=0.3)
-    png = io.BytesIO()
-    _save(fig, png)
-    return png.getvalue()
+    return _png(fig)
 
 
 def static_transmission_error(curves, train: str) -> bytes:
@@ -221,9 +224,7 @@ def static_transmission_error(curves, train: str) -> bytes:
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
     fig.suptitle(f"{train}: static transmission error (mesh approach along the line of action)", fontsize=9)
-    png = io.BytesIO()
-    _save(fig, png)
-    return png.getvalue()
+    return _png(fig)
 
 
 def relief_sweep(sweep: dict, train: str) -> bytes:
@@ -241,9 +242,7 @@ def relief_sweep(sweep: dict, train: str) -> bytes:
     ax.set_title(f"{train}: loaded static transmission error against the tip relief", fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    png = io.BytesIO()
-    _save(fig, png)
-    return png.getvalue()
+    return _png(fig)
 
 
 def mac_heatmap(pairing) -> bytes:
@@ -260,6 +259,4 @@ def mac_heatmap(pairing) -> bytes:
     ax.set_xlabel(f"{pairing.test} modes [Hz]")
     ax.set_title(f"{pairing.train}: modal assurance criterion, worst paired {pairing.paired.min():.9f}"
                  + (f"; {len(pairing.findings)} findings" if pairing.findings else ""), fontsize=9)
-    png = io.BytesIO()
-    _save(fig, png)
-    return png.getvalue()
+    return _png(fig)

@@ -43,11 +43,11 @@ def mesh_relief(mesh):
 
 class ToothPairs:
     """(k_j, e_j) of every slice-and-pair j of ``mesh`` at mesh positions xi: shape xi.shape + (size,);
-    pairs out of contact have k = 0 and e = inf."""
+    pairs out of contact have k = 0 and e = inf.  ``slices`` across a helical face (a spur face is one)."""
 
-    def __init__(self, mesh, mean_stiffness: float, slices: int | None = None):
+    def __init__(self, mesh, mean_stiffness: float, slices: int = DYNAMIC_SLICES):
         g = mesh.geometry
-        self.slices = slices or (DYNAMIC_SLICES if g.face_contact_ratio else 1)
+        self.slices = slices if g.face_contact_ratio else 1
         self.size = self.slices * math.ceil(g.contact_ratio + g.face_contact_ratio)
         per_width = mean_stiffness / (g.contact_ratio * g.face_width)
         self._stiffness = lambda s: np.full(np.shape(s), per_width)

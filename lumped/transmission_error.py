@@ -51,20 +51,26 @@ class StaticTransmissionError:
 
 def mesh_static_transmission_error(mesh, load: float, mean_stiffness: float, points: int = 401,
                                    slices: int | None = None) -> StaticTransmissionError:
-    """The unloaded and loaded static TE of ``mesh`` under ``load`` (N) over one mesh cycle."""
-    slices = slices or (HELICAL_SLICES if mesh.geometry.face_contact_ratio else 1)
+    """The unloaded and loaded static TE of ``mesh`` under ``load`` (N) over one mesh cycle; ``slices`` across a
+    helical face (default ``HELICAL_SLICES``)."""
     xi = np.linspace(0.0, 1.0, points)
-    contact = helical_mesh.loaded_transmission_error(load, *ToothPairs(mesh, mean_stiffness, slices)(xi))
+    pairs = ToothPairs(mesh, mean_stiffness, slices or HELICAL_SLICES)
+    contact = helical_mesh.loaded_transmission_error(load, *pairs(xi))
     return StaticTransmissionError(mesh.id, float(load), float(mean_stiffness), xi, contact.unloaded,
                                    contact.approach, contact.stiffness)
 
 
-def static_transmission_error(spec, points: int = 401, slices: int | None = None) -> list[StaticTransmissionError]:
-    """Every mesh's static TE under the train's static load (mean mesh stiffness load sharing)."""
+def static_loads(spec) -> list[tuple]:
+    """(mesh, static load N, mean stiffness N/m) of every mesh (mean mesh stiffness load sharing)."""
     model = build_model(spec)
     static = static_solution(model)
-    return [mesh_static_transmission_error(mesh, abs(float(f)), float(k), points, slices)
+    return [(mesh, abs(float(f)), float(k))
             for mesh, f, k in zip(spec.meshes, static.mesh_force, model.excitation.mean_stiffness)]
+
+
+def static_transmission_error(spec, points: int = 401, slices: int | None = None) -> list[StaticTransmissionError]:
+    """Every mesh's static TE under the train's static load."""
+    return [mesh_static_transmission_error(mesh, load, k, points, slices) for mesh, load, k in static_loads(spec)]
 
 
 def relieved(mesh, amount: float):
@@ -78,18 +84,16 @@ def relieved(mesh, amount: float):
 def relief_sweep(spec, amounts, points: int = 401, slices: int | None = None) -> dict:
     """Loaded static TE peak-to-peak of the first planet's meshes whose gears carry a tip relief, with the
     relief amount set to each of ``amounts`` (m; the lengths and shapes as the train gives them)."""
-    base = {c.mesh: c for c in static_transmission_error(spec, points, slices)}
     # one planet's meshes: every planet's mesh with a central gear has the same curve over its own cycle
-    meshes = [m for m in spec.meshes if m.planet_index == 0
+    meshes = [(m, load, k) for m, load, k in static_loads(spec) if m.planet_index == 0
               and (m.central_gear.relief_length > 0 or m.planet_gear.relief_length > 0)]
     if not meshes:
         raise GearcheckError(f"{spec.path}: no gear has a tip_relief to sweep (give one a tip_relief with its "
                              "length_mm)")
     out = {"amounts_m": [float(a) for a in amounts], "meshes": {}}
-    for mesh in meshes:
-        b = base[mesh.id]
-        ptp = [float(np.ptp(mesh_static_transmission_error(relieved(mesh, a), b.load, b.mean_stiffness, points,
-                                                           slices).loaded)) for a in amounts]
-        out["meshes"][mesh.id] = {"loaded_peak_to_peak_m": ptp, "mean_deflection_m": b.mean_deflection,
+    for mesh, load, k in meshes:
+        ptp = [float(np.ptp(mesh_static_transmission_error(relieved(mesh, a), load, k, points, slices).loaded))
+               for a in amounts]
+        out["meshes"][mesh.id] = {"loaded_peak_to_peak_m": ptp, "mean_deflection_m": load / k,
                                   "best_amount_m": float(amounts[int(np.argmin(ptp))])}
     return out

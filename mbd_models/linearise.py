@@ -144,7 +144,7 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
         else:
             axes = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0])}
         moves = [(f"{mid}.{name}", axis @ jp) for name, axis in axes.items()] + [(f"{mid}.theta", jr[2])]
-        if mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, member.label + "_z") >= 0:
+        if _axial_dof(mb, mid) is not None:
             moves.append((f"{mid}.z", jp[2]))
         for label, row in moves:
             labels.append(label)
@@ -155,11 +155,15 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
 def _central(mb) -> tuple[list[int], list[int]]:
     """(translation, rotation) dofs of the central members; an axial slide goes with the rotation (a helical
     mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes)."""
-    m = mb.model
     central = [mid for mid, member in mb.spec.members.items() if not member.is_planet]
-    axial = [int(m.jnt_dofadr[j]) for mid in central
-             if (j := mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, mb.spec.members[mid].label + "_z")) >= 0]
+    axial = [dof for mid in central if (dof := _axial_dof(mb, mid)) is not None]
     return [i for mid in central for i in mb.dadr[mid][:2]], [mb.dadr[mid][2] for mid in central] + axial
+
+
+def _axial_dof(mb, mid: str) -> int | None:
+    """The dof address of member ``mid``'s axial slide (a helical stage's members have one), or None."""
+    joint = mujoco.mj_name2id(mb.model, mujoco.mjtObj.mjOBJ_JOINT, mb.spec.members[mid].label + "_z")
+    return int(mb.model.jnt_dofadr[joint]) if joint >= 0 else None
 
 
 def modes_at_speed(mb, input_speed: float) -> ModalResult:

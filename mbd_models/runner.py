@@ -115,12 +115,14 @@ class _ToothContacts:
         m = mb.model
         self.relieved = mb.excitation.relieved
         self.tendons = mb.mesh_tendon[self.relieved]
-        self.wraps = [np.arange(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t]) for t in self.tendons]
-        self.qadr = [m.jnt_qposadr[m.wrap_objid[w]] for w in self.wraps]
+        self.wraps = np.concatenate([np.arange(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t])
+                                     for t in self.tendons])
+        self.qadr = m.jnt_qposadr[m.wrap_objid[self.wraps]]
+        self.starts = np.cumsum(np.concatenate([[0], m.tendon_num[self.tendons][:-1]]))
 
     def apply(self, m: mujoco.MjModel, d: mujoco.MjData, e, pairs) -> None:
         offset = 0.0 if e is None else e[self.relieved]
-        length = np.array([m.wrap_prm[w] @ d.qpos[a] for w, a in zip(self.wraps, self.qadr)]) - offset
+        length = np.add.reduceat(m.wrap_prm[self.wraps] * d.qpos[self.qadr], self.starts) - offset
         k, gap = pairs[..., 0], pairs[..., 1]
         touching = length[:, None] > gap
         total = np.sum(k * touching, axis=-1)

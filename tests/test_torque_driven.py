@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.lumped.variants import wide_stage
+from gearcheck.lumped.variants import edited, wide_stage
 
 TEETH = {3: (30, 24, 78), 4: (30, 24, 78), 5: (21, 24, 69), 6: (30, 24, 78)}  # z_s + z_r divisible by N
 SPEEDS = (500.0, 2000.0, 4000.0, 6000.0)
@@ -66,8 +66,6 @@ def test_presets_pass_torque_driven(preset):
     """The presets without their input shaft (the sun driven by the torque that balances the load) pass their
     cross-check, and their bearings carry the free-body load in both solvers (hub-drive passes too, measured
     at 606 rpm; it is left out here for its 0.4 s settling)."""
-    from gearcheck.lumped.variants import edited
-
     spec = edited(preset, [(r"^input_shaft_.*\n", "")], "torque-driven")
     assert spec.operating.input_shaft_stiffness is None
     result = gearcheck.crosscheck(spec, speed=3000.0)

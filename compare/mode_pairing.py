@@ -46,13 +46,14 @@ class ModePairing:
 
 
 def pair_modes(train: str, reference, test) -> ModePairing:
-    """Pair the modes of two sides (objects with ``solver``, ``modes()`` and ``physical_modes()``)."""
-    labels_a, M, shapes_a = reference.physical_modes()
-    labels_b, _, shapes_b = test.physical_modes()
+    """Pair the modes of two sides (objects with ``solver``, ``modes()`` and ``physical_modes(modal)``)."""
+    modes_a, modes_b = reference.modes(), test.modes()
+    labels_a, M, shapes_a = reference.physical_modes(modes_a)
+    labels_b, _, shapes_b = test.physical_modes(modes_b)
     if labels_a != labels_b:
         raise GearcheckError(f"{train}: {reference.solver} and {test.solver} name different coordinates "
                              f"({len(labels_a)} and {len(labels_b)})")
-    fa, fb = np.asarray(reference.modes().frequencies), np.asarray(test.modes().frequencies)
+    fa, fb = np.asarray(modes_a.frequencies), np.asarray(modes_b.frequencies)
     if len(fa) != len(fb):
         raise GearcheckError(f"{train}: {reference.solver} has {len(fa)} modes, {test.solver} {len(fb)}")
     mac = modal_assurance(M, shapes_a, shapes_b)

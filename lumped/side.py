@@ -49,9 +49,10 @@ class LumpedSide:
     def modes_at_speed(self, input_speed: float) -> ModalResult:
         return modes_at_speed(self.model, input_speed)
 
-    def physical_modes(self) -> tuple[list[str], np.ndarray, np.ndarray]:
-        """(coordinate labels, mass matrix, mode shapes) in the train's physical coordinates (the model's own)."""
-        return self.model.dofs.labels(), self.model.M, self.modes().shapes
+    def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray, np.ndarray]:
+        """(coordinate labels, mass matrix, the shapes of ``modal``) in the train's physical coordinates (the
+        model's own)."""
+        return self.model.dofs.labels(), self.model.M, modal.shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate(self.model, settings, method=self.method, progress=progress)

@@ -43,12 +43,12 @@ class MujocoSide:
     def modes_at_speed(self, input_speed: float) -> ModalResult:
         return linearise.modes_at_speed(self.model, input_speed)
 
-    def physical_modes(self) -> tuple[list[str], np.ndarray, np.ndarray]:
-        """(coordinate labels, mass matrix, mode shapes) in the train's physical coordinates, mapped from
-        MuJoCo's joints by its own Jacobians (:func:`gearcheck.mbd_models.linearise.physical_coordinates`)."""
+    def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray, np.ndarray]:
+        """(coordinate labels, mass matrix, the shapes of ``modal``) in the train's physical coordinates, mapped
+        from MuJoCo's joints by its own Jacobians (:func:`gearcheck.mbd_models.linearise.physical_coordinates`)."""
         labels, T = linearise.physical_coordinates(self.model)
         T_inv = np.linalg.inv(T)
-        return labels, T_inv.T @ linearise.mass_matrix(self.model) @ T_inv, T @ self.modes().shapes
+        return labels, T_inv.T @ linearise.mass_matrix(self.model) @ T_inv, T @ modal.shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock)

@@ -19,8 +19,11 @@ from gearcheck.compare.engine import CrosscheckResult, compare
 from gearcheck.compare.measure import MIN_CYCLES
 from gearcheck.compare.measurements import attach, check_quantities, load_measurements
 from gearcheck.compare.plan import TrainPlan, TransientPlan
+from gearcheck.compare.recorded import RecordedSide
 from gearcheck.compare.tolerances import Tolerances
+from gearcheck.compare.user_model import user_side
 from gearcheck.lumped.loader import load_train
+from gearcheck.lumped.matrix_file import SUFFIXES
 from gearcheck.lumped.modal import settling_time
 from gearcheck.lumped.published import FINDING
 from gearcheck.lumped.published_parameters import LABELS
@@ -35,12 +38,13 @@ from gearcheck.shared.stepping import transient_step
 from gearcheck.shared.units import rad_s_to_rpm
 
 MODELS = ("general",) + PUBLISHED_MODELS
+AGAINST = ("lumped", "mujoco")
 GENERAL_DURATION = 0.1  # s, default simulated time of a train
 PUBLISHED_DURATION = 0.02  # s, of the 4-DOF models' start-stop transient
 
 
-def crosscheck(train, *, speed: float | None = None, duration: float | None = None, model: str = "general",
-               dt_lumped: float | None = None, dt_mujoco: float | None = None, tolerances=None, measurements=None,
+def crosscheck(train, *, speed: float | None = None, duration: float | None = None, model="general",
+               against: str = "lumped", results=None, columns=None, modes=None, dt_lumped: float | None = None, dt_mujoco: float | None = None, tolerances=None, measurements=None,
                sensor_band: tuple[float, float] | None = None, baseline=None, update_baseline: bool = False,
                progress=None) -> CrosscheckResult:
     """Cross-check a train's lumped model against its MuJoCo twin.
@@ -54,9 +58,18 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     duration : float, optional
         Simulated time in s (default: the baseline's when one is checked, else 0.1 s; 0.02 s for a
         published 4-DOF ``model``).
-    model : str
-        ``"general"`` (gearcheck's lumped model) or a 4-DOF model of Matejic et al. (2021):
-        ``"as-published"``, ``"energy-derived"``, ``"energy-derived-axis"``, ``"consistent"``.
+    model : str, path, LinearModel or side
+        ``"general"`` (gearcheck's lumped model against its MuJoCo twin); a 4-DOF model of Matejic et al.
+        (2021) against the twin of its own idealisation: ``"as-published"``, ``"energy-derived"``,
+        ``"energy-derived-axis"``, ``"consistent"``; or a user's model, checked against ``against``: a
+        :class:`~gearcheck.lumped.linear_model.LinearModel`, a ``.mat``/``.npz`` file of matrices,
+        ``"module:factory"`` / ``"file.py:factory"``, or a side (:mod:`gearcheck.compare.user_model`).
+    against : str
+        What a user's model is checked against: ``"lumped"`` (the reference model) or ``"mujoco"`` (the twin).
+    results, columns, modes : path, optional
+        Another solver's results as the user's model (:mod:`gearcheck.compare.recorded`): its time series
+        (``.csv``, ``.parquet``, ``.mat``), the column map (a TOML file or a dict) naming gearcheck's signals
+        in it, and optionally its natural frequencies and mode shapes (``.npz``, ``.mat``, ``.csv``).
     dt_lumped, dt_mujoco : float, optional
         Fixed steps of the two solvers (default: each from its own highest natural frequency).
     tolerances : path or dict, optional
@@ -80,25 +93,50 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         ``.verdict`` ("PASS", "FAIL" or "INCONCLUSIVE"), ``.failures``, ``.unresolved``, ``.quantities`` (``result[name]``),
         ``.measurements``, ``.moved`` (metrics moved from the baseline), ``.write(directory)``.
     """
-    if model not in MODELS:
-        raise GearcheckError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
+    if against not in AGAINST:
+        raise GearcheckError(f"--against {against!r}: choose {' or '.join(AGAINST)}")
     spec = load_train(train, speed)
+    if results is not None:
+        if not (isinstance(model, str) and model == "general"):
+            raise GearcheckError("--results gives the model checked: leave --model out")
+        if columns is None:
+            raise GearcheckError("--results needs --columns, the map of its columns to gearcheck's signals")
+        user = RecordedSide(spec, results, columns, modes)
+        duration = user.duration if duration is None else duration
+    elif isinstance(model, str) and model in MODELS:
+        user = None
+    elif isinstance(model, str) and ":" not in model and Path(model).suffix not in SUFFIXES:
+        if Path(model).suffix:
+            raise GearcheckError(f"--model {model}: a model file is {' or '.join(SUFFIXES)}, not {Path(model).suffix!r}")
+        raise GearcheckError(f"unknown model {model!r}: choose one of {', '.join(MODELS)}, or give your own: a model "
+                             f"file ({' or '.join(SUFFIXES)}), module:factory or file.py:factory")
+    else:
+        user = user_side(model, spec)
     if sensor_band is not None and not 0 < sensor_band[0] < sensor_band[1]:
         raise GearcheckError(f"sensor band {sensor_band[0]:g} {sensor_band[1]:g} Hz: needs 0 < LOW < HIGH")
     tol = Tolerances.for_train(spec, tolerances)
     path = _baseline_path(baseline, spec.name)
     stored = read_baseline(path) if path is not None and not update_baseline else None
     if duration is None:
-        default = GENERAL_DURATION if model == "general" else PUBLISHED_DURATION
+        default = PUBLISHED_DURATION if model in PUBLISHED_MODELS else GENERAL_DURATION
         duration = default if stored is None else stored["duration_s"]
     if stored is not None:  # before the run: a mismatch is refused at once
         check_settings(stored, duration, rad_s_to_rpm(spec.operating.input_speed))
-    if model == "general":
-        reference, test = LumpedSide(spec), MujocoSide(spec)
-        plan = TrainPlan.of(spec, reference.model.kin, step_limits(reference.model).omega_max, duration,
-                            settling_time(reference.model, STEADY_THRESHOLD))
+    if model == "general" or user is not None:
+        lumped = LumpedSide(spec)
+        reference, test = lumped, MujocoSide(spec)
         settings = (RunSettings(duration, dt_lumped), RunSettings(duration, dt_mujoco))
         notes = []
+        if user is not None:
+            reference = lumped if against == "lumped" else test
+            test = user
+            settings = (settings[0 if against == "lumped" else 1], RunSettings(duration))
+            missing = user.unmapped() if hasattr(user, "unmapped") else []
+            if missing:
+                notes.append(f"{user.solver} does not report {len(missing)} of the train's gated quantities "
+                             f"(not compared): {', '.join(missing)}.")
+        plan = TrainPlan.of(spec, lumped.model.kin, step_limits(lumped.model).omega_max, duration,
+                            settling_time(lumped.model, STEADY_THRESHOLD))
     else:
         reference, test = PublishedSide(spec, model), PublishedTwinSide(spec, model)
         modes_a, modes_b = reference.modes(), test.modes()
@@ -114,8 +152,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     entries = list(spec.measurements)
     if measurements is not None:
         entries += load_measurements(measurements) if isinstance(measurements, (str, Path)) else list(measurements)
-    quantities = ([s.name for s in train_signals(spec) if s.compared] if model == "general"
-                  else [f"{label}.acceleration" for label in LABELS])
+    quantities = ([f"{label}.acceleration" for label in LABELS] if model in PUBLISHED_MODELS
+                  else [s.name for s in train_signals(spec) if s.compared])
     tol.check(quantities)
     check_quantities(entries, quantities)  # before the runs: a wrong name is refused at once
     if duration < MIN_CYCLES * plan.cycle:

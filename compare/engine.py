@@ -43,6 +43,7 @@ from gearcheck.compare.align import (
     uniform_grid,
 )
 from gearcheck.compare.metrics import modal_metrics, spectral_metrics, waveform_metrics
+from gearcheck.compare.mode_pairing import pair_modes
 from gearcheck.compare.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.outputs import OutputDirectory
@@ -150,13 +151,9 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     modes_a = reference.modes()
     wall["lumped_modes_s"] = time.perf_counter() - started
     started = time.perf_counter()
-    modes_b = test.modes()
+    modes_b = test.modes() if getattr(test, "has_modes", True) else None
     wall["mujoco_modes_s"] = time.perf_counter() - started
-    if len(modes_a) != len(modes_b):
-        raise SolverError(f"the models have different numbers of modes ({len(modes_a)} {reference.solver}, "
-                          f"{len(modes_b)} {test.solver})")
-    modal_rows = modal_metrics(modes_a.frequencies, modes_b.frequencies, modes_a.types, modes_b.types,
-                               modes_a.multiplicity)
+    modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
 
     asked = settings[0].duration
     adjustable = [s.dt is None for s in settings]
@@ -166,7 +163,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
         attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress)
         needed = plan.needed_duration() if plan.detect_steady else None
-        reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked
+        rerunnable = all(getattr(side, "rerunnable", True) for side in (reference, test))
+        reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked and rerunnable
         if attempt.how is None and not extended and reachable:
             notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
                          f"the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s, plus "
@@ -199,7 +197,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         "lumped": {k: a.info[k] for k in SIDE_SETTINGS if k in a.info},
         "mujoco": {k: v for k, v in b.info.items() if k != "wall_time_s" and _plain(v)},
         "common_sample_rate_hz": fs, "steady_cycle_s": plan.cycle,
-        "integration_check_steps_s": [a_check.info["dt_s"], b_check.info["dt_s"]],
+        "integration_check_steps_s": [c.info["dt_s"] if c is not None else None for c in (a_check, b_check)],
         "sensor_band_hz": list(sensor_band) if sensor_band else None,
         "tolerances": dict(sorted(tolerances.values.items())),
     }
@@ -239,13 +237,29 @@ class _Attempt:
                       for forces, cycle in plan.steady_groups(names) for i in (0, 1)]
             t0, how = steady_state(grid, groups, plan.settle)
             t0 = 0.5 * grid[-1] if how is None else t0
-        errors = {n: (integration_error(a, a_check, n, t0, a), integration_error(b, b_check, n, t0, a)) for n in names}
+        errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a)
+                           for run, check in ((a, a_check), (b, b_check))) for n in names}
         comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors)
         return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons)
 
 
+def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
+    """Mode by mode; a test model with fewer modes (fewer coordinates: a torsional model) mode by mode with
+    its partner by shape (:func:`gearcheck.compare.mode_pairing.pair_modes`)."""
+    if len(modes_a) == len(modes_b):
+        return modal_metrics(modes_a.frequencies, modes_b.frequencies, modes_a.types, modes_b.types,
+                             modes_a.multiplicity)
+    if not (hasattr(reference, "physical_modes") and hasattr(test, "physical_modes")):
+        raise SolverError(f"the models have different numbers of modes ({len(modes_a)} {reference.solver}, "
+                          f"{len(modes_b)} {test.solver}) and no mode shapes to pair them by")
+    partner = pair_modes(spec.name, reference, test, (modes_a, modes_b)).mac.argmax(axis=0)
+    return modal_metrics(modes_a.frequencies[partner], modes_b.frequencies, [modes_a.types[i] for i in partner],
+                         modes_b.types, [modes_a.multiplicity[i] for i in partner])
+
+
 def _run_pairs(sides, settings, wall, progress):
-    """Each side's run and its integration check (2 h, or h / 2 where 2 h is beyond its stable step)."""
+    """Each side's run and its integration check (2 h, or h / 2 where 2 h is beyond its stable step); a
+    recorded side (``rerunnable`` False) has no check."""
     pairs = []
     for i, (side, run_settings) in enumerate(zip(sides, settings)):
         label = ("lumped", "mujoco")[i]
@@ -254,6 +268,9 @@ def _run_pairs(sides, settings, wall, progress):
         started = time.perf_counter()
         run = side.run(run_settings, report)
         wall[f"{label}_run_s"] = time.perf_counter() - started
+        if not getattr(side, "rerunnable", True):
+            pairs.append((run, None))
+            continue
         h = run.info["dt_s"]
         check_dt = 2 * h if 2 * h <= side.stable_step() else 0.5 * h
         report = (lambda f, i=i: progress((1.5 * i + 1.0 + 0.5 * f) / 3.0)) if progress else None

@@ -4,8 +4,8 @@ Both sides give their modes in the train's physical coordinates (each member's c
 radial and tangential axes, its rotation, and its axial motion in a helical stage; the MuJoCo side maps
 its joints there through its own Jacobians).  The mass-weighted MAC (Allemang & Brown 1982) of every
 reference mode against every test mode follows.  A multiple frequency's shapes are any basis of their
-space, so a mode is matched by its share in the span of the test modes of the same frequency group
-(:func:`gearcheck.shared.modal.paired_assurance`).  Findings:
+space, so a mode is matched by its share in the span of the test modes of its frequency group (the sum
+of its MAC over them).  Findings:
 
 * swapped: a reference mode lies, not in its own group's test modes, but in another group's;
 * missing: a reference mode lies in no test mode;
@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gearcheck.shared.errors import GearcheckError
-from gearcheck.shared.modal import frequency_groups, modal_assurance, paired_assurance
+from gearcheck.shared.modal import frequency_groups, modal_assurance
 
 MATCH = 0.9  # a share of a shape above it counts as a match
 NO_MATCH = 0.5  # a shape whose best share is below it has no partner
@@ -45,28 +45,34 @@ class ModePairing:
                 "paired": self.paired.tolist(), "worst_paired": float(self.paired.min()), "findings": self.findings}
 
 
-def pair_modes(train: str, reference, test) -> ModePairing:
-    """Pair the modes of two sides (objects with ``solver``, ``modes()`` and ``physical_modes(modal)``)."""
-    modes_a, modes_b = reference.modes(), test.modes()
+def pair_modes(train: str, reference, test, modes: tuple | None = None) -> ModePairing:
+    """Pair the modes of two sides (objects with ``solver``, ``modes()`` and ``physical_modes(modal)``).
+
+    A test model with fewer coordinates (a torsional model against the translational-torsional reference)
+    is compared on the coordinates it has, with the reference's mass over them; each reference mode's own
+    partners are the test modes of the frequency group nearest to it.  ``modes``: the two sides' modes when
+    already computed."""
+    modes_a, modes_b = modes if modes is not None else (reference.modes(), test.modes())
     labels_a, M, shapes_a = reference.physical_modes(modes_a)
     labels_b, _, shapes_b = test.physical_modes(modes_b)
-    if labels_a != labels_b:
-        raise GearcheckError(f"{train}: {reference.solver} and {test.solver} name different coordinates "
-                             f"({len(labels_a)} and {len(labels_b)})")
+    missing = [label for label in labels_b if label not in labels_a]
+    if missing:
+        raise GearcheckError(f"{train}: {test.solver} has coordinates {reference.solver} does not ({missing[0]}, ...)")
+    keep = [labels_a.index(label) for label in labels_b]
+    M, shapes_a = M[np.ix_(keep, keep)], shapes_a[keep]
     fa, fb = np.asarray(modes_a.frequencies), np.asarray(modes_b.frequencies)
-    if len(fa) != len(fb):
-        raise GearcheckError(f"{train}: {reference.solver} has {len(fa)} modes, {test.solver} {len(fb)}")
     mac = modal_assurance(M, shapes_a, shapes_b)
-    groups = frequency_groups(fa)
-    paired = paired_assurance(mac, groups)
-    group_of = {i: k for k, g in enumerate(groups) for i in g}
-    shares = np.array([[mac[i, g].sum() for g in groups] for i in range(len(fa))])  # reference mode x group
+    groups = frequency_groups(fb)
+    centres = np.array([fb[g[0]] for g in groups])
+    own = [int(np.argmin(np.abs(centres - f) / max(f, centres.max() * 1e-12))) for f in fa]
+    shares = np.array([[mac[i, g].sum() for g in groups] for i in range(len(fa))])  # reference mode x test group
+    paired = shares[np.arange(len(fa)), own]
     findings = []
     for i in range(len(fa)):
         if paired[i] >= MATCH:
             continue
         best = int(np.argmax(shares[i]))
-        if shares[i, best] >= MATCH and best != group_of[i]:
+        if shares[i, best] >= MATCH and best != own[i]:
             j = groups[best][0]
             findings.append(f"swapped: {reference.solver} mode {i + 1} ({fa[i]:.6g} Hz) is {test.solver} mode "
                             f"{j + 1} ({fb[j]:.6g} Hz), MAC {shares[i, best]:.3f}")

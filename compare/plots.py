@@ -248,13 +248,13 @@ def relief_sweep(sweep: dict, train: str) -> bytes:
 def mac_heatmap(pairing) -> bytes:
     """PNG of a :class:`~gearcheck.compare.mode_pairing.ModePairing`: the MAC matrix, reference modes down, test
     modes across, with the frequencies on the axes."""
-    n = len(pairing.frequencies_reference)
     fig, ax = _figure(figsize=(7.5, 6.5))
     image = ax.imshow(pairing.mac, vmin=0.0, vmax=1.0, cmap="viridis", origin="upper")
     fig.colorbar(image, ax=ax, label="MAC")
-    ticks = np.arange(n)
-    ax.set_yticks(ticks, [f"{i + 1}: {f:.5g}" for i, f in enumerate(pairing.frequencies_reference)], fontsize=6)
-    ax.set_xticks(ticks, [f"{f:.5g}" for f in pairing.frequencies_test], fontsize=6, rotation=90)
+    ax.set_yticks(np.arange(len(pairing.frequencies_reference)),
+                  [f"{i + 1}: {f:.5g}" for i, f in enumerate(pairing.frequencies_reference)], fontsize=6)
+    ax.set_xticks(np.arange(len(pairing.frequencies_test)), [f"{f:.5g}" for f in pairing.frequencies_test],
+                  fontsize=6, rotation=90)
     ax.set_ylabel(f"{pairing.reference} modes [Hz]")
     ax.set_xlabel(f"{pairing.test} modes [Hz]")
     ax.set_title(f"{pairing.train}: modal assurance criterion, worst paired {pairing.paired.min():.9f}"

@@ -44,13 +44,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.lumped.published_parameters import LABELS, PaperParameters, check_model, four_dof_result
-from gearcheck.lumped.time_solver import rk4_step
-from gearcheck.shared.errors import DivergenceError
-from gearcheck.shared.modal import ModalResult, modal_result
-from gearcheck.shared.results import TimeResult
-from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import transient_step
+from gearcheck.lumped.linear_model import LinearModel
+from gearcheck.lumped.linear_run import linear_modes
+from gearcheck.lumped.published_parameters import DESCRIPTIONS, LABELS, PaperParameters, check_model
+from gearcheck.shared.modal import ModalResult
 
 FINDING = (
     "Matejic et al. (2021) write the potential energy as 1/2 c1 (y1 - u1)^2 + 1/2 c2 (y1 - u2)^2 (Eq. 4), "
@@ -169,37 +166,18 @@ def four_dof_model(source, model: str = "as-published", planet_sets: int = 1) ->
 
 def natural_frequencies(model: FourDofModel) -> ModalResult:
     """Undamped modes of (C, M), rigid-body modes as 0 Hz, typed rigid or elastic."""
-    return modal_result(model.params.source, model.name, model.C, model.M, LABELS)
+    modal = linear_modes(linear_model(model))
+    modal.train = model.params.source
+    return modal
 
 
-def simulate(model: FourDofModel, settings: RunSettings, load: bool = True) -> TimeResult:
-    """Start-stop regime: from rest (q = q' = 0) under D(t), fixed-step classical RK4.
-
-    load: apply the output torque on theta_b with the mean input torque M_h = T_out/i, so the
-    train's rigid rotation only sees the ripple (the paper's Eq. 13 has no load: load=False,
-    then the whole train accelerates under M_h).  Either way the rigid-body modes are kept: the
-    accelerations contain their (constant) part.  The step defaults to
-    :func:`gearcheck.shared.stepping.transient_step` of the model's own frequencies.
-    """
-    dt = transient_step(natural_frequencies(model).frequencies) if settings.dt is None else settings.dt
-    steps, _ = settings.grid(dt)
-    Minv = np.linalg.inv(model.M)
-    A_q, A_v = -Minv @ model.C, -Minv @ model.B
-
-    def accel(t, q, v):
-        return A_q @ q + A_v @ v + Minv @ model.D(t, load)
-
-    t = np.arange(steps + 1) * dt
-    q = np.zeros((steps + 1, 4))
-    a = np.zeros((steps + 1, 4))
-    qi, vi = np.zeros(4), np.zeros(4)
-    for i in range(steps):
-        a[i] = accel(t[i], qi, vi)
-        qi, vi = rk4_step(lambda s, q_, v_, ti=t[i]: accel(ti + 0.5 * s * dt, q_, v_), qi, vi, dt)
-        q[i + 1] = qi
-    a[-1] = accel(t[-1], qi, vi)
-    if not np.all(np.isfinite(q)):
-        raise DivergenceError(float(t[np.argmax(~np.isfinite(q).all(axis=1))]),
-                              f"the {model.name} RK4 integration (dt = {dt:g} s)")
-    info = {"method": f"{model.name} 4-DOF, rk4", "dt_s": dt, "steps": steps, "load": load}
-    return four_dof_result(model.params.source, model.name, model.name, t, q, a, info)
+def linear_model(model: FourDofModel, load: bool = True) -> LinearModel:
+    """The 4-DOF model as any user's model is given to gearcheck: M q'' + B q' + C q = D(t) from rest
+    (start-stop regime), ``load``: the output torque on theta_b with the mean input torque
+    M_h = T_out / i, so the train's rigid rotation only sees the ripple (the paper's Eq. 13 has no load:
+    load=False, then the whole train accelerates under M_h).  The rigid-body modes are kept: the
+    accelerations contain their (constant) part.  Its coordinates are the paper's, not the train's
+    (an empty map): it is compared with the twin of its own idealisation."""
+    return LinearModel(model.name, list(LABELS), model.M, model.C, C=model.B,
+                       forcing=lambda t: model.D(t, load), physical={}, start="rest", descriptions=DESCRIPTIONS,
+                       source=f"{model.params.source} ({model.name})")

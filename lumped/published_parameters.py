@@ -25,11 +25,10 @@ from gearcheck.lumped.excitation import Excitation
 from gearcheck.lumped.kinematics import kinematics
 from gearcheck.lumped.mesh_stiffness import stiffness_model
 from gearcheck.shared.errors import GearcheckError
-from gearcheck.shared.results import Signal, TimeResult
+from gearcheck.shared.results import TimeResult, coordinate_signals
 
 MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")
 LABELS = ("y1", "theta_h", "theta_f", "theta_b")
-UNITS = ("m", "rad", "rad", "rad")
 KINEMATICS = {  # model -> (y1 direction, where the carrier's mass sits)
     "as-published": ("radial", "pitch"),
     "energy-derived": ("radial", "pitch"),
@@ -132,22 +131,14 @@ class PaperParameters:
         return m_h, t_b
 
 
-KINDS = {"y1": ("acceleration", "m/s^2"), "theta_h": ("angular_acceleration", "rad/s^2"),
-         "theta_f": ("angular_acceleration", "rad/s^2"), "theta_b": ("angular_acceleration", "rad/s^2")}
 DESCRIPTIONS = {"y1": "planet-set displacement y1 (Matejic et al. 2021)", "theta_h": "carrier h angle",
                 "theta_f": "planet angle relative to the carrier", "theta_b": "ring b angle"}
 
 
 def four_dof_result(train: str, solver: str, model: str, t, q, a, info) -> TimeResult:
-    """The named signals of a 4-DOF run: ``LABEL.acceleration`` (gated) and the coordinate ``LABEL``
-    itself, for q = (y1, theta_h, theta_f, theta_b) with time along axis 0.  The regime is a transient
-    from rest: there is no steady window (settle time 0)."""
-    signals, columns = [], []
-    for j, (label, unit) in enumerate(zip(LABELS, UNITS)):
-        kind, acc_unit = KINDS[label]
-        signals.append(Signal(f"{label}.acceleration", kind, acc_unit,
-                              f"{DESCRIPTIONS[label]}: acceleration ({model})"))
-        columns.append(a[:, j])
-        signals.append(Signal(label, "coordinate", unit, DESCRIPTIONS[label], compared=False))
-        columns.append(q[:, j])
-    return TimeResult(train, solver, np.asarray(t), signals, np.column_stack(columns), 0.0, info)
+    """The named signals of a 4-DOF run (:func:`gearcheck.shared.results.coordinate_signals`) for
+    q = (y1, theta_h, theta_f, theta_b) with time along axis 0.  The regime is a transient from rest: there
+    is no steady window (settle time 0)."""
+    columns = [x for j in range(len(LABELS)) for x in (a[:, j], q[:, j])]
+    return TimeResult(train, solver, np.asarray(t), coordinate_signals(LABELS, DESCRIPTIONS, model),
+                      np.column_stack(columns), 0.0, info)

@@ -2,8 +2,9 @@
 
 * :class:`LumpedSide` -- the reference translational-torsional model of a train (Lin & Parker
   1999; several stages after Kiracofe & Parker 2007; mesh phasing after Parker & Lin 2004);
+* :class:`LinearSide` -- any model given as matrices: a user's, in Python or in a file;
 * :class:`PublishedSide` -- one of the 4-DOF models of Matejic et al. (2021), as published or as
-  derived.
+  derived, as a model given as matrices.
 """
 
 from __future__ import annotations
@@ -13,15 +14,16 @@ from functools import cached_property
 import numpy as np
 
 from gearcheck.lumped.assembly import LumpedModel, build_model
+from gearcheck.lumped.linear_model import LinearModel
+from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, simulate_linear, step_limits, unmapped
 from gearcheck.lumped.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed
-from gearcheck.lumped.published import FourDofModel, four_dof_model, natural_frequencies
-from gearcheck.lumped.published import simulate as simulate_4dof
+from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import simulate, stable_step
+from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import undamped_stable_step
 
 
 class LumpedSide:
@@ -61,28 +63,56 @@ class LumpedSide:
         return stable_step(self.model)
 
 
-class PublishedSide:
-    """A 4-DOF model of Matejic et al. (2021) (``name`` one of
-    :data:`gearcheck.lumped.published_parameters.MODELS`), from rest under the paper's excitation
-    (``load``: with the output load on ring b)."""
+class LinearSide:
+    """A model given as matrices (:class:`~gearcheck.lumped.linear_model.LinearModel`: a user's, or a
+    published one) for the train ``spec``; validated against the train's coordinates when built."""
 
-    references = ("matejic2021",)
-
-    def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1):
+    def __init__(self, model: LinearModel, spec, references: tuple[str, ...] = ()):
         self.spec = spec
-        self.solver = name
-        self.load = load
-        self.planet_sets = planet_sets
-
-    @cached_property
-    def model(self) -> FourDofModel:
-        return four_dof_model(self.spec, self.solver, self.planet_sets)
+        self.train = build_model(spec)  # the train's coordinates and kinematics, which the model maps into
+        self.linear = model.check(spec, self.train.dofs.labels())
+        self.solver = model.name
+        self.references = references
 
     def modes(self) -> ModalResult:
-        return natural_frequencies(self.model)
+        modal = linear_modes(self.linear, self.train)
+        modal.train = self.spec.name
+        return modal
+
+    def modes_at_speed(self, input_speed: float) -> ModalResult:
+        return linear_modes_at_speed(self.linear, self.train, input_speed)
+
+    def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray | None, np.ndarray]:
+        """(the train coordinates the model has, its mass matrix over them when they determine its own
+        coordinates, else None; the shapes of ``modal`` over them)."""
+        labels = self.train.dofs.labels()
+        T, mapped = self.linear.to_physical(labels)
+        T = T[mapped]
+        mass = None
+        if T.shape[0] == T.shape[1] and np.linalg.matrix_rank(T) == T.shape[0]:
+            T_inv = np.linalg.inv(T)
+            mass = T_inv.T @ self.linear.M @ T_inv
+        return [label for label, m in zip(labels, mapped) if m], mass, T @ modal.shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
-        return simulate_4dof(self.model, settings, self.load)
+        result = simulate_linear(self.linear, settings, self.train, progress)
+        result.train = self.spec.name
+        return result
 
     def stable_step(self) -> float:
-        return undamped_stable_step(self.modes().frequencies)
+        return stepping.stable_step(step_limits(self.linear))
+
+    def unmapped(self) -> list[str]:
+        """The train's gated signals this model does not report."""
+        return unmapped(self.linear, self.train)
+
+
+class PublishedSide(LinearSide):
+    """A 4-DOF model of Matejic et al. (2021) (``name`` one of
+    :data:`gearcheck.lumped.published_parameters.MODELS`), from rest under the paper's excitation
+    (``load``: with the output load on ring b), through the same door as any user's model."""
+
+    def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1):
+        self.model = four_dof_model(spec, name, planet_sets)
+        self.load, self.planet_sets = load, planet_sets
+        super().__init__(linear_model(self.model, load), spec, ("matejic2021",))

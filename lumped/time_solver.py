@@ -26,6 +26,7 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.contact_laws import deadzone
@@ -334,20 +335,7 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     delta, force = sys.mesh_force(q, v, k, e, de, pairs)
     k = sys.contact_stiffness(q, k, e, pairs)
     spec, dofs = model.spec, model.dofs
-    members = list(spec.members)
-    acc = np.empty((t.size, len(members), 3))
-    angle = np.empty((t.size, len(members)))
-    for j, mid in enumerate(members):
-        member = spec.members[mid]
-        iu, iv, ith = dofs.of_member(mid)[:3]
-        omega = model.kin.speeds[f"{member.stage}.carrier"] if model.rotating_frame_terms else 0.0
-        # inertial acceleration in rotating axes: q'' + 2 Omega k x q' + Omega k x (Omega k x (q + r0))
-        acc[:, j, 0] = qdd[:, iu] - 2 * omega * v[:, iv] - omega**2 * (q[:, iu] + member.radius)
-        acc[:, j, 1] = qdd[:, iv] + 2 * omega * v[:, iu] - omega**2 * q[:, iv]
-        acc[:, j, 2] = qdd[:, ith]
-        # the carrier axes turn with the carrier's actual angle: nominal plus its vibration (wind-up)
-        carrier = f"{member.stage}.carrier"
-        angle[:, j] = model.kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
+    acc, angle = member_motion(spec, model.kin, dofs, t, q, v, qdd, model.rotating_frame_terms)
     rows = {r.name: r for r in model.rows if r.kind == "bearing"}
     bearings = [rows[name] for name in bearing_names(spec)]
     a = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)

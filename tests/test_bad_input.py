@@ -297,7 +297,7 @@ OPTIONS = [
     (["crosscheck"], "give a TRAIN or --all, not both"),
     (["crosscheck", "demo-3p", "--all"], "give a TRAIN or --all, not both"),
     (["crosscheck", "--all", "--speed", "100"], "--speed applies to one train"),
-    (["crosscheck", "demo-3p", "--model", "as-printed"], "argument --model: invalid choice: 'as-printed'"),
+    (["crosscheck", "demo-3p", "--model", "as-printed"], "unknown model 'as-printed': choose one of general"),
     (["crosscheck", "demo-3p", "--model", "as-published"], "demo-3p: the 4-DOF model needs the carrier as input"),
     (["crosscheck", "demo-3p", "--sensor-band", "1000", "100"], "sensor band 1000 100 Hz: needs 0 < LOW < HIGH"),
     (["crosscheck", "demo-3p", "--sensor-band", "-5", "100"],

@@ -59,4 +59,4 @@ def test_the_mac_command(tmp_path, capsys):
     out = tmp_path / "mac"
     assert main(["mac", "demo-4p", "--out", str(out)]) == 0
     assert {p.name for p in out.iterdir()} >= {"mac.png", "mac.json"}
-    assert "lies in its frequency group's MuJoCo modes" in capsys.readouterr().out
+    assert "each lumped mode lies in its frequency group's mujoco modes" in capsys.readouterr().out

@@ -25,6 +25,7 @@ from gearcheck.api import (
                            SOLVERS,
                            campbell,
                            crosscheck,
+                           export_model,
                            load,
                            mjcf,
                            mode_pairing,
@@ -34,6 +35,7 @@ from gearcheck.api import (
                            write_report,
 )
 from gearcheck.compare.engine import CrosscheckResult
+from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
 from gearcheck.lumped.spec import TrainSpec
 from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
 from gearcheck.shared.modal import ModalResult
@@ -41,6 +43,6 @@ from gearcheck.shared.results import TimeResult
 
 __version__ = metadata.version("gearcheck")
 
-__all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "ModalResult", "SolverError",
-           "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell", "crosscheck", "load", "mjcf",
-           "mode_pairing", "modes", "presets", "simulate", "write_report"]
+__all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "LinearModel", "Mesh", "ModalResult",
+           "Periodic", "SolverError", "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell", "crosscheck",
+           "export_model", "load", "mjcf", "mode_pairing", "modes", "presets", "simulate", "write_report"]

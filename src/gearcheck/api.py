@@ -14,6 +14,8 @@ from gearcheck.compare.campbell import campbell as campbell_diagram
 from gearcheck.compare.crosscheck import crosscheck
 from gearcheck.compare.mode_pairing import ModePairing, pair_modes
 from gearcheck.compare.report import write_report
+from gearcheck.compare.user_model import user_side
+from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.loader import load_train, preset_names
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.lumped.spec import TrainSpec
@@ -25,7 +27,8 @@ from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rpm_to_rad_s
 
-__all__ = ["SOLVERS", "campbell", "crosscheck", "load", "mjcf", "modes", "presets", "simulate", "write_report"]
+__all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "load", "mjcf", "mode_pairing", "modes", "presets",
+           "simulate", "write_report"]
 
 SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
 
@@ -119,8 +122,9 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
     return campbell_diagram(spec, speeds, lambda s, w: sides[s].modes_at_speed(w), solvers, harmonics)
 
 
-def mode_pairing(train) -> ModePairing:
-    """The lumped model's and the MuJoCo twin's mode shapes paired by the modal assurance criterion.
+def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
+    """The lumped model's and the MuJoCo twin's mode shapes paired by the modal assurance criterion; with
+    ``model`` (a user's model, as :func:`crosscheck` takes it), that model's against ``against``.
 
     Returns
     -------
@@ -130,7 +134,9 @@ def mode_pairing(train) -> ModePairing:
         figure from :func:`gearcheck.compare.plots.mac_heatmap`.
     """
     spec = load(train)
-    return pair_modes(spec.name, _side("lumped", spec), _side("mujoco", spec))
+    if model is None:
+        return pair_modes(spec.name, _side("lumped", spec), _side("mujoco", spec))
+    return pair_modes(spec.name, _side(against, spec), user_side(model, spec))
 
 
 def _speed(value) -> float:
@@ -174,6 +180,13 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
         ``write(directory)``.
     """
     return _side(solver, load(train, speed), method).run(RunSettings(duration, dt, output_dt, settle), progress)
+
+
+def export_model(train, path) -> None:
+    """Write the reference lumped model of ``train`` as a file of matrices (``.mat`` or ``.npz``), the layout a
+    user's own model is read in (:mod:`gearcheck.lumped.matrix_file`): every coordinate, sign and row of
+    gearcheck's conventions, to compare with or to start from."""
+    write_matrix_file(reference_linear_model(load(train)), path)
 
 
 def mjcf(train, speed: float | None = None) -> str:

@@ -142,9 +142,12 @@ def _parser() -> argparse.ArgumentParser:
                    help="writes campbell.png and campbell.json (default out/campbell)")
     s.set_defaults(func=cmd_campbell)
 
-    s = sub.add_parser("mac", help="mode shapes of the lumped model and the MuJoCo twin paired by the modal "
-                                   "assurance criterion (PNG heat map and JSON)")
+    s = sub.add_parser("mac", help="mode shapes of the lumped model and the MuJoCo twin (or your --model and "
+                                   "--against) paired by the modal assurance criterion (PNG heat map and JSON)")
     _train_arg(s)
+    s.add_argument("--model", metavar="MODEL", help="your model: a .mat/.npz file of matrices, module:factory or "
+                                                   "file.py:factory")
+    s.add_argument("--against", default="lumped", choices=("lumped", "mujoco"), help="what --model is paired with")
     s.add_argument("--out", type=Path, default=Path("out/mac"), metavar="DIR",
                    help="writes mac.png and mac.json (default out/mac)")
     s.set_defaults(func=cmd_mac)
@@ -181,9 +184,19 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--duration", type=SECONDS, metavar="S",
                    help="simulated time (default: the baseline's with --baseline, else 0.1 s; 0.02 s for a "
                         "--model other than general)")
-    s.add_argument("--model", default="general", choices=MODELS,
-                   help="lumped model checked against MuJoCo: gearcheck's general model (default) or a "
-                        "published 4-DOF model (double-planet: as-published, energy-derived, ...)")
+    s.add_argument("--model", default="general", metavar="MODEL",
+                   help="the model checked: gearcheck's general model against MuJoCo (default), a published "
+                        f"4-DOF model ({', '.join(MODELS[1:])}: double-planet) against the twin of its "
+                        "idealisation, or your own: a .mat/.npz file of matrices, module:factory or "
+                        "file.py:factory (checked against --against)")
+    s.add_argument("--against", default="lumped", choices=("lumped", "mujoco"),
+                   help="what your own model is checked against: the reference lumped model (default) or the "
+                        "MuJoCo twin")
+    s.add_argument("--results", type=Path, metavar="FILE",
+                   help="another solver's time series as the model checked (.csv, .parquet, .mat)")
+    s.add_argument("--columns", type=Path, metavar="FILE", help="TOML map of --results' columns to signals")
+    s.add_argument("--modes", type=Path, metavar="FILE",
+                   help="with --results: its natural frequencies and mode shapes (.npz, .mat, .csv)")
     s.add_argument("--dt-lumped", type=SECONDS, metavar="S", help="lumped RK4 step (default: derived)")
     s.add_argument("--dt-mujoco", type=SECONDS, metavar="S", help="MuJoCo step (default: derived)")
     s.add_argument("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table")
@@ -212,6 +225,12 @@ def _parser() -> argparse.ArgumentParser:
     _train_arg(s)
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)")
     s.set_defaults(func=cmd_stiffness)
+
+    s = sub.add_parser("export", help="write the reference lumped model as a file of matrices (.mat or .npz): the "
+                                      "layout --model reads, with every convention of gearcheck's coordinates")
+    _train_arg(s)
+    s.add_argument("-o", "--output", type=Path, required=True, metavar="FILE", help="output .mat or .npz file")
+    s.set_defaults(func=cmd_export)
 
     s = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a train")
     _train_arg(s)
@@ -321,11 +340,11 @@ def cmd_mac(args) -> int:
     from gearcheck.compare.plots import mac_heatmap
 
     with OutputDirectory(args.out) as place:
-        pairing = gearcheck.mode_pairing(args.train)
+        pairing = gearcheck.mode_pairing(args.train, args.model, args.against)
         write_file(place.path / "mac.png", mac_heatmap(pairing))
         write_file(place.path / "mac.json", json.dumps(pairing.to_dict(), indent=2) + "\n")
-    print(f"{pairing.train}: {len(pairing.paired)} modes; each lumped mode lies in its frequency group's MuJoCo "
-          f"modes to {1.0 - pairing.paired.min():.1e} (worst)")
+    print(f"{pairing.train}: {len(pairing.paired)} modes; each {pairing.reference} mode lies in its frequency group's "
+          f"{pairing.test} modes to {1.0 - pairing.paired.min():.1e} (worst)")
     for line in pairing.findings:
         print(f"  {line}")
     print(f"  wrote {args.out / 'mac.png'} and {args.out / 'mac.json'}")
@@ -385,6 +404,14 @@ def cmd_stiffness(args) -> int:
     return 0
 
 
+def cmd_export(args) -> int:
+    if args.output.suffix not in (".mat", ".npz"):
+        raise GearcheckError(f"-o {args.output}: a model file is .mat or .npz")
+    gearcheck.export_model(args.train, args.output)
+    print(f"wrote {args.output}")
+    return 0
+
+
 def cmd_mjcf(args) -> int:
     if args.output is not None:
         check_place(args.output, "-o", folder=False)
@@ -425,6 +452,8 @@ def cmd_calibrate(args) -> int:
 def cmd_crosscheck(args) -> int:
     if args.all == (args.train is not None):
         raise GearcheckError("give a TRAIN or --all, not both")
+    if args.all and (args.model not in MODELS or args.results is not None):
+        raise GearcheckError("--model FILE and --results check one train; --all runs the shipped presets")
     if args.all and args.speed is not None:
         raise GearcheckError("--speed applies to one train; --all runs each preset at its own speed")
     names = gearcheck.presets() if args.all else [args.train]
@@ -433,7 +462,8 @@ def cmd_crosscheck(args) -> int:
         for name in names:
             bar = ProgressBar(f"crosscheck {name}")
             result = gearcheck.crosscheck(
-                name, speed=args.speed, duration=args.duration, model=args.model, dt_lumped=args.dt_lumped,
+                name, speed=args.speed, duration=args.duration, model=args.model, against=args.against,
+                results=args.results, columns=args.columns, modes=args.modes, dt_lumped=args.dt_lumped,
                 dt_mujoco=args.dt_mujoco, tolerances=args.tolerances, measurements=args.measurements,
                 sensor_band=args.sensor_band, baseline=args.baseline, update_baseline=args.update_baseline,
                 progress=bar)

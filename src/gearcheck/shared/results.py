@@ -122,6 +122,20 @@ def bearing_names(spec) -> list[str]:
     return [f"{mid}.bearing_{axis}" for mid in planets for axis in ("radial", "tangential")]
 
 
+def coordinate_signals(coordinates, descriptions: dict, model: str, compared: bool = True) -> list[Signal]:
+    """The signals of a model's own coordinates, two per coordinate: ``NAME.acceleration`` (gated when
+    ``compared``) and ``NAME`` itself.  A coordinate whose last part names an angle (theta...) is a
+    rotation (rad), any other a translation (m)."""
+    signals = []
+    for name in coordinates:
+        angular = name.rsplit(".", 1)[-1].startswith("theta")
+        kind, unit = ("angular_acceleration", "rad") if angular else ("acceleration", "m")
+        what = descriptions.get(name, name)
+        signals += [Signal(f"{name}.acceleration", kind, f"{unit}/s^2", f"{what}: acceleration ({model})", compared),
+                    Signal(name, "coordinate", unit, what, compared=False)]
+    return signals
+
+
 def train_signals(spec) -> list[Signal]:
     """The signals of a gear train run, in the order :func:`train_result` holds them."""
     signals = []

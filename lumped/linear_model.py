@@ -1,0 +1,314 @@
+"""A linear lumped model given as matrices: the way in for a model gearcheck did not build.
+
+A user's model (written in Python, or exported from MATLAB as a file of matrices) is
+
+    M q'' + (C + G + sum_m c_m a_m a_m^T) q' + (K(t) + K_omega + sum_m k_m(t) a_m a_m^T) q = F(t)
+
+over its own coordinates q: M its mass matrix, C its damping, G its gyroscopic matrix at the operating
+speed (skew), K(t) its stiffness (mean K, optionally periodic over a mesh cycle), K_omega its
+speed-dependent stiffness (centripetal softening, circulatory terms), F(t) its forcing (mean F), and
+each mesh m a deflection row a_m (the mesh's compression along its line of action) with a periodic
+stiffness k_m(t) and a damping c_m -- the usual structure of a gear model (Lin & Parker 1999; Kahraman
+1994).  ``physical`` says what its coordinates are in the train's: each of gearcheck's physical
+coordinates (``stage1.sun.x``, ``stage1.planet1.tangential``, ``stage1.ring.theta``, ...) as a
+combination of the model's coordinates; coordinates the model does not have are held.  Through that
+map the model reports the train's named signals, computed from its own motion and its own meshes.
+
+:meth:`LinearModel.check` validates it as the loader validates a train file: one line per error,
+naming the source, the field and the value.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gearcheck.shared.errors import TrainFileError
+
+SYMMETRY_TOLERANCE = 1e-9  # relative asymmetry of M, K, C accepted as round-off
+MEAN_TOLERANCE = 1e-6  # relative difference accepted between a given mean and the mean of the samples
+UNIT_SLIP = 100.0  # a mass or inertia this many times off the train's own is taken for a unit slip
+START = ("static", "rest")
+INTERPOLATIONS = ("linear", "hold")
+
+
+@dataclass(frozen=True)
+class Periodic:
+    """A quantity periodic in ``period`` (s): ``samples`` (N, ...) at t = i period / N, linearly interpolated
+    (``interpolation="linear"``: a smooth quantity) or each held until the next (``"hold"``: a quantity with
+    jumps, such as the stiffness of a mesh as its tooth pairs come and go); or a Fourier series
+    ``mean_value`` + sum_h ``cos[h]`` cos(2 pi orders[h] t / period) + ``sin[h]`` sin(...)."""
+
+    period: float
+    samples: np.ndarray | None = None
+    interpolation: str = "linear"
+    mean_value: np.ndarray | None = None
+    orders: np.ndarray | None = None
+    cos: np.ndarray | None = None
+    sin: np.ndarray | None = None
+
+    @property
+    def mean(self) -> np.ndarray:
+        return self.samples.mean(axis=0) if self.samples is not None else self.mean_value
+
+    def __call__(self, t: float) -> np.ndarray:
+        if self.samples is not None:
+            n = len(self.samples)
+            x = (t / self.period % 1.0) * n
+            i = int(x) % n
+            if self.interpolation == "hold":
+                return self.samples[i]
+            w = x - math.floor(x)
+            return (1.0 - w) * self.samples[i] + w * self.samples[(i + 1) % n]
+        phase = 2.0 * math.pi * np.asarray(self.orders) * t / self.period
+        return self.mean_value + np.tensordot(np.cos(phase), self.cos, 1) + np.tensordot(np.sin(phase), self.sin, 1)
+
+    def over_period(self, points: int = 64) -> np.ndarray:
+        """Values over one period: the samples themselves, or the series at ``points`` phases."""
+        if self.samples is not None:
+            return self.samples
+        return np.array([self(i * self.period / points) for i in range(points)])
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A mesh of the model: deflection ``row`` . q along the line of action (m), stiffness k(t) (N/m, a
+    :class:`Periodic` of scalars or a constant) and damping (N s/m).  ``id`` is the train's mesh id
+    (``stage1.sun-planet1``): the model then reports that mesh's force and transmission error."""
+
+    id: str
+    row: np.ndarray
+    stiffness: Periodic | float
+    damping: float = 0.0
+
+    def k(self, t: float) -> float:
+        return float(self.stiffness(t)) if isinstance(self.stiffness, Periodic) else float(self.stiffness)
+
+    @property
+    def k_mean(self) -> float:
+        return float(self.stiffness.mean) if isinstance(self.stiffness, Periodic) else float(self.stiffness)
+
+    @property
+    def k_max(self) -> float:
+        s = self.stiffness
+        return float(np.max(s.over_period())) if isinstance(s, Periodic) else float(s)
+
+
+@dataclass
+class LinearModel:
+    """M q'' + (C + G + mesh damping) q' + (K(t) + K_omega + mesh stiffness) q = F(t) over ``coordinates``.
+
+    stiffness: K(t) (a :class:`Periodic` of matrices whose mean is K), or None (K constant).
+    forcing: F(t) (a :class:`Periodic` whose mean is F, or any callable of t), or None (F constant).
+    physical: train coordinate label -> {model coordinate: coefficient}; None: the model's coordinates are
+    the train's own labels.  start: "static" (from K_mean q = F) or "rest" (q = q' = 0).
+    descriptions: coordinate -> what it is (reports).
+    """
+
+    name: str
+    coordinates: list[str]
+    M: np.ndarray
+    K: np.ndarray
+    C: np.ndarray | None = None
+    G: np.ndarray | None = None
+    K_omega: np.ndarray | None = None
+    F: np.ndarray | None = None
+    stiffness: Periodic | None = None
+    forcing: Periodic | Callable | None = None
+    meshes: list[Mesh] = field(default_factory=list)
+    physical: dict[str, dict[str, float]] | None = None
+    start: str = "static"
+    descriptions: dict[str, str] = field(default_factory=dict)
+    source: str = ""  # the file or factory it came from: error messages name it
+
+    @property
+    def n(self) -> int:
+        return len(self.coordinates)
+
+    def matrix(self, name: str) -> np.ndarray:
+        """A matrix or vector by its field name, zeros when not given."""
+        value = getattr(self, name)
+        if value is not None:
+            return np.asarray(value, dtype=float)
+        return np.zeros(self.n) if name == "F" else np.zeros((self.n, self.n))
+
+    @property
+    def mesh_rows(self) -> np.ndarray:
+        return np.array([m.row for m in self.meshes], dtype=float).reshape(len(self.meshes), self.n)
+
+    def _mesh_sum(self, values) -> np.ndarray:
+        A = self.mesh_rows
+        return (A.T * np.asarray(values, dtype=float)) @ A
+
+    @property
+    def K_mean(self) -> np.ndarray:
+        """The stiffness of the modes: K with every mesh at its mean stiffness."""
+        return self.matrix("K") + self._mesh_sum([m.k_mean for m in self.meshes])
+
+    @property
+    def damping(self) -> np.ndarray:
+        """Everything that multiplies q': C + G + the meshes' damping."""
+        return self.matrix("C") + self.matrix("G") + self._mesh_sum([m.damping for m in self.meshes])
+
+    def K_peak(self) -> np.ndarray:
+        """A stiffness no less than K(t) + K_omega's symmetric part at any time (the stable step's bound)."""
+        K = self.matrix("K")
+        if self.stiffness is not None:
+            over = self.stiffness.over_period()
+            worst = max(range(len(over)), key=lambda i: np.linalg.eigvalsh(0.5 * (over[i] + over[i].T))[-1])
+            K = over[worst]
+        K_omega = self.matrix("K_omega")
+        return K + 0.5 * (K_omega + K_omega.T) + self._mesh_sum([m.k_max for m in self.meshes])
+
+    def F_at(self, t: float) -> np.ndarray:
+        return self.matrix("F") if self.forcing is None else np.asarray(self.forcing(t), dtype=float)
+
+    def K_at(self, t: float) -> np.ndarray:
+        return self.matrix("K") if self.stiffness is None else self.stiffness(t)
+
+    # -- validation ---------------------------------------------------------------------------------------
+
+    def check(self, spec=None, labels: list[str] | None = None) -> "LinearModel":
+        """Validate shapes, symmetry, positive definiteness of M, the periodic parts against their means and,
+        given the train (``spec``, its coordinate ``labels``), the map and the units; returns self."""
+        n = self.n
+        if n == 0 or len(set(self.coordinates)) != n:
+            raise self._error("coordinates", f"{n} names with {n - len(set(self.coordinates))} repeated: need at "
+                              "least one, each once")
+        for name in ("M", "K", "C", "G", "K_omega", "F"):
+            self._check_array(name, (n,) if name == "F" else (n, n), required=name in ("M", "K"))
+        M = self.matrix("M")
+        for name in ("M", "K", "C"):
+            self._check_symmetric(name, +1)
+        self._check_symmetric("G", -1)
+        lowest = np.linalg.eigvalsh(M)[0]
+        if lowest <= 0:
+            raise self._error("M", f"not positive definite (eigenvalue {lowest:.4g}): every coordinate needs mass "
+                              "or inertia")
+        if self.stiffness is not None:
+            self._check_periodic("stiffness", self.stiffness, (n, n), "K")
+        if isinstance(self.forcing, Periodic):
+            self._check_periodic("forcing", self.forcing, (n,), "F")
+        for j, mesh in enumerate(self.meshes):
+            self._check_mesh(j, mesh)
+        if self.start not in START:
+            raise self._error("start", f"{self.start!r}: choose {' or '.join(START)}")
+        if spec is not None:
+            self._check_map(spec, labels)
+        return self
+
+    def _error(self, field_name: str, message: str) -> TrainFileError:
+        return TrainFileError(self.source or self.name, field_name, message)
+
+    def _check_array(self, name: str, shape: tuple, required: bool) -> None:
+        value = getattr(self, name)
+        if value is None:
+            if required:
+                raise self._error(name, "missing")
+            return
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise self._error(name, "not a numeric array") from None
+        if array.shape != shape:
+            raise self._error(name, f"shape {array.shape}, expected {shape} ({self.n} coordinates)")
+        bad = np.argwhere(~np.isfinite(array))
+        if bad.size:
+            raise self._error(name, f"entry {tuple(int(i) for i in bad[0])} is {array[tuple(bad[0])]}")
+        setattr(self, name, array)
+
+    def _check_symmetric(self, name: str, sign: int) -> None:
+        A = getattr(self, name)
+        if A is None:
+            return
+        scale = np.max(np.abs(A)) or 1.0
+        gap = np.abs(A - sign * A.T)
+        if gap.max() > SYMMETRY_TOLERANCE * scale:
+            i, j = np.unravel_index(np.argmax(gap), A.shape)
+            what = "symmetric" if sign > 0 else "skew-symmetric (a gyroscopic matrix)"
+            raise self._error(name, f"not {what}: [{self.coordinates[i]}, {self.coordinates[j]}] = {A[i, j]:.6g} "
+                              f"against [{self.coordinates[j]}, {self.coordinates[i]}] = {A[j, i]:.6g}")
+
+    def _check_periodic(self, name: str, p: Periodic, shape: tuple, mean_of: str) -> None:
+        if not (isinstance(p.period, (int, float)) and math.isfinite(p.period) and p.period > 0):
+            raise self._error(f"{name}.period", f"{p.period!r}: needs a positive period in s")
+        if p.interpolation not in INTERPOLATIONS:
+            raise self._error(f"{name}.interpolation", f"{p.interpolation!r}: choose {' or '.join(INTERPOLATIONS)}")
+        values = p.over_period()
+        if values.shape[1:] != shape or not np.all(np.isfinite(values)):
+            raise self._error(name, f"values of shape {values.shape[1:]} (expected {shape}) or not finite")
+        if p.samples is not None:
+            target = self.matrix(mean_of)
+            gap = np.max(np.abs(p.mean - target))
+            if gap > MEAN_TOLERANCE * (np.max(np.abs(target)) or 1.0):
+                raise self._error(mean_of, f"is not the mean of the {name} samples (largest difference {gap:.4g}): "
+                                  f"{mean_of} must be their mean over the period")
+
+    def _check_mesh(self, j: int, mesh: Mesh) -> None:
+        where = f"meshes[{j}]"
+        row = np.asarray(mesh.row, dtype=float)
+        if row.shape != (self.n,) or not np.all(np.isfinite(row)) or not np.any(row):
+            raise self._error(f"{where}.row", f"{mesh.id}: needs {self.n} finite coefficients, not all zero")
+        if isinstance(mesh.stiffness, Periodic):
+            values = np.asarray(mesh.stiffness.over_period(), dtype=float)
+            if not (mesh.stiffness.period > 0 and np.all(np.isfinite(values))):
+                raise self._error(f"{where}.stiffness", f"{mesh.id}: needs a positive period and finite values")
+        if not mesh.k_mean > 0 or mesh.damping < 0 or not math.isfinite(mesh.damping):
+            raise self._error(f"{where}", f"{mesh.id}: mean stiffness {mesh.k_mean:.4g} N/m must be > 0 and damping "
+                              f"{mesh.damping:.4g} N s/m >= 0")
+
+    def _check_map(self, spec, labels: list[str]) -> None:
+        known = set(labels)
+        mesh_ids = {m.id for m in spec.meshes}
+        for mesh in self.meshes:
+            if mesh.id not in mesh_ids:
+                raise self._error("meshes", f"{mesh.id!r} is not a mesh of {spec.name} ({', '.join(sorted(mesh_ids))})")
+        for label, combination in self.physical_map().items():
+            if label not in known:
+                raise self._error("physical", f"{label!r} is not a coordinate of {spec.name} (e.g. {labels[0]}, "
+                                  f"{labels[-1]})")
+            for coordinate, coefficient in combination.items():
+                if coordinate not in self.coordinates:
+                    raise self._error(f"physical.{label}", f"{coordinate!r} is not one of the model's coordinates")
+                if not math.isfinite(coefficient) or coefficient == 0:
+                    raise self._error(f"physical.{label}", f"coefficient {coefficient!r} of {coordinate}")
+        self._check_units(spec)
+
+    def physical_map(self) -> dict[str, dict[str, float]]:
+        if self.physical is not None:
+            return self.physical
+        return {c: {c: 1.0} for c in self.coordinates}
+
+    def _check_units(self, spec) -> None:
+        """A coordinate that is one train coordinate (coefficient +-1) must carry that member's mass (a
+        translation) or inertia (a rotation) within UNIT_SLIP: a factor 1000 or 1e6 is a unit slip."""
+        for label, combination in self.physical_map().items():
+            if len(combination) != 1:
+                continue
+            (coordinate, coefficient), = combination.items()
+            if abs(coefficient) != 1.0:
+                continue
+            member_id, dof = label.rsplit(".", 1)
+            member = spec.members[member_id]
+            expected, what = (member.inertia, "inertia (kg m^2)") if dof == "theta" else (member.mass, "mass (kg)")
+            i = self.coordinates.index(coordinate)
+            ratio = self.M[i, i] / expected
+            if not 1.0 / UNIT_SLIP <= ratio <= UNIT_SLIP:
+                raise self._error(f"M[{coordinate}]", f"{self.M[i, i]:.6g} but {member_id}'s {what} is {expected:.6g} "
+                                  f"(x {ratio:.3g}): a unit slip? (SI throughout: kg, m, rad, N, s)")
+
+    # -- the map to the train's coordinates -----------------------------------------------------------------
+
+    def to_physical(self, labels: list[str]) -> tuple[np.ndarray, list[bool]]:
+        """(T, mapped): physical = T q over the train's coordinate ``labels``; mapped[i] says whether label i
+        is one of the model's (the others are held: zero rows)."""
+        T = np.zeros((len(labels), self.n))
+        index = {c: j for j, c in enumerate(self.coordinates)}
+        rows = self.physical_map()
+        for i, label in enumerate(labels):
+            for coordinate, coefficient in rows.get(label, {}).items():
+                T[i, index[coordinate]] = coefficient
+        return T, [label in rows for label in labels]

@@ -1,0 +1,182 @@
+"""Modes and time runs of a :class:`~gearcheck.lumped.linear_model.LinearModel`, with the train's named signals.
+
+* :func:`linear_modes` -- K_mean x = omega^2 M x (typed like the reference's modes when the model's
+  coordinates are the train's), and :func:`linear_modes_at_speed`, the gyroscopic problem with G and
+  K_omega (Cooley & Parker 2012);
+* :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest), the
+  stiffness, meshes and forcing evaluated at each stage's time;
+* :func:`linear_result` -- what the run reports: every coordinate and its acceleration, and, through
+  the model's map to the train's coordinates, the train's signals the model has (member accelerations
+  in carrier and world axes from :func:`~gearcheck.lumped.member_motion.member_motion`, its meshes'
+  force, transmission error, load factor and stiffness).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from gearcheck.lumped.member_motion import member_motion
+from gearcheck.lumped.time_solver import rk4_step
+from gearcheck.shared import stepping
+from gearcheck.shared.errors import DivergenceError
+from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
+from gearcheck.shared.results import TimeResult, coordinate_signals, train_signals
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.units import rad_s_to_rpm
+
+CHUNK = 2000  # steps between progress reports
+
+
+def _typing(model, train) -> tuple:
+    """(translation, rotation) indices for Lin & Parker's mode types: the central members' coordinates, when
+    the model's coordinates are the train's own; else (None, None)."""
+    if train is None or model.physical is not None:
+        return None, None
+    spec = train.spec
+    central = [(i, c.rsplit(".", 1)) for i, c in enumerate(model.coordinates)]
+    central = [(i, dof) for i, (member, dof) in central if not spec.members[member].is_planet]
+    return [i for i, d in central if d not in ("theta", "z")], [i for i, d in central if d in ("theta", "z")]
+
+
+def linear_modes(model, train=None) -> ModalResult:
+    """Natural frequencies and shapes at mean stiffness, over the model's own coordinates."""
+    return modal_result(train.spec.name if train else model.name, model.name, model.K_mean, model.M,
+                        model.coordinates, *_typing(model, train))
+
+
+def linear_modes_at_speed(model, train, input_speed: float) -> ModalResult:
+    """The gyroscopic modes at ``input_speed`` (rad/s): G and K_omega scaled from the train's own speed (G with
+    the speed, K_omega with its square)."""
+    r = input_speed / train.spec.operating.input_speed
+    K_omega = model.matrix("K_omega")
+    return speed_modal_result(train.spec.name, model.name, model.M, r * model.matrix("G"),
+                              model.K_mean + r * r * 0.5 * (K_omega + K_omega.T), model.coordinates,
+                              *_typing(model, train), rad_s_to_rpm(input_speed))
+
+
+def step_limits(model) -> stepping.StepLimits:
+    return stepping.StepLimits.of(model.M, model.K_peak(), model.damping)
+
+
+def default_step(model) -> float:
+    periods = [m.stiffness.period for m in model.meshes if hasattr(m.stiffness, "period")]
+    if model.stiffness is not None:
+        periods.append(model.stiffness.period)
+    return stepping.default_step(step_limits(model), [1.0 / p for p in periods])
+
+
+def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> TimeResult:
+    """Fixed-step RK4 of the model; ``train`` (spec, kin, dofs of the train, or None) names its signals.
+    The step defaults to :func:`default_step`; a step beyond RK4's stability limit is refused."""
+    started = time.perf_counter()
+    limits = step_limits(model)
+    dt = default_step(model) if settings.dt is None else settings.dt
+    stepping.check_step(dt, limits, [], f"model {model.name}")
+    steps, every = settings.check_work(dt, 3 * model.n, f"model {model.name}")
+    M_inv = np.linalg.inv(model.M)
+    D = model.damping
+    K_omega = model.matrix("K_omega")
+    A = model.mesh_rows
+    t = np.arange(steps + 1) * dt
+    stage_t = t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt  # where every fixed-step solver samples its drive
+    k_mesh = np.array([[[m.k(s) for m in model.meshes] for s in row] for row in stage_t]).reshape(steps + 1, 3, -1)
+
+    def acceleration(ti, s, q, v, k):
+        stiffness_force = (model.K_at(ti) + K_omega) @ q + A.T @ (k * (A @ q))
+        return M_inv @ (model.F_at(ti) - D @ v - stiffness_force)
+
+    q, v = _start(model)
+    n_out = steps // every + 1
+    Q, V, Qdd = (np.empty((n_out, model.n)) for _ in range(3))
+    for i in range(steps + 1):
+        if i % every == 0:
+            j = i // every
+            Q[j], V[j], Qdd[j] = q, v, acceleration(t[i], 0, q, v, k_mesh[i, 0])
+        if i == steps:
+            break
+        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(stage_t[i, s], s, q_, v_, k_mesh[i, s]), q, v, dt)
+        if i % CHUNK == 0:
+            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                raise DivergenceError(float(t[i + 1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
+            if progress is not None:
+                progress(i / steps)
+    if not np.all(np.isfinite(Q)):
+        raise DivergenceError(float(t[-1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
+    if progress is not None:
+        progress(1.0)
+    info = {"method": f"{model.name}, rk4", "dt_s": dt, "steps": steps,
+            "wall_time_s": time.perf_counter() - started}
+    return linear_result(model, train, t[::every], Q, V, Qdd, info)
+
+
+def _start(model) -> tuple[np.ndarray, np.ndarray]:
+    """(q, q') at t = 0: at rest, or the static state K_mean q = F (least squares where rigid modes leave it
+    undetermined: the minimum-norm solution)."""
+    zero = np.zeros(model.n)
+    if model.start == "rest":
+        return zero, zero
+    K_omega = model.matrix("K_omega")
+    q, *_ = np.linalg.lstsq(model.K_mean + K_omega, model.matrix("F"), rcond=None)
+    return q, zero
+
+
+def linear_result(model, train, t, q, v, qdd, info) -> TimeResult:
+    """The named signals of a run (see the module docstring)."""
+    mapped = train is not None and bool(model.physical_map())
+    signals, columns = coordinate_signals(model.coordinates, model.descriptions, model.name,
+                                          compared=not mapped), []
+    for j in range(model.n):
+        columns += [qdd[:, j], q[:, j]]
+    static = {}
+    if mapped:
+        named, values, static = _train_signals(model, train, t, q, v, qdd)
+        signals, columns = signals + named, columns + values
+    return TimeResult(model.name, model.name, np.asarray(t), signals, np.column_stack(columns), 0.0, info, static=static)
+
+
+def _train_signals(model, train, t, q, v, qdd):
+    """The train's signals the model has: a member's angular acceleration when its rotation is one of the
+    model's coordinates, its translational accelerations when both its translations are, and its meshes'."""
+    labels = train.dofs.labels()
+    T, mapped = model.to_physical(labels)
+    has = dict(zip(labels, mapped))
+    acc, angle = member_motion(train.spec, train.kin, train.dofs, t, q @ T.T, v @ T.T, qdd @ T.T)
+    by_name = {s.name: s for s in train_signals(train.spec)}
+    signals, columns = [], []
+    for j, mid in enumerate(train.spec.members):
+        u, w, th = (labels[i] for i in train.dofs.of_member(mid)[:3])
+        if has[u] and has[w]:
+            c, s = np.cos(angle[:, j]), np.sin(angle[:, j])
+            world = (c * acc[:, j, 0] - s * acc[:, j, 1], s * acc[:, j, 0] + c * acc[:, j, 1])
+            for axis, x_world, x_carrier in zip("xy", world, acc[:, j, :2].T):
+                signals += [by_name[f"{mid}.a{axis}.world"], by_name[f"{mid}.a{axis}.carrier"]]
+                columns += [x_world, x_carrier]
+        if has[th]:
+            signals.append(by_name[f"{mid}.alpha"])
+            columns.append(acc[:, j, 2])
+    q0, _ = _start(model)
+    static = {}
+    for m in model.meshes:
+        row = np.asarray(m.row, dtype=float)
+        k = np.array([m.k(s) for s in t])
+        delta = q @ row
+        force = k * delta + m.damping * (v @ row)
+        static_force = m.k_mean * float(row @ q0)
+        static[f"{m.id}.force"] = static_force
+        signals += [by_name[f"{m.id}.{x}"] for x in ("force", "dte", "kv", "stiffness")]
+        columns += [force, delta, force / static_force if static_force else np.full_like(force, np.nan), k]
+    return signals, columns, static
+
+
+def unmapped(model, train) -> list[str]:
+    """The train's gated signals the model does not report."""
+    have = set(_names(model, train))
+    return [s.name for s in train_signals(train.spec) if s.compared and s.name not in have]
+
+
+def _names(model, train) -> list[str]:
+    one = np.zeros((1, model.n))
+    return [s.name for s in _train_signals(model, train, np.zeros(1), one, one, one)[0]]
+

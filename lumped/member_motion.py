@@ -1,0 +1,32 @@
+"""What a member's motion looks like from outside: inertial accelerations from rotating-frame coordinates.
+
+The coordinates of a stage turn with its carrier at Omega (Lin & Parker 1999): a member's centre
+moves q = (u, v) along the carrier's axes about its nominal place r0 (a planet's pin), so its
+inertial acceleration along those axes is q'' + 2 Omega k x q' + Omega k x (Omega k x (q + r0)), and
+the axes themselves turn with the carrier's actual angle (nominal plus its vibration).  Every model
+expressed in these coordinates, the reference and a user's, reports its members this way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def member_motion(spec, kin, dofs, t, q, v, qdd, rotating_frame_terms: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """(acc, angle): acc (n_t, n_members, 3) the inertial acceleration of each member's centre along its
+    carrier's axes and its angular acceleration, angle (n_t, n_members) the angle of those axes (world =
+    R(angle) carrier), from q, q', q'' (n_t, n) over the coordinates ``dofs``
+    (:class:`~gearcheck.lumped.assembly.DofMap`); ``kin`` the train's kinematics."""
+    members = list(spec.members)
+    acc = np.empty((t.size, len(members), 3))
+    angle = np.empty((t.size, len(members)))
+    for j, mid in enumerate(members):
+        member = spec.members[mid]
+        iu, iv, ith = dofs.of_member(mid)[:3]
+        carrier = f"{member.stage}.carrier"
+        omega = kin.speeds[carrier] if rotating_frame_terms else 0.0
+        acc[:, j, 0] = qdd[:, iu] - 2 * omega * v[:, iv] - omega**2 * (q[:, iu] + member.radius)
+        acc[:, j, 1] = qdd[:, iv] + 2 * omega * v[:, iu] - omega**2 * q[:, iv]
+        acc[:, j, 2] = qdd[:, ith]
+        angle[:, j] = kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
+    return acc, angle

@@ -1,0 +1,205 @@
+"""A user's own model through the front door: as matrices in Python or in a .mat/.npz file, as a factory
+named on the command line, as another solver's time series; the published 4-DOF models through the same
+door.  Physics: the reference exported and read back is the reference (modes to round-off, the cross-check
+passes); a torsional model derived by hand is the reference constrained to rigid translations; bad files
+end in one line and exit status 2 with nothing written."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.io
+
+import gearcheck
+from gearcheck.cli import main
+from gearcheck.compare.mode_pairing import pair_modes
+from gearcheck.lumped.export import reference_linear_model, write_matrix_file
+from gearcheck.lumped.matrix_file import read_matrix_file
+from gearcheck.lumped.side import LinearSide, LumpedSide
+from gearcheck.shared.settings import RunSettings
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+TORSIONAL = f"{EXAMPLES / 'torsional_user_model.py'}:torsional_model"
+
+
+@pytest.mark.parametrize("suffix", [".mat", ".npz"])
+@pytest.mark.parametrize("preset", ["demo-3p", "helical-planetary"])
+def test_exported_reference_reads_back_as_the_reference(tmp_path, preset, suffix):
+    """Modes to round-off (every sample held over its cell; their mean is the exact mean stiffness) and each
+    reference mode lies in its own partner's span to 1e-9."""
+    spec = gearcheck.load(preset)
+    path = tmp_path / f"model{suffix}"
+    write_matrix_file(reference_linear_model(spec), path)
+    side = LinearSide(read_matrix_file(path), spec)
+    reference = LumpedSide(spec)
+    fa, fb = reference.modes().frequencies, side.modes().frequencies
+    np.testing.assert_allclose(fb, fa, rtol=1e-12, atol=1e-9)
+    assert pair_modes(spec.name, reference, side).paired.min() > 1 - 1e-9
+    assert side.modes().types == reference.modes().types
+
+
+def test_exported_reference_passes_the_crosscheck(tmp_path):
+    """The file route end to end: the reference as a .mat of held stiffness samples passes against the
+    reference; the planet bearing forces it has no rows for are named as not compared."""
+    path = tmp_path / "demo.mat"
+    write_matrix_file(reference_linear_model(gearcheck.load("demo-3p")), path)
+    result = gearcheck.crosscheck("demo-3p", model=str(path), duration=0.05)
+    assert result.verdict == "PASS", result.failures
+    gated = [q for q in result.quantities if q.status != "negligible"]
+    assert len(gated) >= 20
+    assert any("bearing_radial.force" in note for note in result.notes)
+    assert max(m["rel_error"] for m in result.modal) < 1e-12
+
+
+def test_torsional_model_is_the_reference_with_rigid_translations():
+    """The hand-derived torsional model (examples/) equals the reference's K and M projected onto its map
+    (planet centres riding their pins, every other translation held): M to round-off, K to the held
+    sampling of the rectangular stiffness (each jump moves by at most a sample: 2 / 4096 of the stiffness
+    swing per cycle)."""
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        from torsional_user_model import SAMPLES, torsional_model
+    finally:
+        sys.path.remove(str(EXAMPLES))
+    spec = gearcheck.load("demo-3p")
+    side = LinearSide(torsional_model(spec), spec)
+    reference = LumpedSide(spec).model
+    T, _ = side.linear.to_physical(reference.dofs.labels())
+    np.testing.assert_allclose(T.T @ reference.M @ T, side.linear.M, rtol=1e-14, atol=1e-15)
+    K = T.T @ reference.K_mean @ T
+    assert np.max(np.abs(K - side.linear.K_mean)) < 2.0 / SAMPLES * np.max(np.abs(K))
+    # fewer coordinates, fewer modes: the rotational ones are stiffened by the held translations
+    f_user, f_ref = side.modes().frequencies, LumpedSide(spec).modes().frequencies
+    assert len(f_user) == 6 and len(f_ref) == 18
+    assert 1.0 < f_user[0] / f_ref[0] < 1.05
+
+
+def test_factory_on_the_command_line(tmp_path, capsys):
+    """--model file.py:factory: the torsional model is compared on the quantities it has; its modes are paired
+    by shape; it fails, and says which quantities it does not report."""
+    status = main(["crosscheck", "demo-3p", "--model", TORSIONAL, "--duration", "0.05", "--out", str(tmp_path)])
+    assert status == 1
+    report = (tmp_path / "report.md").read_text()
+    assert "does not report" in report and "stage1.sun.ax.world" in report
+    status = main(["mac", "demo-3p", "--model", TORSIONAL, "--out", str(tmp_path / "mac")])
+    assert (tmp_path / "mac" / "mac.png").is_file()
+
+
+def test_published_models_through_the_same_door():
+    """The 4-DOF models of Matejic et al. (2021) are LinearSides: their run is the RK4 of M q'' + B q' + C q = D
+    from rest, checked here against the closed form of the first step's acceleration a(0) = M^-1 D(0)."""
+    from gearcheck.lumped.side import PublishedSide
+
+    side = PublishedSide(gearcheck.load("double-planet"), "energy-derived")
+    assert isinstance(side, LinearSide)
+    run = side.run(RunSettings(0.002, 1e-6))
+    a0 = np.linalg.solve(side.model.M, side.model.D(0.0))
+    np.testing.assert_allclose([run[f"{c}.acceleration"][0] for c in side.linear.coordinates], a0, rtol=1e-12,
+                               atol=1e-12 * np.abs(a0).max())
+
+
+def test_recorded_results_from_another_solver(tmp_path):
+    """Another solver's results: the reference's own run written as CSV with renamed columns is compared
+    against the twin and passes, with its integration check absent (nothing re-runs a recording)."""
+    spec = gearcheck.load("demo-3p")
+    run = LumpedSide(spec).run(RunSettings(0.06, None))
+    names = ["stage1.ring.ay.world", "stage1.carrier.alpha", "stage1.planet1.sun.force"]
+    columns = {name: f"c{i}" for i, name in enumerate(names)}
+    import pandas as pd
+
+    frame = pd.DataFrame({"t": run.t, **{columns[n]: run[n] for n in names}})
+    frame.to_csv(tmp_path / "other.csv", index=False, float_format="%.17g")
+    result = gearcheck.crosscheck("demo-3p", results=tmp_path / "other.csv",
+                                  columns={"solver": "other", "signals": columns}, against="mujoco")
+    assert result.verdict == "PASS", result.failures
+    assert sorted(q.name for q in result.quantities) == sorted(names)
+    assert all(q.metrics["integration_error"]["test"] is None for q in result.quantities)
+    assert result.modal == []
+
+
+def _npz(path, **arrays):
+    np.savez(path, **arrays)
+    return path
+
+
+def bad_files(tmp):
+    spec = gearcheck.load("demo-3p")
+    good = reference_linear_model(spec)
+    write_matrix_file(good, tmp / "good.npz")
+    base = dict(np.load(tmp / "good.npz"))
+    n = len(good.coordinates)
+
+    def edit(name, **changes):
+        data = {k: v for k, v in base.items() if changes.get(k, 0) is not None}
+        data.update({k: v for k, v in changes.items() if v is not None})
+        return _npz(tmp / f"{name}.npz", **data)
+
+    asym = base["M"].copy()
+    asym[0, 1] = 1.0
+    neg = base["M"].copy()
+    neg[0, 0] = -1.0
+    grams = base["M"].copy()
+    grams[0, 0] *= 1000
+    coords = base["coordinates"].copy()
+    coords[0] = "stage1.sun.q"
+    (tmp / "broken.mat").write_bytes(b"MATLAB 5.0 not really")
+    (tmp / "model.txt").write_text("M = 1")
+    return [
+        (edit("missing-K", K=None), "K: missing"),
+        (edit("shape", K=np.eye(n + 1)), "K: shape (19, 19), expected (18, 18)"),
+        (edit("asym", M=asym), "M: not symmetric"),
+        (edit("negative", M=neg), "M: not positive definite"),
+        (edit("nan", K=np.where(np.eye(n) > 0, np.nan, base["K"])), "K: entry (0, 0) is nan"),
+        (edit("grams", M=grams), "a unit slip"),
+        (edit("unknown-label", coordinates=coords), "'stage1.sun.q' is not a coordinate of demo-3p"),
+        (edit("units", units=np.array("mm")), "units: 'mm'"),
+        (edit("extra", Q=np.eye(2)), "Q: unknown variable"),
+        (edit("mesh-id", mesh_ids=np.array(["stage1.nope"] * 6)), "'stage1.nope' is not a mesh of demo-3p"),
+        (edit("mesh-rows", mesh_rows=np.zeros((6, 3))), "mesh_rows: shape (6, 3), expected (6, 18)"),
+        (tmp / "broken.mat", "broken.mat: cannot be read as .mat"),
+        (tmp / "model.txt", "a model file is .mat or .npz, not '.txt'"),
+        (tmp / "absent.npz", "absent.npz: no such file"),
+    ]
+
+
+def test_bad_model_files_one_line_exit_2(tmp_path, capsys):
+    cases = bad_files(tmp_path)
+    for path, fragment in cases:
+        out = tmp_path / f"out-{path.stem}"
+        status = main(["crosscheck", "demo-3p", "--model", str(path), "--out", str(out)])
+        err = capsys.readouterr().err.strip()
+        assert status == 2, (path, err)
+        assert path.name in err and fragment in err, (fragment, err)
+        assert "\n" not in err and "Traceback" not in err
+        assert not out.exists()
+
+
+def test_bad_factory_one_line(tmp_path, capsys):
+    (tmp_path / "user.py").write_text("def broken(spec):\n    raise ValueError('my model is unfinished')\n")
+    for model, fragment in [(f"{tmp_path / 'user.py'}:broken", "building the model failed: ValueError: my model"),
+                            (f"{tmp_path / 'user.py'}:absent", "has no callable 'absent'"),
+                            ("no_such_module_xyz:f", "importing no_such_module_xyz failed"),
+                            ("plain", "unknown model 'plain': choose one of general")]:
+        status = main(["crosscheck", "demo-3p", "--model", model, "--out", str(tmp_path / "o")])
+        err = capsys.readouterr().err.strip()
+        assert status == 2 and fragment in err and "\n" not in err, err
+
+
+def test_mat_layout_matlab_stacks(tmp_path):
+    """A MATLAB user's K(t) stack K(:,:,i) (n x n x N) reads as N samples whose mean must be K."""
+    spec = gearcheck.load("demo-3p")
+    model = reference_linear_model(spec)
+    K_t = np.stack([model.K * (1 + 0.1 * np.cos(2 * np.pi * i / 8)) for i in range(8)], axis=-1)
+    data = {"coordinates": np.array(model.coordinates, dtype=object), "M": model.M, "K": model.K, "K_samples": K_t,
+            "period": 1e-3}
+    scipy.io.savemat(tmp_path / "m.mat", data)
+    read = read_matrix_file(tmp_path / "m.mat")
+    assert read.stiffness.samples.shape == (8, 18, 18)
+    np.testing.assert_allclose(read.stiffness(0.0), model.K * 1.1)
+    data["K"] = model.K * 1.01
+    scipy.io.savemat(tmp_path / "bad.mat", data)
+    with pytest.raises(gearcheck.GearcheckError, match="K: is not the mean of the stiffness samples"):
+        LinearSide(read_matrix_file(tmp_path / "bad.mat"), spec)

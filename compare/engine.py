@@ -48,6 +48,7 @@ from gearcheck.compare.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.side import display_name
 
 NEGLIGIBLE = 1e-6
 TARGET_FRACTION = 0.5  # default steps keep both solvers' integration error bounds within this part of a tolerance
@@ -96,6 +97,7 @@ class CrosscheckResult:
     moved: list[str] | None = None  # metrics moved from a baseline (None: no baseline checked)
     steady_how: str | None = None  # detected | decayed | transient | None (no steady state)
     settle_s: float | None = None  # the reference's free vibration decay time (steady-state runs)
+    solvers: tuple = ("lumped", "mujoco")  # the reference's and the test's names
 
     @property
     def failures(self) -> list[str]:
@@ -117,6 +119,11 @@ class CrosscheckResult:
         if self.failures or self.moved:
             return "FAIL"
         return "INCONCLUSIVE" if self.unresolved else "PASS"
+
+    @property
+    def solver_names(self) -> tuple[str, str]:
+        """The reference's and the test's names as reports write them."""
+        return tuple(display_name(name) for name in self.solvers)
 
     @property
     def passed(self) -> bool:
@@ -205,7 +212,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     return CrosscheckResult(spec, run_settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
                             comparisons, t0, how in ("detected", "decayed", "transient"), (a, b), (modes_a, modes_b),
                             grid, series, wall, notes=notes, references=list(dict.fromkeys(references)),
-                            steady_how=how, settle_s=plan.settle if plan.detect_steady else None)
+                            steady_how=how, settle_s=plan.settle if plan.detect_steady else None,
+                            solvers=(reference.solver, test.solver))
 
 
 @dataclass

@@ -13,8 +13,14 @@ from matplotlib.figure import Figure
 
 from gearcheck.lumped.mesh_stiffness import stiffness_model
 
-LUMPED_STYLE = {"color": "tab:blue", "lw": 1.2, "label": "lumped"}
-MUJOCO_STYLE = {"color": "tab:orange", "lw": 1.0, "ls": "--", "label": "MuJoCo"}
+REFERENCE_STYLE = {"color": "tab:blue", "lw": 1.2}
+TEST_STYLE = {"color": "tab:orange", "lw": 1.0, "ls": "--"}
+
+
+def _styles(result) -> tuple[dict, dict]:
+    """The reference's and the test's line styles, labelled with their names."""
+    a, b = result.solver_names
+    return {**REFERENCE_STYLE, "label": a}, {**TEST_STYLE, "label": b}
 
 
 def _figure(rows: int = 1, cols: int = 1, figsize=(9, 5), **kwargs):
@@ -54,9 +60,11 @@ def headline_quantities(result) -> list[str]:
 
 def _title(result, what: str) -> str:
     s = result.settings
+    a, b = result.solver_names
     return (f"{result.spec.name} at {s['input_speed_rpm']:.6g} rpm: {what}\n"
-            f"lumped {s['lumped']['method']} dt={s['lumped']['dt_s']:.3g} s, "
-            f"MuJoCo {s['mujoco'].get('integrator', '')} dt={s['mujoco'].get('dt_s', float('nan')):.3g} s")
+            f"{a} {s['lumped'].get('method', '')} dt={s['lumped'].get('dt_s', float('nan')):.3g} s, "
+            f"{b} {s['mujoco'].get('integrator', s['mujoco'].get('method', ''))} "
+            f"dt={s['mujoco'].get('dt_s', float('nan')):.3g} s")
 
 
 def time_histories(result, path, cycles: int = 4):
@@ -69,8 +77,9 @@ def time_histories(result, path, cycles: int = 4):
     fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
         a, b = result.series[name]
-        ax.plot(t[window] * 1e3, a[window], **LUMPED_STYLE)
-        ax.plot(t[window] * 1e3, b[window], **MUJOCO_STYLE)
+        style_a, style_b = _styles(result)
+        ax.plot(t[window] * 1e3, a[window], **style_a)
+        ax.plot(t[window] * 1e3, b[window], **style_b)
         ax.set_ylabel(f"[{units[name]}]")
         ax.set_title(name, fontsize=9)
         ax.grid(alpha=0.3)
@@ -88,7 +97,7 @@ def spectra(result, path):
     f_mesh = 1.0 / result.settings["steady_cycle_s"]
     fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
-        for x, style in zip(result.series[name], (LUMPED_STYLE, MUJOCO_STYLE)):
+        for x, style in zip(result.series[name], _styles(result)):
             seg = x[window] - np.mean(x[window])
             w = np.hanning(seg.size)
             amp = 2 * np.abs(np.fft.rfft(seg * w)) / np.sum(w)
@@ -108,15 +117,18 @@ def spectra(result, path):
 
 def natural_frequencies(result, path):
     rows = result.modal
+    if not rows:  # a recording without modes
+        return False
+    a, b = result.solver_names
     idx = np.arange(1, len(rows) + 1)
     fig, (ax, ax2) = _figure(2, 1, figsize=(9, 5), sharex=True)
-    ax.plot(idx, [r["reference_hz"] for r in rows], "o", color="tab:blue", label="lumped")
-    ax.plot(idx, [r["test_hz"] for r in rows], "x", color="tab:orange", label="MuJoCo")
+    ax.plot(idx, [r["reference_hz"] for r in rows], "o", color="tab:blue", label=a)
+    ax.plot(idx, [r["test_hz"] for r in rows], "x", color="tab:orange", label=b)
     ax.set_ylabel("natural frequency [Hz]")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     errors = np.array([max(r["rel_error"], 1e-17) for r in rows])
-    ax2.semilogy(idx, errors, "s", color="tab:green", label="|f_MuJoCo - f_lumped| / f_lumped")
+    ax2.semilogy(idx, errors, "s", color="tab:green", label=f"|f_{b} - f_{a}| / f_{a}")
     ax2.axhline(result.modal_tolerance, color="tab:red", ls="--", label="tolerance")
     ax2.set_xlabel("mode")
     ax2.set_ylabel("relative difference [-]")
@@ -249,7 +261,7 @@ def mac_heatmap(pairing) -> bytes:
     """PNG of a :class:`~gearcheck.compare.mode_pairing.ModePairing`: the MAC matrix, reference modes down, test
     modes across, with the frequencies on the axes."""
     fig, ax = _figure(figsize=(7.5, 6.5))
-    image = ax.imshow(pairing.mac, vmin=0.0, vmax=1.0, cmap="viridis", origin="upper")
+    image = ax.imshow(pairing.mac, vmin=0.0, vmax=1.0, cmap="viridis", origin="upper", aspect="auto")
     fig.colorbar(image, ax=ax, label="MAC")
     ax.set_yticks(np.arange(len(pairing.frequencies_reference)),
                   [f"{i + 1}: {f:.5g}" for i, f in enumerate(pairing.frequencies_reference)], fontsize=6)

@@ -24,6 +24,7 @@ import numpy as np
 
 from gearcheck.compare.align import STEADY_THRESHOLD
 from gearcheck.shared.citations import cite
+from gearcheck.shared.side import display_name
 
 SCHEMA = "gearcheck.crosscheck"
 SCHEMA_VERSION = 1
@@ -92,6 +93,7 @@ def to_dict(result) -> dict:
                    "mujoco_type": r["test_type"], "rel_error": _u(r["rel_error"], RATIO),
                    "status": "pass" if r["rel_error"] <= result.modal_tolerance else "fail"} for r in result.modal],
         "modes_tolerance": _u(result.modal_tolerance, RATIO),
+        "solvers": {"reference": result.solvers[0], "test": result.solvers[1]},
         "quantities": quantities,
         "measurements": result.measurements,
         "notes": result.notes,
@@ -134,14 +136,23 @@ def _run_line(data) -> str:
     return f"Run: {data['volatile']['timestamp']}; wall times: {wall}"
 
 
+def solver_names(data) -> tuple[str, str]:
+    """How the report names the reference (a) and the test (b): the built-in solvers as "lumped" and "MuJoCo",
+    a user's model by its own name."""
+    names = data.get("solvers", {"reference": "lumped", "test": "mujoco"})
+    return tuple(display_name(names[k]) for k in ("reference", "test"))
+
+
 def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]]]]:
     """(title, header, rows) of every table, shared by the Markdown and HTML writers."""
+    A, B = solver_names(data)
     tables = []
-    tables.append(("Natural frequencies", ["mode", "type", "mult.", "lumped [Hz]", "MuJoCo [Hz]", "rel. diff.",
-                                           "status"],
-                   [[str(m["mode"]), m["type"], str(m["multiplicity"]), f"{m['lumped']['value']:.6f}",
-                     f"{m['mujoco']['value']:.6f}", f"{m['rel_error']['value']:.2e}", m["status"]]
-                    for m in data["modes"]]))
+    if data["modes"]:  # a recording without a modes file has none
+        tables.append(("Natural frequencies", ["mode", "type", "mult.", f"{A} [Hz]", f"{B} [Hz]", "rel. diff.",
+                                               "status"],
+                       [[str(m["mode"]), m["type"], str(m["multiplicity"]), f"{m['lumped']['value']:.6f}",
+                         f"{m['mujoco']['value']:.6f}", f"{m['rel_error']['value']:.2e}", m["status"]]
+                        for m in data["modes"]]))
     rows = []
     for q in data["quantities"]:
         e, ie = q["errors"], q["integration_error"]
@@ -152,8 +163,8 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]]]]:
                      _fmt(ie["lumped"] and ie["lumped"]["value"], 2), _fmt(ie["mujoco"] and ie["mujoco"]["value"], 2),
                      _fmt(q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"], 3), q["status"]])
     tables.append(("Time-domain quantities (steady window)",
-                   ["quantity", "unit", "RMS lumped", "RMS MuJoCo", "p-p lumped", "p-p MuJoCo", "rel. RMS err.",
-                    "NRMSE", "correlation", "lag [µs]", "integr. err. lumped", "integr. err. MuJoCo", "tol. NRMSE",
+                   ["quantity", "unit", f"RMS {A}", f"RMS {B}", f"p-p {A}", f"p-p {B}", "rel. RMS err.",
+                    "NRMSE", "correlation", "lag [µs]", f"integr. err. {A}", f"integr. err. {B}", "tol. NRMSE",
                     "status"], rows))
     rows = []
     for q in data["quantities"]:
@@ -162,7 +173,7 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]]]]:
                 rows.append([q["name"], s["line"], f"{s['frequency']['value']:.6g}", _fmt(s["lumped"]["value"]),
                              _fmt(s["mujoco"]["value"]), _fmt(s["rel_error"] and s["rel_error"]["value"], 3)])
     tables.append(("Spectral lines (Hann-windowed amplitude)",
-                   ["quantity", "line", "f [Hz]", "lumped", "MuJoCo", "rel. err."], rows))
+                   ["quantity", "line", "f [Hz]", A, B, "rel. err."], rows))
     if data["measurements"]:
         def value(x, digits=4):
             return _fmt(x and x["value"], digits)
@@ -204,23 +215,24 @@ def _summary_lines(data) -> list[str]:
            "decayed": f"the free vibration of the start decayed to {STEADY_THRESHOLD:g}",
            "transient": "the whole transient",
            None: "NO steady state: second half shown, verdict inconclusive"}[steady["how"]]
-    steps = s["integration_check_steps"]["value"]
+    steps = [f"{x:.4g} s" if x is not None else "none: a recording" for x in s["integration_check_steps"]["value"]]
     p = data["provenance"]
+    A, B = solver_names(data)
     return [
         f"Verdict: **{verdict}**",
         "",
         f"- Train: {data['train']['name']} — {data['train']['description']} ({data['train']['source']})",
         f"- Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
         f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})",
-        f"- Lumped solver: {_settings_line(s['lumped'])}",
-        f"- MuJoCo solver: {_settings_line(s['mujoco'])}",
+        f"- Reference ({A}): {_settings_line(s['lumped'])}",
+        f"- Test ({B}): {_settings_line(s['mujoco'])}",
         f"- gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "
         f"NumPy {p['numpy_version']}, Python {p['python']}, {p['machine']}; train {p['train_file']} "
         f"sha256 {p['train_sha256'][:16]}…",
-        "- Metrics: NRMSE = rms(b − a)/rms(a) after removing the lag; lumped = a (reference), MuJoCo = b; "
+        f"- Metrics: NRMSE = rms(b − a)/rms(a) after removing the lag; {A} = a (reference), {B} = b; "
         "'negligible' = below 1e-6 of the largest quantity of its kind in both solvers (not gated).",
         "- Integration error: a bound per solver, rms(x_h − x_2h)/rms(a) against the same run at twice the step "
-        f"(check steps {', '.join(f'{x:.4g} s' for x in steps)}; an order-p integrator's error is at most that, RK4's "
+        f"(check steps {', '.join(steps)}; an order-p integrator's error is at most that, RK4's "
         "a fifteenth of it); 'unresolved' = the two bounds together reach the tolerance.",
     ]
 
@@ -283,8 +295,8 @@ def write_report(result, directory) -> dict:
     data = to_dict(result)
     figures = []
     for name, draw in FIGURES.items():
-        draw(result, out / name)
-        figures.append(name)
+        if draw(result, out / name) is not False:  # False: nothing to draw (a recording without modes)
+            figures.append(name)
     (out / "report.json").write_text(json.dumps(data, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     write_markdown(data, out / "report.md", figures)
     write_html(data, out / "report.html", [out / f for f in figures])

@@ -20,7 +20,7 @@ def summary_row(data: dict) -> dict:
     moved = data["verdict"]["moved_from_baseline"] or []
     return {
         "train": data["train"]["name"], "status": data["verdict"]["verdict"],
-        "modes": len(modes), "max_mode_rel_error": max(m["rel_error"]["value"] for m in modes),
+        "modes": len(modes), "max_mode_rel_error": max((m["rel_error"]["value"] for m in modes), default=None),
         "quantities": len(data["quantities"]), "failed": len(data["verdict"]["failures"]), "moved": len(moved),
         "worst_nrmse_mesh_force": worst("mesh_force"),
         "worst_nrmse_acceleration": worst("acceleration", "angular_acceleration"),

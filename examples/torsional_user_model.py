@@ -47,6 +47,7 @@ def torsional_model(spec) -> LinearModel:
         row[names.index(carrier.id)] = -r_c * np.cos(mesh.geometry.pressure_angle)
         period = 1.0 / kin.mesh_frequency[mesh.id]
         k = exc.stiffness(np.arange(SAMPLES) * period / SAMPLES + 0.5 * period / SAMPLES)[:, j]
+        k += exc.mean_stiffness[j] - k.mean()  # held samples move a jump by up to a sample: keep the exact mean
         m_eq = 1.0 / sum(row[i] ** 2 / M[i, i] for i in np.flatnonzero(row))  # the mesh's effective mass
         meshes.append(Mesh(mesh.id, row, Periodic(period, samples=k, interpolation="hold"),
                            2.0 * mesh.damping_ratio * np.sqrt(k.mean() * m_eq)))

@@ -12,6 +12,13 @@ from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
 
+DISPLAY = {"lumped": "lumped", "mujoco": "MuJoCo"}  # how reports write the built-in solvers' names
+
+
+def display_name(solver: str) -> str:
+    """How reports write a side's name: the built-in solvers as "lumped" and "MuJoCo", any other as it is."""
+    return DISPLAY.get(solver, solver)
+
 
 class Side(Protocol):
     solver: str  # how reports name it: "lumped", "mujoco", "as-published", ...

@@ -15,6 +15,7 @@ import numpy as np
 
 from gearcheck.compare.align import STEADY_THRESHOLD
 from gearcheck.compare.baseline import BASELINE_DIR, check_settings, compare_to_baseline, read_baseline, write_baseline
+from gearcheck.compare.diagnosis import diagnose_side
 from gearcheck.compare.engine import CrosscheckResult, compare
 from gearcheck.compare.measure import MIN_CYCLES
 from gearcheck.compare.measurements import attach, check_quantities, load_measurements
@@ -161,6 +162,9 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
                              f"of {spec.name}, or its lowest mode), the least a comparison needs")
     result = compare(spec, reference, test, plan, settings, tol, sensor_band, progress)
     result.notes = notes + result.notes
+    if user is not None and result.modal_results[1] is not None and hasattr(user, "physical_modes"):
+        result.diagnosis = diagnose_side(lumped.model, user, result.modal_results[1])
+        result.notes += [f"Diagnosis: {line}" for line in result.diagnosis.lines()]
     attach(result, entries)
     if path is not None and update_baseline:
         write_baseline(result, path)

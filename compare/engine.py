@@ -98,6 +98,7 @@ class CrosscheckResult:
     steady_how: str | None = None  # detected | decayed | transient | None (no steady state)
     settle_s: float | None = None  # the reference's free vibration decay time (steady-state runs)
     solvers: tuple = ("lumped", "mujoco")  # the reference's and the test's names
+    diagnosis: object | None = None  # a user's model: the term of the reference that best explains its modes
 
     @property
     def failures(self) -> list[str]:

@@ -46,8 +46,9 @@ import pandas as pd
 import scipy.io
 from scipy.io.matlab import MatReadError
 
-from gearcheck.lumped.assembly import AXIAL_DOF, build_model
+from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.files import read_toml
+from gearcheck.lumped.modal import central_coordinates
 from gearcheck.shared.errors import GearcheckError, TrainFileError
 from gearcheck.shared.modal import ModalResult, energy_fractions, mode_types, multiplicities, rigid_or_elastic
 from gearcheck.shared.results import TimeResult, train_signals
@@ -260,17 +261,10 @@ def read_modes(path: str | Path, spec, solver: str | None = None) -> tuple[Modal
     mass = _mass(data["mass"], source, len(coordinates))[np.ix_(rows, rows)] if "mass" in extras else None
     types, fractions = rigid_or_elastic(frequencies), None
     if labels == known:
-        fractions = energy_fractions(model.M if mass is None else mass, shapes, *_central(spec, model.dofs.names))
+        fractions = energy_fractions(model.M if mass is None else mass, shapes, *central_coordinates(spec, model.dofs.labels()))
         types = mode_types(fractions, frequencies)
     modal = ModalResult(spec.name, frequencies, shapes, types, multiplicities(frequencies), labels, solver, fractions)
     return modal, labels, mass
-
-
-def _central(spec, names) -> tuple[list[int], list[int]]:
-    """Indices of the central members' translations and of their rotations (and axial slides)."""
-    central = [(i, dof) for i, (member, dof) in enumerate(names) if not spec.members[member].is_planet]
-    turning = ("theta", AXIAL_DOF)
-    return [i for i, d in central if d not in turning], [i for i, d in central if d in turning]
 
 
 def _labels(raw, source: str, known: list[str]) -> list[str]:

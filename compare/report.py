@@ -94,6 +94,7 @@ def to_dict(result) -> dict:
                    "status": "pass" if r["rel_error"] <= result.modal_tolerance else "fail"} for r in result.modal],
         "modes_tolerance": _u(result.modal_tolerance, RATIO),
         "solvers": {"reference": result.solvers[0], "test": result.solvers[1]},
+        "diagnosis": result.diagnosis.to_dict() if result.diagnosis is not None else None,
         "quantities": quantities,
         "measurements": result.measurements,
         "notes": result.notes,

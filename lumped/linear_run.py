@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 from gearcheck.lumped.member_motion import member_motion
+from gearcheck.lumped.modal import central_coordinates
 from gearcheck.lumped.time_solver import rk4_step
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import DivergenceError
@@ -30,14 +31,13 @@ CHUNK = 2000  # steps between progress reports
 
 
 def _typing(model, train) -> tuple:
-    """(translation, rotation) indices for Lin & Parker's mode types: the central members' coordinates, when
-    the model's coordinates are the train's own; else (None, None)."""
-    if train is None or model.physical is not None:
+    """(translation, rotation) indices for Lin & Parker's mode types: the model's coordinates that are the
+    central members' own; (None, None) when it has none (then modes are rigid or elastic)."""
+    if train is None:
         return None, None
-    spec = train.spec
-    central = [(i, c.rsplit(".", 1)) for i, c in enumerate(model.coordinates)]
-    central = [(i, dof) for i, (member, dof) in central if not spec.members[member].is_planet]
-    return [i for i, d in central if d not in ("theta", "z")], [i for i, d in central if d in ("theta", "z")]
+    known = set(train.dofs.labels())
+    translation, rotation = central_coordinates(train.spec, [c if c in known else "" for c in model.coordinates])
+    return (translation, rotation) if translation or rotation else (None, None)
 
 
 def linear_modes(model, train=None) -> ModalResult:

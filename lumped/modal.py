@@ -16,11 +16,18 @@ from gearcheck.shared.modal import ModalResult, modal_result
 from gearcheck.shared.units import rad_s_to_rpm
 
 
-def _central(model) -> tuple[list[int], list[int]]:
-    central = [(i, dof) for i, (member, dof) in enumerate(model.dofs.names)
-               if not model.spec.members[member].is_planet]
-    turning = ("theta", AXIAL_DOF)  # a helical mesh's axial force goes with its torque (Eritenel & Parker 2009)
+def central_coordinates(spec, labels) -> tuple[list[int], list[int]]:
+    """Indices, among the coordinate ``labels`` (``member.dof``), of the central members' translations and of
+    their rotations (a helical mesh's axial force goes with its torque, Eritenel & Parker 2009: the axial
+    slides count with the rotations); labels of no member of ``spec`` are neither."""
+    named = [(i, label.rsplit(".", 1)) for i, label in enumerate(labels) if "." in label]
+    central = [(i, dof) for i, (member, dof) in named if member in spec.members and not spec.members[member].is_planet]
+    turning = ("theta", AXIAL_DOF)
     return [i for i, d in central if d not in turning], [i for i, d in central if d in turning]
+
+
+def _central(model) -> tuple[list[int], list[int]]:
+    return central_coordinates(model.spec, model.dofs.labels())
 
 
 def modes(model) -> ModalResult:

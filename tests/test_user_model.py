@@ -82,6 +82,7 @@ def test_factory_on_the_command_line(tmp_path, capsys):
     assert status == 1
     report = (tmp_path / "report.md").read_text()
     assert "does not report" in report and "stage1.sun.ax.world" in report
+    assert "Diagnosis: No single-term mistake: agrees with the reference reduced to its 6 coordinates" in report
     status = main(["mac", "demo-3p", "--model", TORSIONAL, "--out", str(tmp_path / "mac")])
     assert (tmp_path / "mac" / "mac.png").is_file()
 
@@ -116,6 +117,9 @@ def test_recorded_results_from_another_solver(tmp_path):
     assert sorted(q.name for q in result.quantities) == sorted(names)
     assert all(q.metrics["integration_error"]["test"] is None for q in result.quantities)
     assert result.modal == []
+    result.write(tmp_path / "report")
+    report = (tmp_path / "report" / "report.md").read_text()
+    assert "Test (other)" in report and "none: a recording" in report and "Natural frequencies" not in report
 
 
 def _npz(path, **arrays):
@@ -201,3 +205,53 @@ def test_mat_layout_matlab_stacks(tmp_path):
     scipy.io.savemat(tmp_path / "bad.mat", data)
     with pytest.raises(gearcheck.GearcheckError, match="K: is not the mean of the stiffness samples"):
         LinearSide(read_matrix_file(tmp_path / "bad.mat"), spec)
+
+
+def _broken(spec, kind):
+    """The reference as a user's LinearModel with one deliberate mistake of ``kind``."""
+    from dataclasses import replace
+
+    model = reference_linear_model(spec)
+    model.name = kind
+    sun = model.coordinates.index("stage1.sun.theta")
+    if kind in ("dropped coupling", "sign error"):
+        row = model.meshes[1].row.copy()
+        row[sun] = 0.0 if kind == "dropped coupling" else -row[sun]
+        model.meshes[1] = replace(model.meshes[1], row=row)
+    elif kind == "inertia":
+        model.M = model.M.copy()
+        model.M[sun, sun] *= 1.5
+    else:
+        model.G = None
+    return model
+
+
+@pytest.mark.parametrize("kind, term", [
+    ("dropped coupling", "mesh stage1.planet2.sun: coefficient of stage1.sun.theta dropped"),
+    ("sign error", "mesh stage1.planet2.sun: sign of the stage1.sun.theta coefficient flipped"),
+    ("inertia", "stage1.sun.theta inertia x 1.5"),
+    ("gyroscopic", "gyroscopic terms missing"),
+])
+def test_diagnosis_through_the_door_names_the_term(kind, term):
+    """A broken copy of the reference given as a user's model: the diagnosis names the broken term first, at
+    round-off, and the reference itself scores far worse (a missing Coriolis term only shows at speed)."""
+    from gearcheck.compare.diagnosis import diagnose_side
+    from gearcheck.lumped.assembly import build_model
+
+    spec = gearcheck.load("demo-3p")
+    diagnosis = diagnose_side(build_model(spec), LinearSide(_broken(spec, kind), spec))
+    assert diagnosis.best.term.startswith(term), diagnosis.summary()
+    assert diagnosis.best.score < 1e-9 < diagnosis.reference_score
+
+
+def test_diagnosis_of_the_torsional_model_is_its_reduction():
+    """The torsional model agrees with the reference reduced to its coordinates: its disagreement with the
+    full reference is the reduction, which the diagnosis says instead of blaming a term."""
+    from gearcheck.compare.diagnosis import diagnose_side
+    from gearcheck.compare.user_model import user_side
+    from gearcheck.lumped.assembly import build_model
+
+    spec = gearcheck.load("demo-3p")
+    diagnosis = diagnose_side(build_model(spec), user_side(TORSIONAL, spec))
+    assert diagnosis.agrees and diagnosis.reduced_to == 6
+    assert "the reduction itself" in diagnosis.lines()[0]

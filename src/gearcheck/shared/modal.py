@@ -227,6 +227,9 @@ def speed_modal_result(train: str, solver: str, M: np.ndarray, D: np.ndarray, K:
     frequencies, growth, shapes = frequencies[order], growth[order], shapes[:, order]
     stability = ["rigid" if f == 0 and g == 0 else "stable" if g <= 0 else "divergence" if f == 0 else "flutter"
                  for f, g in zip(frequencies, growth)]
+    if translation is None:  # no central members to classify by
+        return ModalResult(train, frequencies, shapes, rigid_or_elastic(frequencies), multiplicities(frequencies),
+                           list(dof_labels), solver, None, speed_rpm, growth, stability)
     fractions = energy_fractions(M, shapes, translation, rotation)
     return ModalResult(train, frequencies, shapes, mode_types(fractions, frequencies), multiplicities(frequencies),
                        list(dof_labels), solver, fractions, speed_rpm, growth, stability)

@@ -113,9 +113,9 @@ class Calibration:
         """The calibrated train file; file references rewritten relative to ``directory`` if given."""
         doc = copy.deepcopy(self.document)
         if directory is not None:
-            for table, key in (("train", "measurements_file"), ("operating", "torque_csv")):
+            for table, key in (("train", "measurements_file"), ("train", "user_model"), ("operating", "torque_csv")):
                 name = doc.get(table, {}).get(key)
-                if name is not None:
+                if name is not None and ":" not in name:  # a file, not module:factory
                     doc[table][key] = os.path.relpath(beside(self.source, name), directory)
         return self.header + tomli_w.dumps(doc)
 

@@ -40,6 +40,7 @@ from gearcheck.shared.units import rad_s_to_rpm
 
 MODELS = ("general",) + PUBLISHED_MODELS
 AGAINST = ("lumped", "mujoco")
+USER = "user"  # the model the train file registers (train.user_model)
 GENERAL_DURATION = 0.1  # s, default simulated time of a train
 PUBLISHED_DURATION = 0.02  # s, of the 4-DOF models' start-stop transient
 
@@ -64,7 +65,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         (2021) against the twin of its own idealisation: ``"as-published"``, ``"energy-derived"``,
         ``"energy-derived-axis"``, ``"consistent"``; or a user's model, checked against ``against``: a
         :class:`~gearcheck.lumped.linear_model.LinearModel`, a ``.mat``/``.npz`` file of matrices,
-        ``"module:factory"`` / ``"file.py:factory"``, or a side (:mod:`gearcheck.compare.user_model`).
+        ``"module:factory"`` / ``"file.py:factory"``, a side (:mod:`gearcheck.compare.user_model`), or
+        ``"user"``: the one the train file registers (``train.user_model``).
     against : str
         What a user's model is checked against: ``"lumped"`` (the reference model) or ``"mujoco"`` (the twin).
     results, columns, modes : path, optional
@@ -104,6 +106,10 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
             raise GearcheckError("--results needs --columns, the map of its columns to gearcheck's signals")
         user = RecordedSide(spec, results, columns, modes)
         duration = user.duration if duration is None else duration
+    elif isinstance(model, str) and model == USER:
+        if spec.user_model is None:
+            raise GearcheckError(f"--model user: {spec.name} registers no user_model (train.user_model in its file)")
+        user = user_side(spec.user_model, spec)
     elif isinstance(model, str) and model in MODELS:
         user = None
     elif isinstance(model, str) and ":" not in model and Path(model).suffix not in SUFFIXES:

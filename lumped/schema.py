@@ -553,6 +553,8 @@ TRAIN_TABLE = Table(
                        "members held by their torsional support stiffness", ()),
         "measurements_file": Text("a TOML file of [[measurements]] (relative to the train file) shown in every "
                                   "cross-check and used by calibrate", None),
+        "user_model": Text("your own model of this train, checked by `crosscheck --model user`: a .mat or .npz "
+                           "file of matrices (relative to the train file) or `module:factory`", None),
     },
     "identification and power flow",
 )

@@ -160,6 +160,7 @@ class TrainSpec:
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
     measurements: tuple[dict, ...] = ()  # measured reference values, SI (see schema.MEASUREMENT)
     tolerances: dict = field(default_factory=dict)  # cross-check tolerance overrides, flat keys
+    user_model: str | None = None  # a user's model of the train (a file path or module:factory), --model user
 
     def member(self, member_id: str) -> Member:
         return self.members[member_id]
@@ -245,6 +246,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         text_hash=text_hash, references=tuple(train["references"]),
         measurements=tuple(_measurements(data, source, fail)),
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
+        user_model=_user_model(train["user_model"], source),
     )
 
 
@@ -280,6 +282,13 @@ def beside(source: str, name: str):
     folder)."""
     base = Path(__file__).parent / "presets" if source.startswith("preset:") else Path(source).parent
     return base / name
+
+
+def _user_model(name: str | None, source: str) -> str | None:
+    """train.user_model: a file of matrices named relative to the train file, or ``module:factory`` as given."""
+    if name is None or ":" in name:
+        return name
+    return str(beside(source, name))
 
 
 def _measurements(data: dict, source: str, fail) -> list[dict]:

@@ -255,3 +255,20 @@ def test_diagnosis_of_the_torsional_model_is_its_reduction():
     diagnosis = diagnose_side(build_model(spec), user_side(TORSIONAL, spec))
     assert diagnosis.agrees and diagnosis.reduced_to == 6
     assert "the reduction itself" in diagnosis.lines()[0]
+
+
+def test_train_file_registers_its_user_model(tmp_path, capsys):
+    """train.user_model names the model (a file relative to the train file) that --model user checks; a train
+    without one is refused in one line."""
+    from gearcheck.lumped.loader import preset_text
+
+    write_matrix_file(reference_linear_model(gearcheck.load("demo-3p")), tmp_path / "mine.npz")
+    text = preset_text("demo-3p").replace("[train]\n", '[train]\nuser_model = "mine.npz"\n', 1)
+    (tmp_path / "train.toml").write_text(text)
+    spec = gearcheck.load(tmp_path / "train.toml")
+    assert spec.user_model == str(tmp_path / "mine.npz")
+    pairing = gearcheck.mode_pairing(spec, model=spec.user_model)
+    assert pairing.paired.min() > 1 - 1e-9
+    status = main(["crosscheck", "demo-3p", "--model", "user", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert status == 2 and "demo-3p registers no user_model" in err and not (tmp_path / "o").exists()

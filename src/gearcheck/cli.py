@@ -187,8 +187,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--model", default="general", metavar="MODEL",
                    help="the model checked: gearcheck's general model against MuJoCo (default), a published "
                         f"4-DOF model ({', '.join(MODELS[1:])}: double-planet) against the twin of its "
-                        "idealisation, or your own: a .mat/.npz file of matrices, module:factory or "
-                        "file.py:factory (checked against --against)")
+                        "idealisation, or your own: a .mat/.npz file of matrices, module:factory, "
+                        "file.py:factory, or 'user' (the train file's train.user_model), checked against --against")
     s.add_argument("--against", default="lumped", choices=("lumped", "mujoco"),
                    help="what your own model is checked against: the reference lumped model (default) or the "
                         "MuJoCo twin")

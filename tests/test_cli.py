@@ -2,10 +2,12 @@
 
 import json
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from gearcheck.cli import main
+from gearcheck.shared.results import units_of
 
 
 def test_presets_lists_every_preset_with_its_source(capsys):
@@ -37,8 +39,15 @@ def test_modes_json_schema(capsys):
 def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
     assert main(["run", "demo-3p", "--solver", "lumped", "--duration", "0.01", "--speed", "1000",
                  "--output-dt", "2e-5", "--out", str(tmp_path)]) == 0
-    df = pd.read_csv(tmp_path / "timeseries.csv")
+    df = pd.read_parquet(tmp_path / "timeseries.parquet")
     assert {"t", "stage1.ring.ay.world", "stage1.planet1.sun.force", "stage1.planet1.sun.dte"} <= set(df.columns)
     assert df["t"].iloc[-1] == pytest.approx(0.01, rel=1e-3)
+    units = units_of(tmp_path / "timeseries.parquet")
+    assert units["stage1.ring.ay.world"]["unit"] == "m/s^2" and units["stage1.planet1.sun.force"]["unit"] == "N"
+    assert main(["run", "demo-3p", "--duration", "0.01", "--speed", "1000", "--output-dt", "2e-5", "--format", "csv",
+                 "--out", str(tmp_path / "csv")]) == 0
+    csv = pd.read_csv(tmp_path / "csv" / "timeseries.csv")
+    assert list(csv.columns) == list(df.columns)  # the same table, 9 significant digits
+    np.testing.assert_allclose(csv.to_numpy(), df.to_numpy(), rtol=1e-8, atol=1e-12 * np.abs(df.to_numpy()).max())
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["solver"] == "lumped" and summary["info"]["method"] == "rk4"

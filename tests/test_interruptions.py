@@ -84,7 +84,7 @@ def test_a_second_run_into_the_same_folder_is_refused(tmp_path, capsys):
     assert err.count("\n") == 1 and f"--out {out}: another gearcheck run (pid " in err
     assert not out.exists()
     assert main(["run", "demo-3p", "--duration", "0.001", "--out", str(out)]) == 0  # the lock went with the first
-    assert (out / "timeseries.csv").exists()
+    assert (out / "timeseries.parquet").exists()
 
 
 def test_a_closed_pipe_ends_the_program_quietly(tmp_path):
@@ -118,4 +118,4 @@ def test_a_folder_that_is_no_earlier_output_is_never_replaced(tmp_path, capsys):
     empty = tmp_path / "empty"
     empty.mkdir()
     assert main(["run", "demo-3p", "--duration", "0.001", "--out", str(empty)]) == 0
-    assert (empty / MARKER).exists() and (empty / "timeseries.csv").exists()
+    assert (empty / MARKER).exists() and (empty / "timeseries.parquet").exists()

@@ -172,6 +172,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--output-dt", type=SECONDS, metavar="S", help="output sampling interval (default: every step)")
     s.add_argument("--method", default="rk4", help="lumped integrator: rk4 (default) or RK45, DOP853, Radau, "
                                                    "BDF, LSODA")
+    s.add_argument("--format", choices=("parquet", "csv"), default="parquet",
+                   help="time series file format: parquet (default: full precision, compressed, units in its "
+                        "metadata) or csv")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_run)
 
@@ -385,7 +388,7 @@ def cmd_run(args) -> int:
         result = gearcheck.simulate(spec, args.solver, args.duration, dt=args.dt, output_dt=args.output_dt,
                                     method=args.method, progress=bar)
         bar.close()
-        written = [path.name for path in result.write_files(place.path)]
+        written = [path.name for path in result.write_files(place.path, args.format)]
     print(f"{spec.name} ({args.solver}): {result.t.size} samples over {result.t[-1]:.6g} s, "
           f"dt = {result.info['dt_s']:.4g} s, wall {result.info['wall_time_s']:.3g} s")
     for name in written:

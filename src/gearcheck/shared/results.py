@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from gearcheck.shared.errors import SolverError
 from gearcheck.shared.outputs import OutputDirectory
 
 
@@ -97,23 +98,53 @@ class TimeResult:
         return {"train": self.train, "solver": self.solver, "settle_time_s": self.settle_time,
                 "samples": int(w.sum()), "info": self.info, "series": stats}
 
-    def write(self, directory) -> list[Path]:
-        """Write ``timeseries.csv`` (and ``raw.csv`` if any) and ``summary.json`` as the folder ``directory``,
-        whole or not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the files' paths."""
+    def write(self, directory, fmt: str = "parquet") -> list[Path]:
+        """Write ``timeseries.parquet`` (or ``.csv``), ``raw.parquet`` (if any) and ``summary.json`` as the folder
+        ``directory``, whole or not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the
+        files' paths."""
         with OutputDirectory(directory, "directory") as place:
-            names = [p.name for p in self.write_files(place.path)]
+            names = [p.name for p in self.write_files(place.path, fmt)]
         return [Path(directory) / name for name in names]
 
-    def write_files(self, out: Path) -> list[Path]:
-        """Write the files into the existing folder ``out``."""
-        written = [out / "timeseries.csv"]
-        self.to_dataframe().to_csv(written[-1], index=False, float_format="%.9g")
+    def write_files(self, out: Path, fmt: str = "parquet") -> list[Path]:
+        """Write the files into the existing folder ``out``: Parquet (full precision, compressed, each column's
+        unit and description in the file's metadata: ``units_of``) or CSV (9 significant digits)."""
+        if fmt not in SERIES_FORMATS:
+            raise SolverError(f"format {fmt!r}: choose {' or '.join(SERIES_FORMATS)}")
+        columns = {"t": ("s", "time")} | {s.name: (s.unit, s.description) for s in self.signals}
+        written = [_write_table(self.to_dataframe(), out / f"timeseries.{fmt}", columns)]
         if self.raw:
-            written.append(out / "raw.csv")
-            pd.DataFrame({"t": self.t, **self.raw}).to_csv(written[-1], index=False, float_format="%.9g")
+            raw = {"t": ("s", "time")} | {name: ("", f"{self.solver} coordinate or sensor") for name in self.raw}
+            written.append(_write_table(pd.DataFrame({"t": self.t, **self.raw}), out / f"raw.{fmt}", raw))
         written.append(out / "summary.json")
         written[-1].write_text(json.dumps(self.summary(), indent=2, sort_keys=True) + "\n")
         return written
+
+
+SERIES_FORMATS = ("parquet", "csv")
+UNITS_KEY = b"gearcheck.units"
+
+
+def _write_table(frame: pd.DataFrame, path: Path, columns: dict) -> Path:
+    """One table as Parquet (its columns' units and descriptions in the schema metadata) or CSV."""
+    if path.suffix == ".csv":
+        frame.to_csv(path, index=False, float_format="%.9g")
+        return path
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    meta = {UNITS_KEY: json.dumps({k: {"unit": u, "description": d} for k, (u, d) in columns.items()}).encode()}
+    pq.write_table(table.replace_schema_metadata({**(table.schema.metadata or {}), **meta}), path,
+                   compression="zstd")
+    return path
+
+
+def units_of(path) -> dict:
+    """The units and descriptions a gearcheck Parquet file holds for its columns."""
+    import pyarrow.parquet as pq
+
+    return json.loads(pq.read_schema(path).metadata[UNITS_KEY])
 
 
 def bearing_names(spec) -> list[str]:

@@ -1,0 +1,297 @@
+"""The history of cross-checks: one record per (commit, train) in a SQLite file, and change points.
+
+Why SQLite: the store is one file that CI restores and saves whole; no server; an append is one
+transaction (an interrupted run leaves the previous store), and the primary key (commit, train)
+makes appending again an upsert; any SQLite client, pandas or a spreadsheet import reads it.  A
+Parquet dataset would be either one small file per run (thousands of files to carry between CI
+runs) or one file rewritten on every append.
+
+Schema ``gearcheck.history`` version 1 (in the table ``meta``)::
+
+    commits(commit PRIMARY KEY, date, seq)   date: ISO 8601 UTC; seq: order of first appearance
+    runs(commit, train, verdict, failures, unresolved, moved, steady_state, duration_s, input_speed_rpm,
+         gearcheck_version, mujoco_version, numpy_version, python, machine, git_revision, train_sha256,
+         PRIMARY KEY (commit, train))       failures, unresolved, moved: JSON lists
+    metrics(commit, train, position, item, metric, kind, unit, value, tolerance, status, gated,
+            PRIMARY KEY (commit, train, item, metric))
+
+A run's metrics (``item`` / ``metric``): per quantity (``item`` its name) ``nrmse`` (gated against
+``tolerance`` when the quantity is), ``lumped.rms``, ``lumped.peak_to_peak``, ``mujoco.rms``,
+``mujoco.peak_to_peak`` (in the quantity's unit), ``integration_error.lumped`` and
+``integration_error.mujoco`` (with the quantity's tolerance, which their sum must stay below); per
+mode (``item`` "mode N") ``rel_error`` (gated), ``lumped.frequency`` and ``mujoco.frequency`` (Hz);
+``item`` "wall_time": one metric per timed step (s).
+
+Change points (:func:`change_points`): point ``i`` of a metric's series over commits is where the
+metric moved when both the point and the median of the next ``CONFIRM`` points (itself included)
+differ, on the same side, from the median of the previous ``WINDOW`` points (counted from the last
+change point) by more than the threshold ``max(K * sigma, TOLERANCE_SHARE * tolerance,
+relative * |median|, ROUND_OFF)``.  ``sigma`` is the noise: the median absolute difference of
+successive points inside those two windows (never across ``i``), over 0.6745 * sqrt(2) (a standard
+deviation for Gaussian noise).  A single outlier is no change point (the median after it is at the
+old level), a step is marked once, at its first commit, and its new level becomes the reference; a
+move at the latest commit has nothing after it to confirm it and is marked at once.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as _dt
+import json
+import math
+import sqlite3
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from gearcheck.shared.errors import GearcheckError
+
+SCHEMA = "gearcheck.history"
+SCHEMA_VERSION = 1
+REPORT_SCHEMA = "gearcheck.crosscheck"
+
+WINDOW = 8  # points before a candidate that set its reference level and noise
+CONFIRM = 3  # points from a candidate on whose median the move must persist
+K = 4.0  # noise multiples a move must exceed
+TOLERANCE_SHARE = 0.1  # a gated metric moves when it moves by this share of its tolerance
+RELATIVE_FLOOR = 0.01  # a physical value (amplitude, frequency) moves when it moves by this part of itself
+ROUND_OFF = 1e-12  # moves below this (in the metric's unit) are round-off
+_NOISE = 0.6745 * math.sqrt(2.0)  # median |x_j - x_j-1| of Gaussian noise, in standard deviations
+
+_TABLES = """
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE commits (commit_id TEXT PRIMARY KEY, date TEXT NOT NULL, seq INTEGER NOT NULL UNIQUE);
+CREATE TABLE runs (
+    commit_id TEXT NOT NULL REFERENCES commits(commit_id), train TEXT NOT NULL, verdict TEXT NOT NULL,
+    failures TEXT NOT NULL, unresolved TEXT NOT NULL, moved TEXT, steady_state INTEGER,
+    duration_s REAL, input_speed_rpm REAL, gearcheck_version TEXT, mujoco_version TEXT, numpy_version TEXT,
+    python TEXT, machine TEXT, git_revision TEXT, train_sha256 TEXT,
+    PRIMARY KEY (commit_id, train));
+CREATE TABLE metrics (
+    commit_id TEXT NOT NULL, train TEXT NOT NULL, position INTEGER NOT NULL, item TEXT NOT NULL,
+    metric TEXT NOT NULL, kind TEXT, unit TEXT, value REAL, tolerance REAL, status TEXT, gated INTEGER NOT NULL,
+    PRIMARY KEY (commit_id, train, item, metric),
+    FOREIGN KEY (commit_id, train) REFERENCES runs(commit_id, train));
+"""
+_RUN_COLUMNS = ("verdict", "failures", "unresolved", "moved", "steady_state", "duration_s", "input_speed_rpm",
+                "gearcheck_version", "mujoco_version", "numpy_version", "python", "machine", "git_revision",
+                "train_sha256")
+
+
+def append(store, data: dict, commit: str, date: str | None = None, machine: str | None = None) -> None:
+    """Record the cross-check ``data`` (a report.json dict) of ``commit`` in the SQLite file ``store``
+    (made if missing), in one transaction; a record of the same commit and train is replaced.
+
+    ``date``: the commit's date, ISO 8601 (default: now; a commit already recorded keeps its date unless
+    one is given); ``machine``: where it ran (default: the report's provenance)."""
+    if not isinstance(commit, str) or not commit.strip():
+        raise GearcheckError(f"{store}: a commit id is required to record a run, got {commit!r}")
+    commit = commit.strip()
+    if not isinstance(data, dict) or data.get("schema") != REPORT_SCHEMA or data.get("schema_version") != 1:
+        raise GearcheckError(f"{store}: can only record a {REPORT_SCHEMA} version 1 report, got "
+                             f"{data.get('schema') if isinstance(data, dict) else type(data).__name__!r}")
+    when = _utc(date) if date is not None else None
+    run, metrics = _record(data, machine)
+    train = data["train"]["name"]
+    with _connect(store, write=True) as con:
+        con.execute("BEGIN IMMEDIATE")
+        try:
+            if not con.execute("SELECT count(*) FROM sqlite_master").fetchone()[0]:
+                con.executescript("BEGIN;" + _TABLES)  # executescript commits first: start again
+                con.executemany("INSERT INTO meta VALUES (?, ?)",
+                                [("schema", SCHEMA), ("schema_version", str(SCHEMA_VERSION))])
+            _check(con, store)
+            known = con.execute("SELECT date FROM commits WHERE commit_id = ?", (commit,)).fetchone()
+            if known is None:
+                seq = con.execute("SELECT coalesce(max(seq), 0) + 1 FROM commits").fetchone()[0]
+                con.execute("INSERT INTO commits VALUES (?, ?, ?)", (commit, when or _utc(None), seq))
+            elif when is not None:
+                con.execute("UPDATE commits SET date = ? WHERE commit_id = ?", (when, commit))
+            con.execute("DELETE FROM metrics WHERE commit_id = ? AND train = ?", (commit, train))
+            con.execute("DELETE FROM runs WHERE commit_id = ? AND train = ?", (commit, train))
+            con.execute(f"INSERT INTO runs (commit_id, train, {', '.join(_RUN_COLUMNS)}) "
+                        f"VALUES ({', '.join('?' * (len(_RUN_COLUMNS) + 2))})",
+                        (commit, train, *(run[c] for c in _RUN_COLUMNS)))
+            con.executemany("INSERT INTO metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                            [(commit, train, position, *row) for position, row in enumerate(metrics)])
+            con.execute("COMMIT")
+        except BaseException:
+            con.rollback()
+            raise
+
+
+def read(store) -> pd.DataFrame:
+    """Every recorded metric, long format, in commit order: ``order`` (the commit's place), ``commit``,
+    ``date``, ``train``, ``verdict``, ``position``, ``item``, ``metric``, ``kind``, ``unit``, ``value``,
+    ``tolerance``, ``status``, ``gated``."""
+    with _connect(store) as con:
+        frame = pd.read_sql_query(
+            "SELECT c.seq, m.commit_id AS 'commit', c.date, m.train, r.verdict, m.position, m.item, m.metric, "
+            "m.kind, m.unit, m.value, m.tolerance, m.status, m.gated "
+            "FROM metrics m JOIN runs r USING (commit_id, train) JOIN commits c USING (commit_id) "
+            "ORDER BY c.date, c.seq, m.train, m.position", con)
+    frame.insert(0, "order", _order(frame))
+    frame["gated"] = frame["gated"].astype(bool)
+    return frame.drop(columns="seq")
+
+
+def runs(store) -> pd.DataFrame:
+    """One row per recorded run, in commit order: ``order``, ``commit``, ``date``, ``train`` and the run's
+    verdict, failures, unresolved and moved (lists), steady state, settings, versions and machine."""
+    with _connect(store) as con:
+        frame = pd.read_sql_query(
+            f"SELECT c.seq, r.commit_id AS 'commit', c.date, r.train, {', '.join('r.' + c for c in _RUN_COLUMNS)} "
+            "FROM runs r JOIN commits c USING (commit_id) ORDER BY c.date, c.seq, r.train", con)
+    frame.insert(0, "order", _order(frame))
+    for column in ("failures", "unresolved", "moved"):
+        frame[column] = [json.loads(v) if v is not None else None for v in frame[column]]
+    return frame.drop(columns="seq")
+
+
+def commits(store) -> list[str]:
+    """The recorded commits in order: by date, then by first appearance in the store."""
+    with _connect(store) as con:
+        return [row[0] for row in con.execute("SELECT commit_id FROM commits ORDER BY date, seq")]
+
+
+def change_points(values, tolerance: float | None = None, relative: float = 0.0, k: float = K,
+                  window: int = WINDOW, confirm: int = CONFIRM) -> list[int]:
+    """Indices in ``values`` (a metric over commits, oldest first; NaN or None: not recorded, skipped) where
+    the metric moved beyond its noise (the rule is in the module doc): ``tolerance`` the metric's gate,
+    ``relative`` the part of its level it must move by."""
+    x = np.array([np.nan if v is None else v for v in values], dtype=float)
+    where = np.flatnonzero(np.isfinite(x))
+    x = x[where]
+    fixed = max(ROUND_OFF, TOLERANCE_SHARE * tolerance if tolerance else 0.0)
+    found, start = [], 0
+    for i in range(1, x.size):
+        before, after = x[max(start, i - window):i], x[i:i + confirm]
+        level, new = float(np.median(before)), float(np.median(after))
+        steps = np.abs(np.concatenate([np.diff(before), np.diff(after)]))
+        sigma = float(np.median(steps)) / _NOISE if steps.size else 0.0
+        threshold = max(k * sigma, fixed, relative * abs(level))
+        jump, shift = x[i] - level, new - level
+        if abs(jump) > threshold and abs(shift) > threshold and jump * shift > 0:
+            found.append(int(where[i]))
+            start = i
+    return found
+
+
+def floors(metric: str, unit: str | None) -> dict | None:
+    """The keywords of :func:`change_points` for a recorded metric (with its tolerance added by the caller):
+    ``relative`` for physical values, none for ratios; None for wall times, which are machine noise."""
+    if unit == "s" and metric.endswith("_s"):
+        return None
+    return {"relative": RELATIVE_FLOOR} if unit not in ("1", None) else {}
+
+
+def _record(data: dict, machine: str | None) -> tuple[dict, list[tuple]]:
+    """The run's row and its metric rows (item, metric, kind, unit, value, tolerance, status, gated)."""
+    try:
+        prov, verdict, settings = data.get("provenance") or {}, data["verdict"], data.get("settings") or {}
+        run = {
+            "verdict": verdict["verdict"], "failures": json.dumps(verdict.get("failures") or []),
+            "unresolved": json.dumps(verdict.get("unresolved") or []),
+            "moved": None if verdict.get("moved_from_baseline") is None else json.dumps(verdict["moved_from_baseline"]),
+            "steady_state": _flag((data.get("steady_state") or {}).get("detected")),
+            "duration_s": _value(settings.get("duration")), "input_speed_rpm": _value(settings.get("input_speed")),
+            "gearcheck_version": prov.get("gearcheck_version"), "mujoco_version": prov.get("mujoco_version"),
+            "numpy_version": prov.get("numpy_version"), "python": prov.get("python"),
+            "machine": machine or prov.get("machine"), "git_revision": prov.get("git_revision"),
+            "train_sha256": prov.get("train_sha256"),
+        }
+        rows = []
+        for q in data.get("quantities") or []:
+            tol, status = _value(q.get("tolerance_nrmse")), q.get("status")
+            gated = tol is not None and status != "negligible"
+            rows.append((q["name"], "nrmse", q["kind"], "1", _value(q["errors"]["nrmse"]), tol, status, gated))
+            for solver in ("lumped", "mujoco"):
+                for stat in ("rms", "peak_to_peak"):
+                    rows.append((q["name"], f"{solver}.{stat}", q["kind"], q["unit"],
+                                 _value((q.get(solver) or {}).get(stat)), None, None, False))
+            for solver in ("lumped", "mujoco"):
+                rows.append((q["name"], f"integration_error.{solver}", q["kind"], "1",
+                             _value((q.get("integration_error") or {}).get(solver)), tol, None, False))
+        mode_tol = _value(data.get("modes_tolerance"))
+        for m in data.get("modes") or []:
+            item = f"mode {m['mode']}"
+            rows.append((item, "rel_error", m.get("type"), "1", _value(m["rel_error"]), mode_tol, m.get("status"),
+                         mode_tol is not None))
+            for solver in ("lumped", "mujoco"):
+                rows.append((item, f"{solver}.frequency", m.get("type"), "Hz", _value(m.get(solver)), None, None,
+                             False))
+        for name, value in sorted(((data.get("volatile") or {}).get("wall_time") or {}).items()):
+            rows.append(("wall_time", name, "wall_time", "s", _value(value), None, None, False))
+        data["train"]["name"]
+    except (KeyError, TypeError, AttributeError) as exc:
+        raise GearcheckError(f"cannot record the report: it lacks {exc}") from None
+    return run, rows
+
+
+def _value(field):
+    """A number of report.json (``{"value": x, "unit": u}`` or a bare number) as a float, or None."""
+    value = field.get("value") if isinstance(field, dict) else field
+    if value is None or isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        return None
+    return float(value)
+
+
+def _flag(value) -> int | None:
+    return None if value is None else int(bool(value))
+
+
+def _utc(date: str | None) -> str:
+    """An ISO 8601 date-time as UTC ``YYYY-MM-DDTHH:MM:SSZ`` (naive: taken as UTC), or now."""
+    if date is None:
+        moment = _dt.datetime.now(_dt.timezone.utc)
+    else:
+        try:
+            moment = _dt.datetime.fromisoformat(date.strip())
+        except (ValueError, AttributeError):
+            raise GearcheckError(f"commit date {date!r}: not an ISO 8601 date") from None
+        if moment.tzinfo is None:
+            moment = moment.replace(tzinfo=_dt.timezone.utc)
+    return moment.astimezone(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def _order(frame: pd.DataFrame) -> list[int]:
+    """Each row's commit as its place among the commits (0 = oldest)."""
+    seqs = sorted(set(zip(frame["date"], frame["seq"])))
+    place = {seq: n for n, (_, seq) in enumerate(seqs)}
+    return [place[s] for s in frame["seq"]]
+
+
+@contextlib.contextmanager
+def _connect(store, write: bool = False):
+    """An open connection to ``store`` (checked to be a history store unless it is new and ``write``); every
+    SQLite error is a one-line GearcheckError naming the file."""
+    path = Path(store)
+    if path.is_dir():
+        raise GearcheckError(f"history store {store}: is a folder, not a file")
+    if not write and not path.is_file():
+        raise GearcheckError(f"history store {store}: no such file")
+    con = None
+    try:
+        if write:
+            con = sqlite3.connect(path, timeout=30, isolation_level=None)
+        else:
+            con = sqlite3.connect(path.absolute().as_uri() + "?mode=ro", uri=True, timeout=30)
+            _check(con, store)
+        yield con
+    except sqlite3.Error as exc:
+        raise GearcheckError(f"history store {store}: not a readable gearcheck history store ({exc})") from None
+    finally:
+        if con is not None:
+            con.close()
+
+
+def _check(con: sqlite3.Connection, store) -> None:
+    """Refuse a SQLite file that is not a history store of this schema version."""
+    tables = {row[0] for row in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    if "meta" not in tables:
+        raise GearcheckError(f"history store {store}: a SQLite file but not a gearcheck history store")
+    meta = dict(con.execute("SELECT key, value FROM meta").fetchall())
+    if meta.get("schema") != SCHEMA or meta.get("schema_version") != str(SCHEMA_VERSION):
+        raise GearcheckError(f"history store {store}: schema {meta.get('schema')} version "
+                             f"{meta.get('schema_version')}, this gearcheck reads {SCHEMA} version {SCHEMA_VERSION}")

@@ -8,12 +8,12 @@ runs) or one file rewritten on every append.
 
 Schema ``gearcheck.history`` version 1 (in the table ``meta``)::
 
-    commits(commit PRIMARY KEY, date, seq)   date: ISO 8601 UTC; seq: order of first appearance
-    runs(commit, train, verdict, failures, unresolved, moved, steady_state, duration_s, input_speed_rpm,
+    commits(commit_id PRIMARY KEY, date, seq)   date: ISO 8601 UTC; seq: order of first appearance
+    runs(commit_id, train, verdict, failures, unresolved, moved, steady_state, duration_s, input_speed_rpm,
          gearcheck_version, mujoco_version, numpy_version, python, machine, git_revision, train_sha256,
-         PRIMARY KEY (commit, train))       failures, unresolved, moved: JSON lists
-    metrics(commit, train, position, item, metric, kind, unit, value, tolerance, status, gated,
-            PRIMARY KEY (commit, train, item, metric))
+         PRIMARY KEY (commit_id, train))       failures, unresolved, moved: JSON lists
+    metrics(commit_id, train, position, item, metric, kind, unit, value, tolerance, status, gated,
+            PRIMARY KEY (commit_id, train, item, metric))
 
 A run's metrics (``item`` / ``metric``): per quantity (``item`` its name) ``nrmse`` (gated against
 ``tolerance`` when the quantity is), ``lumped.rms``, ``lumped.peak_to_peak``, ``mujoco.rms``,
@@ -27,10 +27,14 @@ metric moved when both the point and the median of the next ``CONFIRM`` points (
 differ, on the same side, from the median of the previous ``WINDOW`` points (counted from the last
 change point) by more than the threshold ``max(K * sigma, TOLERANCE_SHARE * tolerance,
 relative * |median|, ROUND_OFF)``.  ``sigma`` is the noise: the median absolute difference of
-successive points inside those two windows (never across ``i``), over 0.6745 * sqrt(2) (a standard
-deviation for Gaussian noise).  A single outlier is no change point (the median after it is at the
-old level), a step is marked once, at its first commit, and its new level becomes the reference; a
-move at the latest commit has nothing after it to confirm it and is marked at once.
+successive points among the previous ``NOISE_WINDOW`` (never across a change point) and in the
+confirming window, over 0.6745 * sqrt(2) (a standard deviation for Gaussian noise), times
+``1 + 2 / n`` for ``n`` differences and ``sqrt(1 + 1 / m)`` for a level from ``m`` points (a noise or
+a level known from few points asks for a larger move).  Deterministic metrics (gearcheck's, on one
+machine and one set of versions) have no noise, and the floors decide.  A single outlier is no
+change point (the median after it is at the old level); a step is marked once, at its first commit,
+and its new level becomes the reference; a move at the latest commit has nothing after it to
+confirm it and is marked at once.
 """
 
 from __future__ import annotations
@@ -41,18 +45,19 @@ import json
 import math
 import sqlite3
 from pathlib import Path
+from statistics import median
 
-import numpy as np
 import pandas as pd
 
 from gearcheck.shared.errors import GearcheckError
 
 SCHEMA = "gearcheck.history"
 SCHEMA_VERSION = 1
-REPORT_SCHEMA = "gearcheck.crosscheck"
+REPORT_SCHEMA, REPORT_SCHEMA_VERSION = "gearcheck.crosscheck", 1  # what it records
 
-WINDOW = 8  # points before a candidate that set its reference level and noise
+WINDOW = 8  # points before a candidate whose median is the level it moved from
 CONFIRM = 3  # points from a candidate on whose median the move must persist
+NOISE_WINDOW = 30  # points before a candidate whose successive differences measure the noise
 K = 4.0  # noise multiples a move must exceed
 TOLERANCE_SHARE = 0.1  # a gated metric moves when it moves by this share of its tolerance
 RELATIVE_FLOOR = 0.01  # a physical value (amplitude, frequency) moves when it moves by this part of itself
@@ -67,16 +72,25 @@ CREATE TABLE runs (
     failures TEXT NOT NULL, unresolved TEXT NOT NULL, moved TEXT, steady_state INTEGER,
     duration_s REAL, input_speed_rpm REAL, gearcheck_version TEXT, mujoco_version TEXT, numpy_version TEXT,
     python TEXT, machine TEXT, git_revision TEXT, train_sha256 TEXT,
-    PRIMARY KEY (commit_id, train));
+    PRIMARY KEY (commit_id, train)) WITHOUT ROWID;
 CREATE TABLE metrics (
     commit_id TEXT NOT NULL, train TEXT NOT NULL, position INTEGER NOT NULL, item TEXT NOT NULL,
     metric TEXT NOT NULL, kind TEXT, unit TEXT, value REAL, tolerance REAL, status TEXT, gated INTEGER NOT NULL,
     PRIMARY KEY (commit_id, train, item, metric),
-    FOREIGN KEY (commit_id, train) REFERENCES runs(commit_id, train));
+    FOREIGN KEY (commit_id, train) REFERENCES runs(commit_id, train)) WITHOUT ROWID;
 """
+_ORDERED = "(SELECT commit_id, date, row_number() OVER (ORDER BY date, seq) - 1 AS place FROM commits)"
 _RUN_COLUMNS = ("verdict", "failures", "unresolved", "moved", "steady_state", "duration_s", "input_speed_rpm",
                 "gearcheck_version", "mujoco_version", "numpy_version", "python", "machine", "git_revision",
                 "train_sha256")
+
+
+def check_store(store) -> None:
+    """Refuse, before any run, a store that exists and is not a history store of this schema version, or a
+    folder; a missing one is made by the first :func:`append`."""
+    if Path(store).exists() or Path(store).is_symlink():
+        with _connect(store):
+            pass
 
 
 def append(store, data: dict, commit: str, date: str | None = None, machine: str | None = None) -> None:
@@ -86,19 +100,24 @@ def append(store, data: dict, commit: str, date: str | None = None, machine: str
     ``date``: the commit's date, ISO 8601 (default: now; a commit already recorded keeps its date unless
     one is given); ``machine``: where it ran (default: the report's provenance)."""
     if not isinstance(commit, str) or not commit.strip():
-        raise GearcheckError(f"{store}: a commit id is required to record a run, got {commit!r}")
+        raise GearcheckError(f"history store {store}: a commit id is required to record a run, got {commit!r}")
     commit = commit.strip()
-    if not isinstance(data, dict) or data.get("schema") != REPORT_SCHEMA or data.get("schema_version") != 1:
-        raise GearcheckError(f"{store}: can only record a {REPORT_SCHEMA} version 1 report, got "
-                             f"{data.get('schema') if isinstance(data, dict) else type(data).__name__!r}")
+    kind = (data.get("schema"), data.get("schema_version")) if isinstance(data, dict) else type(data).__name__
+    if kind != (REPORT_SCHEMA, REPORT_SCHEMA_VERSION):
+        raise GearcheckError(f"history store {store}: records {REPORT_SCHEMA} version {REPORT_SCHEMA_VERSION} "
+                             f"reports, not {kind}")
     when = _utc(date) if date is not None else None
-    run, metrics = _record(data, machine)
-    train = data["train"]["name"]
+    try:
+        train, run, metrics = _record(data, machine)
+    except (KeyError, TypeError, AttributeError) as exc:
+        raise GearcheckError(f"history store {store}: the report cannot be recorded: missing or malformed field "
+                             f"{exc}") from None
     with _connect(store, write=True) as con:
         con.execute("BEGIN IMMEDIATE")
         try:
             if not con.execute("SELECT count(*) FROM sqlite_master").fetchone()[0]:
-                con.executescript("BEGIN;" + _TABLES)  # executescript commits first: start again
+                for statement in _TABLES.split(";")[:-1]:
+                    con.execute(statement)
                 con.executemany("INSERT INTO meta VALUES (?, ?)",
                                 [("schema", SCHEMA), ("schema_version", str(SCHEMA_VERSION))])
             _check(con, store)
@@ -117,7 +136,8 @@ def append(store, data: dict, commit: str, date: str | None = None, machine: str
                             [(commit, train, position, *row) for position, row in enumerate(metrics)])
             con.execute("COMMIT")
         except BaseException:
-            con.rollback()
+            if con.in_transaction:
+                con.execute("ROLLBACK")
             raise
 
 
@@ -127,13 +147,12 @@ def read(store) -> pd.DataFrame:
     ``tolerance``, ``status``, ``gated``."""
     with _connect(store) as con:
         frame = pd.read_sql_query(
-            "SELECT c.seq, m.commit_id AS 'commit', c.date, m.train, r.verdict, m.position, m.item, m.metric, "
-            "m.kind, m.unit, m.value, m.tolerance, m.status, m.gated "
-            "FROM metrics m JOIN runs r USING (commit_id, train) JOIN commits c USING (commit_id) "
-            "ORDER BY c.date, c.seq, m.train, m.position", con)
-    frame.insert(0, "order", _order(frame))
+            "SELECT c.place AS 'order', m.commit_id AS 'commit', c.date, m.train, r.verdict, m.position, m.item, "
+            "m.metric, m.kind, m.unit, m.value, m.tolerance, m.status, m.gated "
+            f"FROM metrics m JOIN runs r USING (commit_id, train) JOIN {_ORDERED} c USING (commit_id) "
+            "ORDER BY c.place, m.train, m.position", con)
     frame["gated"] = frame["gated"].astype(bool)
-    return frame.drop(columns="seq")
+    return frame
 
 
 def runs(store) -> pd.DataFrame:
@@ -141,18 +160,18 @@ def runs(store) -> pd.DataFrame:
     verdict, failures, unresolved and moved (lists), steady state, settings, versions and machine."""
     with _connect(store) as con:
         frame = pd.read_sql_query(
-            f"SELECT c.seq, r.commit_id AS 'commit', c.date, r.train, {', '.join('r.' + c for c in _RUN_COLUMNS)} "
-            "FROM runs r JOIN commits c USING (commit_id) ORDER BY c.date, c.seq, r.train", con)
-    frame.insert(0, "order", _order(frame))
+            f"SELECT c.place AS 'order', r.commit_id AS 'commit', c.date, r.train, "
+            f"{', '.join('r.' + c for c in _RUN_COLUMNS)} "
+            f"FROM runs r JOIN {_ORDERED} c USING (commit_id) ORDER BY c.place, r.train", con)
     for column in ("failures", "unresolved", "moved"):
         frame[column] = [json.loads(v) if v is not None else None for v in frame[column]]
-    return frame.drop(columns="seq")
+    return frame
 
 
 def commits(store) -> list[str]:
     """The recorded commits in order: by date, then by first appearance in the store."""
     with _connect(store) as con:
-        return [row[0] for row in con.execute("SELECT commit_id FROM commits ORDER BY date, seq")]
+        return [row[0] for row in con.execute(f"SELECT commit_id FROM {_ORDERED} ORDER BY place")]
 
 
 def change_points(values, tolerance: float | None = None, relative: float = 0.0, k: float = K,
@@ -160,73 +179,70 @@ def change_points(values, tolerance: float | None = None, relative: float = 0.0,
     """Indices in ``values`` (a metric over commits, oldest first; NaN or None: not recorded, skipped) where
     the metric moved beyond its noise (the rule is in the module doc): ``tolerance`` the metric's gate,
     ``relative`` the part of its level it must move by."""
-    x = np.array([np.nan if v is None else v for v in values], dtype=float)
-    where = np.flatnonzero(np.isfinite(x))
-    x = x[where]
+    where = [i for i, v in enumerate(values) if v is not None and math.isfinite(v)]
+    x = [float(values[i]) for i in where]
     fixed = max(ROUND_OFF, TOLERANCE_SHARE * tolerance if tolerance else 0.0)
-    found, start = [], 0
-    for i in range(1, x.size):
+    found, marked, start = [], set(), 0
+    for i in range(1, len(x)):
         before, after = x[max(start, i - window):i], x[i:i + confirm]
-        level, new = float(np.median(before)), float(np.median(after))
-        steps = np.abs(np.concatenate([np.diff(before), np.diff(after)]))
-        sigma = float(np.median(steps)) / _NOISE if steps.size else 0.0
+        level, new = median(before), median(after)
+        steps = [abs(x[j] - x[j - 1]) for j in range(max(1, i - NOISE_WINDOW), i) if j not in marked]
+        steps += [abs(b - a) for a, b in zip(after, after[1:])]
+        sigma = median(steps) / _NOISE * (1 + 2 / len(steps)) * math.sqrt(1 + 1 / len(before)) if steps else 0.0
         threshold = max(k * sigma, fixed, relative * abs(level))
         jump, shift = x[i] - level, new - level
         if abs(jump) > threshold and abs(shift) > threshold and jump * shift > 0:
-            found.append(int(where[i]))
+            found.append(where[i])
+            marked.add(i)
             start = i
     return found
 
 
-def floors(metric: str, unit: str | None) -> dict | None:
-    """The keywords of :func:`change_points` for a recorded metric (with its tolerance added by the caller):
-    ``relative`` for physical values, none for ratios; None for wall times, which are machine noise."""
-    if unit == "s" and metric.endswith("_s"):
+def rule(item: str, unit: str | None, tolerance: float | None) -> dict | None:
+    """The keywords of :func:`change_points` for a recorded metric: its tolerance, and ``relative`` for a
+    physical value (not a ratio); None for wall times, which are machine noise, not the code's."""
+    if item == "wall_time":
         return None
-    return {"relative": RELATIVE_FLOOR} if unit not in ("1", None) else {}
+    return {"tolerance": tolerance, "relative": 0.0 if unit in ("1", None) else RELATIVE_FLOOR}
 
 
-def _record(data: dict, machine: str | None) -> tuple[dict, list[tuple]]:
-    """The run's row and its metric rows (item, metric, kind, unit, value, tolerance, status, gated)."""
-    try:
-        prov, verdict, settings = data.get("provenance") or {}, data["verdict"], data.get("settings") or {}
-        run = {
-            "verdict": verdict["verdict"], "failures": json.dumps(verdict.get("failures") or []),
-            "unresolved": json.dumps(verdict.get("unresolved") or []),
-            "moved": None if verdict.get("moved_from_baseline") is None else json.dumps(verdict["moved_from_baseline"]),
-            "steady_state": _flag((data.get("steady_state") or {}).get("detected")),
-            "duration_s": _value(settings.get("duration")), "input_speed_rpm": _value(settings.get("input_speed")),
-            "gearcheck_version": prov.get("gearcheck_version"), "mujoco_version": prov.get("mujoco_version"),
-            "numpy_version": prov.get("numpy_version"), "python": prov.get("python"),
-            "machine": machine or prov.get("machine"), "git_revision": prov.get("git_revision"),
-            "train_sha256": prov.get("train_sha256"),
-        }
-        rows = []
-        for q in data.get("quantities") or []:
-            tol, status = _value(q.get("tolerance_nrmse")), q.get("status")
-            gated = tol is not None and status != "negligible"
-            rows.append((q["name"], "nrmse", q["kind"], "1", _value(q["errors"]["nrmse"]), tol, status, gated))
-            for solver in ("lumped", "mujoco"):
-                for stat in ("rms", "peak_to_peak"):
-                    rows.append((q["name"], f"{solver}.{stat}", q["kind"], q["unit"],
-                                 _value((q.get(solver) or {}).get(stat)), None, None, False))
-            for solver in ("lumped", "mujoco"):
-                rows.append((q["name"], f"integration_error.{solver}", q["kind"], "1",
-                             _value((q.get("integration_error") or {}).get(solver)), tol, None, False))
-        mode_tol = _value(data.get("modes_tolerance"))
-        for m in data.get("modes") or []:
-            item = f"mode {m['mode']}"
-            rows.append((item, "rel_error", m.get("type"), "1", _value(m["rel_error"]), mode_tol, m.get("status"),
-                         mode_tol is not None))
-            for solver in ("lumped", "mujoco"):
-                rows.append((item, f"{solver}.frequency", m.get("type"), "Hz", _value(m.get(solver)), None, None,
-                             False))
-        for name, value in sorted(((data.get("volatile") or {}).get("wall_time") or {}).items()):
-            rows.append(("wall_time", name, "wall_time", "s", _value(value), None, None, False))
-        data["train"]["name"]
-    except (KeyError, TypeError, AttributeError) as exc:
-        raise GearcheckError(f"cannot record the report: it lacks {exc}") from None
-    return run, rows
+def _record(data: dict, machine: str | None) -> tuple[str, dict, list[tuple]]:
+    """The train's name, the run's row and its metric rows (item, metric, kind, unit, value, tolerance, status,
+    gated); KeyError, TypeError or AttributeError where the report lacks a field or has one malformed."""
+    prov, verdict, settings = data.get("provenance") or {}, data["verdict"], data.get("settings") or {}
+    run = {
+        "verdict": verdict["verdict"], "failures": json.dumps(verdict.get("failures") or []),
+        "unresolved": json.dumps(verdict.get("unresolved") or []),
+        "moved": None if verdict.get("moved_from_baseline") is None else json.dumps(verdict["moved_from_baseline"]),
+        "steady_state": _flag((data.get("steady_state") or {}).get("detected")),
+        "duration_s": _value(settings.get("duration")), "input_speed_rpm": _value(settings.get("input_speed")),
+        "gearcheck_version": prov.get("gearcheck_version"), "mujoco_version": prov.get("mujoco_version"),
+        "numpy_version": prov.get("numpy_version"), "python": prov.get("python"),
+        "machine": machine or prov.get("machine"), "git_revision": prov.get("git_revision"),
+        "train_sha256": prov.get("train_sha256"),
+    }
+    rows = []
+    for q in data.get("quantities") or []:
+        tol, status = _value(q.get("tolerance_nrmse")), q.get("status")
+        rows.append((q["name"], "nrmse", q["kind"], "1", _value(q["errors"]["nrmse"]), tol, status,
+                     tol is not None and status != "negligible"))
+        for solver in ("lumped", "mujoco"):
+            for stat in ("rms", "peak_to_peak"):
+                rows.append((q["name"], f"{solver}.{stat}", q["kind"], q["unit"],
+                             _value((q.get(solver) or {}).get(stat)), None, None, False))
+        for solver in ("lumped", "mujoco"):
+            rows.append((q["name"], f"integration_error.{solver}", q["kind"], "1",
+                         _value((q.get("integration_error") or {}).get(solver)), tol, None, False))
+    mode_tol = _value(data.get("modes_tolerance"))
+    for m in data.get("modes") or []:
+        item = f"mode {m['mode']}"
+        rows.append((item, "rel_error", m.get("type"), "1", _value(m["rel_error"]), mode_tol, m.get("status"),
+                     mode_tol is not None))
+        for solver in ("lumped", "mujoco"):
+            rows.append((item, f"{solver}.frequency", m.get("type"), "Hz", _value(m.get(solver)), None, None, False))
+    for name, value in sorted(((data.get("volatile") or {}).get("wall_time") or {}).items()):
+        rows.append(("wall_time", name, "wall_time", "s", _value(value), None, None, False))
+    return data["train"]["name"], run, rows
 
 
 def _value(field):
@@ -255,13 +271,6 @@ def _utc(date: str | None) -> str:
     return moment.astimezone(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
-def _order(frame: pd.DataFrame) -> list[int]:
-    """Each row's commit as its place among the commits (0 = oldest)."""
-    seqs = sorted(set(zip(frame["date"], frame["seq"])))
-    place = {seq: n for n, (_, seq) in enumerate(seqs)}
-    return [place[s] for s in frame["seq"]]
-
-
 @contextlib.contextmanager
 def _connect(store, write: bool = False):
     """An open connection to ``store`` (checked to be a history store unless it is new and ``write``); every
@@ -280,7 +289,7 @@ def _connect(store, write: bool = False):
             _check(con, store)
         yield con
     except sqlite3.Error as exc:
-        raise GearcheckError(f"history store {store}: not a readable gearcheck history store ({exc})") from None
+        raise GearcheckError(f"history store {store}: cannot be {'written' if write else 'read'} ({exc})") from None
     finally:
         if con is not None:
             con.close()

@@ -7,6 +7,7 @@ pyplot, so writing a report never touches the user's matplotlib backend.
 from __future__ import annotations
 
 import io
+from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -23,13 +24,15 @@ def _styles(result) -> tuple[dict, dict]:
     return {**REFERENCE_STYLE, "label": a}, {**TEST_STYLE, "label": b}
 
 
-def _figure(rows: int = 1, cols: int = 1, figsize=(9, 5), **kwargs):
-    fig = Figure(figsize=figsize)
+def _figure(rows: int = 1, cols: int = 1, figsize=(9, 5), layout=None, **kwargs):
+    """A figure and its axes; ``layout="constrained"`` keeps a two-line title clear of tall stacks of panels."""
+    fig = Figure(figsize=figsize, layout=layout)
     return fig, fig.subplots(rows, cols, **kwargs)
 
 
 def _save(fig, path):
-    fig.tight_layout()
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
     fig.savefig(path, dpi=110, metadata={"Software": None}, format="png")
 
 
@@ -74,7 +77,7 @@ def time_histories(result, path, cycles: int = 4):
     t = result.grid
     t_end = t[-1]
     window = t >= t_end - cycles / f_cycle
-    fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
+    fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), layout="constrained", sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
         a, b = result.series[name]
         style_a, style_b = _styles(result)
@@ -89,30 +92,168 @@ def time_histories(result, path, cycles: int = 4):
     _save(fig, path)
 
 
-def spectra(result, path):
-    names = headline_quantities(result)
-    units = {q.name: q.unit for q in result.quantities}
+LOG_SPAN = 20.0  # a spectrum spanning more than this ratio of frequencies gets a logarithmic frequency axis
+MESH_HARMONICS = 3  # the spectra reach this harmonic of the fastest mesh
+GUIDE_HARMONICS = 4  # harmonics of each mesh frequency marked (the spectral lines compared: k = 1..4)
+DYNAMIC_RANGE = 1e6  # amplitudes shown below a panel's largest
+MAX_FAILING = 6  # failing quantities plotted, the worst by NRMSE over tolerance
+STAGE_COLORS = ("tab:green", "tab:purple", "tab:brown", "tab:olive", "tab:cyan", "tab:pink")  # their mesh harmonics
+
+
+@dataclass(frozen=True)
+class SpectrumRange:
+    """The frequency axis of the spectra: ``low`` to ``high`` Hz, logarithmic when ``log``; with the mesh
+    frequencies of each stage and the natural frequencies (elastic, both sides, below Nyquist) to mark."""
+
+    low: float
+    high: float
+    log: bool
+    meshes: dict[str, tuple[float, ...]]
+    naturals: tuple[float, ...]
+
+
+def spectrum_range(result) -> SpectrumRange:
+    """Up to the higher of the third harmonic of the fastest mesh and the highest elastic natural frequency
+    below Nyquist (and at most Nyquist), from zero, or logarithmic from half the lowest of those frequencies
+    when the span exceeds ``LOG_SPAN``.  Mesh frequencies are those of the compared "1x mesh" lines, by stage
+    (the first part of a quantity's name); without them (a transient) the cycle of the steady-state test."""
+    nyquist = 0.5 * result.settings["common_sample_rate_hz"]
+    meshes: dict[str, set[float]] = {}
+    for q in result.quantities:
+        for line in q.spectrum:
+            if line["line"] == "1x mesh":
+                meshes.setdefault(q.name.split(".")[0], set()).add(_distinct(line["frequency_hz"]))
+    naturals = sorted({_distinct(f) for modal in result.modal_results if modal is not None
+                       for f, kind in zip(modal.frequencies, modal.types) if kind != "rigid" and 0 < f < nyquist})
+    mesh_values = sorted(f for stage in meshes.values() for f in stage)
+    marks = mesh_values + naturals or [1.0 / result.settings["steady_cycle_s"]]
+    top = max([MESH_HARMONICS * f for f in mesh_values[-1:]] + naturals, default=2 * MESH_HARMONICS * marks[0])
+    high = min(nyquist, 1.1 * top)
+    log = high / min(marks) > LOG_SPAN
+    return SpectrumRange(0.5 * min(marks) if log else 0.0, high, log,
+                         {k: tuple(sorted(v)) for k, v in sorted(meshes.items())}, tuple(naturals))
+
+
+def _distinct(f: float) -> float:
+    """A frequency to 9 significant digits: one mark for a multiple mode or a frequency both sides share."""
+    return float(f"{f:.9g}")
+
+
+def _amplitude_spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided Hann-windowed amplitude spectrum of the fluctuation of ``x``."""
+    seg = x - np.mean(x)
+    w = np.hanning(seg.size)
+    return np.fft.rfftfreq(seg.size, 1 / fs), 2 * np.abs(np.fft.rfft(seg * w)) / np.sum(w)
+
+
+def _spectrum_panel(ax, result, name: str, rng: SpectrumRange, legend: bool) -> None:
+    """Both sides' spectra of ``name`` over the steady window on ``rng``, mesh harmonics and natural
+    frequencies marked."""
     window = result.grid >= result.steady_start_s
     fs = result.settings["common_sample_rate_hz"]
-    f_mesh = 1.0 / result.settings["steady_cycle_s"]
-    fig, axes = _figure(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True, squeeze=False)
-    for ax, name in zip(axes[:, 0], names):
-        for x, style in zip(result.series[name], _styles(result)):
-            seg = x[window] - np.mean(x[window])
-            w = np.hanning(seg.size)
-            amp = 2 * np.abs(np.fft.rfft(seg * w)) / np.sum(w)
-            freq = np.fft.rfftfreq(seg.size, 1 / fs)
-            ax.semilogy(freq, np.maximum(amp, 1e-30), **style)
-        for k in range(1, 6):
-            ax.axvline(k * f_mesh, color="gray", lw=0.5, ls=":")
-        ax.set_xlim(0, min(0.5 * fs, 6 * f_mesh))
+    peak = 0.0
+    for x, style in zip(result.series[name], _styles(result)):
+        freq, amp = _amplitude_spectrum(x[window], fs)
+        ax.plot(freq[1:], np.maximum(amp[1:], 1e-30), **style)
+        shown = (freq >= rng.low) & (freq <= rng.high)
+        peak = max(peak, float(np.max(amp[shown], initial=0.0)))
+    ax.set_yscale("log")
+    if rng.log:
+        ax.set_xscale("log")
+    for j, (stage, freqs) in enumerate(rng.meshes.items()):
+        for i, f in enumerate(freqs):
+            for k in range(1, GUIDE_HARMONICS + 1):
+                if k * f <= rng.high:
+                    label = f"{stage} mesh {f:.4g} Hz x1-{GUIDE_HARMONICS}" if legend and i == 0 and k == 1 else None
+                    ax.axvline(k * f, color=STAGE_COLORS[j % len(STAGE_COLORS)], lw=0.8, ls=":", label=label)
+    for i, f in enumerate(rng.naturals):
+        ax.axvline(f, color="tab:red", lw=0.5, ls="--", alpha=0.5,
+                   label="natural frequencies" if legend and i == 0 else None)
+    ax.set_xlim(rng.low, rng.high)
+    if peak > 0:
+        ax.set_ylim(peak / DYNAMIC_RANGE, 3 * peak)
+    ax.grid(alpha=0.3, which="both")
+
+
+def spectra_figure(result) -> Figure:
+    """The headline quantities' spectra on :func:`spectrum_range`."""
+    names = headline_quantities(result)
+    units = {q.name: q.unit for q in result.quantities}
+    rng = spectrum_range(result)
+    fig, axes = _figure(len(names), 1, figsize=(9, 2.4 * len(names) + 0.6), layout="constrained", sharex=True,
+                        squeeze=False)
+    for i, (ax, name) in enumerate(zip(axes[:, 0], names)):
+        _spectrum_panel(ax, result, name, rng, legend=i == 0)
         ax.set_ylabel(f"amplitude [{units[name]}]")
         ax.set_title(name, fontsize=9)
-        ax.grid(alpha=0.3, which="both")
-    axes[0, 0].legend(loc="upper right", fontsize=8)
-    axes[-1, 0].set_xlabel("frequency [Hz] (dotted: mesh harmonics)")
+    axes[0, 0].legend(loc="upper right", fontsize=7, ncol=2)
+    axes[-1, 0].set_xlabel(f"frequency [Hz]{' (log)' if rng.log else ''}; dotted: mesh harmonics of each stage, "
+                           "dashed: natural frequencies")
     fig.suptitle(_title(result, "amplitude spectra of the steady window (Hann)"), fontsize=9)
+    return fig
+
+
+def spectra(result, path):
+    _save(spectra_figure(result), path)
+
+
+def _worst_first(result) -> list:
+    """The failing quantities, the largest NRMSE over tolerance first (stable)."""
+    def over(q):
+        nrmse = q.metrics["nrmse"]
+        return np.inf if nrmse is None or not q.tolerance else nrmse / q.tolerance
+    return sorted((q for q in result.quantities if q.status == "fail"), key=over, reverse=True)
+
+
+def failing_figure(result, cycles: int = 4) -> Figure | None:
+    """One row per failing quantity (at most ``MAX_FAILING``, the worst first): both sides over the last
+    ``cycles`` cycles of its own mesh (the steady-state cycle without one) with their difference, and both
+    spectra on :func:`spectrum_range`; None when nothing fails."""
+    failing = _worst_first(result)
+    if not failing:
+        return None
+    shown = failing[:MAX_FAILING]
+    rng = spectrum_range(result)
+    t = result.grid
+    fig, axes = _figure(len(shown), 2, figsize=(12, 2.6 * len(shown) + 0.8), layout="constrained",
+                        squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
+    style_a, style_b = _styles(result)
+    a_name, b_name = result.solver_names
+    for i, (q, (ax_t, ax_f)) in enumerate(zip(shown, axes)):
+        mesh = next((s["frequency_hz"] for s in q.spectrum if s["line"] == "1x mesh"), None)
+        period = 1.0 / mesh if mesh else result.settings["steady_cycle_s"]
+        window = t >= max(t[-1] - cycles * period, result.steady_start_s)
+        a, b = (x[window] for x in result.series[q.name])
+        ax_t.plot(t[window] * 1e3, b - a, color="tab:red", lw=0.7, alpha=0.6, label=f"{b_name} - {a_name}")
+        ax_t.plot(t[window] * 1e3, a, **style_a)
+        ax_t.plot(t[window] * 1e3, b, **style_b)
+        ax_t.set_ylabel(f"[{q.unit}]")
+        nrmse = q.metrics["nrmse"]
+        ratio = f" ({nrmse / q.tolerance:.3g}x)" if nrmse is not None and q.tolerance else ""
+        ax_t.set_title(f"{q.name}: NRMSE {_fmt(nrmse)} > tolerance {_fmt(q.tolerance)}{ratio}", fontsize=9,
+                       loc="left")
+        ax_t.grid(alpha=0.3)
+        _spectrum_panel(ax_f, result, q.name, rng, legend=i == 0)
+        ax_f.set_title("spectrum", fontsize=9)
+    axes[0, 0].legend(loc="upper right", fontsize=7)
+    axes[0, 1].legend(loc="upper right", fontsize=6)
+    axes[-1, 0].set_xlabel(f"time [ms], last {cycles} mesh cycles")
+    axes[-1, 1].set_xlabel(f"frequency [Hz]{' (log)' if rng.log else ''}")
+    capped = (f"; the {MAX_FAILING} worst by NRMSE / tolerance shown, all {len(failing)} in the report's tables"
+              if len(failing) > MAX_FAILING else "")
+    fig.suptitle(_title(result, f"{len(failing)} failing quantities{capped}"), fontsize=9)
+    return fig
+
+
+def failing(result, path):
+    fig = failing_figure(result)
+    if fig is None:
+        return False
     _save(fig, path)
+
+
+def _fmt(x) -> str:
+    return "—" if x is None else f"{x:.3g}"
 
 
 def natural_frequencies(result, path):
@@ -143,7 +284,7 @@ def error_bars(result, path):
     fig, ax = _figure(figsize=(9, max(3.0, 0.22 * len(gated) + 1.5)))
     y = np.arange(len(gated))
     values = [max(q.metrics["nrmse"], 1e-12) for q in gated]
-    colors = ["tab:red" if q.status == "fail" else "tab:green" for q in gated]
+    colors = [{"fail": "tab:red", "unresolved": "tab:orange"}.get(q.status, "tab:green") for q in gated]
     ax.barh(y, values, color=colors)
     ax.scatter([q.tolerance or np.nan for q in gated], y, marker="|", s=200, color="black", label="tolerance")
     ax.set_yticks(y, [q.name for q in gated], fontsize=7)
@@ -155,7 +296,8 @@ def error_bars(result, path):
     _save(fig, path)
 
 
-FIGURES = {
+FIGURES = {  # failing.png only when a quantity fails
+    "failing.png": failing,
     "time_histories.png": time_histories,
     "spectra.png": spectra,
     "natural_frequencies.png": natural_frequencies,

@@ -6,9 +6,8 @@ line of the Markdown and HTML.  Everything else is identical byte for byte.
 
 JSON schema ``gearcheck.crosscheck`` version 1: every number that has a unit is an object
 ``{"value": x, "unit": "..."}``; dimensionless ratios carry unit ``"1"``.  :func:`report_schema` is that
-schema in JSON Schema (draft 2020-12); ``python -m gearcheck.compare.report DIR`` writes it and the train
-file's (:func:`gearcheck.lumped.json_schema.train_schema`) into DIR (the repository ships them in
-``schemas/``).
+schema in JSON Schema (draft 2020-12); :func:`gearcheck.compare.junit.write_schemas` writes it with the
+train file's (the repository ships them in ``schemas/``).
 
 A report is read at a glance: a verdict banner with the count of every status, failing rows first in
 every table, every spectral line flagged against its quantity's tolerance (advisory), and the measured
@@ -26,7 +25,6 @@ import math
 import platform
 import re
 import subprocess
-import sys
 from importlib import metadata
 from pathlib import Path
 
@@ -35,7 +33,7 @@ import numpy as np
 
 from gearcheck.compare.align import STEADY_THRESHOLD
 from gearcheck.compare.diagnosis import KINDS
-from gearcheck.lumped.json_schema import DRAFT, schema_text, train_schema
+from gearcheck.lumped.json_schema import DRAFT
 from gearcheck.lumped.loader import preset_text
 from gearcheck.lumped.schema import MEASUREMENT
 from gearcheck.shared.citations import cite
@@ -242,11 +240,12 @@ def banner(data) -> tuple[str, str, list[str]]:
 LINE_RULE = ("A line is flagged fail when its relative amplitude error exceeds its quantity's NRMSE tolerance. "
              "The flags are advisory and leave the verdict alone: the verdict gates the whole waveform (NRMSE), "
              "to which a line contributes at least |A_b − A_a|/(√2 RMS_a) (column 'NRMSE part'), so a large "
-             "relative error on a line that carries little of the signal does not fail its quantity.")
+             "relative error on a line that carries little of the signal does not fail its quantity. The table "
+             "lists the world-y accelerations and the forces; report.json holds every quantity's lines.")
 
 
-def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], str]]:
-    """(title, header, rows, note) of every table, failing rows first, shared by the Markdown and HTML writers."""
+def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], list[str]]]:
+    """(title, header, rows, notes) of every table, failing rows first, shared by the Markdown and HTML writers."""
     A, B = solver_names(data)
     tables = []
     if data["modes"]:  # a recording without a modes file has none
@@ -254,7 +253,7 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], str]]:
                                                "tol.", "status"],
                        [[str(m["mode"]), m["type"], str(m["multiplicity"]), f"{m['lumped']['value']:.6f}",
                          f"{m['mujoco']['value']:.6f}", f"{m['rel_error']['value']:.2e}",
-                         f"{data['modes_tolerance']['value']:.0e}", m["status"]] for m in data["modes"]], ""))
+                         f"{data['modes_tolerance']['value']:.0e}", m["status"]] for m in data["modes"]], []))
     rows = []
     for q in data["quantities"]:
         e, ie = q["errors"], q["integration_error"]
@@ -267,7 +266,7 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], str]]:
     tables.append(("Time-domain quantities (steady window)",
                    ["quantity", "unit", f"RMS {A}", f"RMS {B}", f"p-p {A}", f"p-p {B}", "rel. RMS err.",
                     "NRMSE", "correlation", "lag [µs]", f"integr. err. {A}", f"integr. err. {B}", "tol. NRMSE",
-                    "status"], rows, ""))
+                    "status"], rows, []))
     rows = []
     for q in data["quantities"]:
         if q["name"].endswith(".ay.world") or q["name"].endswith(".force"):
@@ -278,7 +277,7 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], str]]:
                              _fmt(s["nrmse_part"] and s["nrmse_part"]["value"], 2), tol, s["status"]])
     tables.append(("Spectral lines (Hann-windowed amplitude)",
                    ["quantity", "line", "f [Hz]", A, B, "rel. err.", "NRMSE part", "tol.", "status"], rows,
-                   LINE_RULE))
+                   [LINE_RULE]))
     if data["measurements"]:
         def value(x, digits=4):
             return _fmt(x and x["value"], digits)
@@ -291,7 +290,7 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], str]]:
                          value(m["published_model"]), value(m["lumped"]), value(m["mujoco"]),
                          value(m["error_published_model"], 3), value(m["error_lumped"], 3), value(m["error_mujoco"], 3),
                          m["source"]] for m in data["measurements"]],
-                       " ".join(measurement_notes(data))))
+                       measurement_notes(data)))
     return [(title, header, failing_first(rows), note) for title, header, rows, note in tables]
 
 
@@ -305,16 +304,18 @@ def measurement_notes(data) -> list[str]:
     solvers that miss."""
     A, B = solver_names(data)
     name, cal, train_file = data["train"]["name"], data["calibration"], data["provenance"]["train_file"]
+    reading = ("Each row reads both solvers through the measuring chain's band and takes the test's statistic over "
+               "the steady window.")
     if cal is None:
         where = CALIBRATED_COMPARISONS.get(name)
-        notes = [f"These rows compare the train file's own parameters ({train_file}), which are not calibrated to "
-                 "these measurements, with the test."
+        notes = [f"{reading} These rows compare the train file's own parameters ({train_file}), which are not "
+                 "calibrated to these measurements, with the test."
                  + (f" The calibrated comparison: {where}." if where else
                     f" `gearcheck calibrate {train_file.removeprefix('preset:')} --fit FIELD=LOW:HIGH` fits "
                     "chosen fields of the train file to them.")]
     else:
-        notes = [f"The train file was calibrated to measurements by `gearcheck calibrate` from {cal['from']} "
-                 f"({', '.join(cal['fitted'])})."]
+        notes = [f"{reading} The train file was calibrated to measurements by `gearcheck calibrate` from "
+                 f"{cal['from']} ({', '.join(cal['fitted'])})."]
     tolerance = {q["name"]: q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"] for q in data["quantities"]}
     for m in data["measurements"]:
         what = f"{m['quantity']} {m['metric']}"
@@ -326,9 +327,11 @@ def measurement_notes(data) -> list[str]:
             notes.append(f"{what}: {A} and {B} differ from each other by {100 * apart:.3g} % (beyond the quantity's "
                          f"tolerance of {100 * tol:g} %): read the quantity's row before the measurement.")
         elif abs(ea) > MISS and abs(eb) > MISS and ea * eb > 0:
+            published = m["error_published_model"]
             notes.append(f"{what}: both solvers miss the test by the same amount ({A} {_percent(ea)}, {B} "
                          f"{_percent(eb)}; they agree with each other to {100 * apart:.2g} %): it is the model, "
-                         "its parameters, not the solvers, that disagrees with the test.")
+                         "its parameters, not the solvers, that disagrees with the test"
+                         + (f" (the source's own model: {_percent(published['value'])})." if published else "."))
         else:
             notes.append(f"{what}: {A} {_percent(ea)}, {B} {_percent(eb)} from the measured {measured:.4g} "
                          f"{m['measured']['unit']}" + (f", within twice the default measurement uncertainty "
@@ -391,8 +394,8 @@ def write_markdown(data, path: Path, figures: list[str]) -> None:
     lines += ["", _run_line(data), ""]
     if data["notes"]:
         lines += ["## Findings", ""] + [f"{note}\n" for note in data["notes"]]
-    for title, header, rows, note in markdown_tables(data):
-        lines += [f"## {title}", ""] + ([note, ""] if note else [])
+    for title, header, rows, notes in markdown_tables(data):
+        lines += [f"## {title}", ""] + [f"{note}\n" for note in notes]
         lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         lines += ["| " + " | ".join(r) + " |" for r in rows]
         lines.append("")
@@ -430,13 +433,13 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
     parts.append(f"<p>{esc(_run_line(data))}</p>")
     if data["notes"]:
         parts.append("<h2>Findings</h2>" + "".join(f"<p>{esc(note)}</p>" for note in data["notes"]))
-    for title, header, rows, note in markdown_tables(data):
+    for title, header, rows, notes in markdown_tables(data):
         statuses = [r[-1] for r in rows if r[-1] in STATUSES]
         folded = len(rows) > OPEN_ROWS and not {"fail", "unresolved"} & set(statuses)
         tally = _counts_text({k: statuses.count(k) for k in STATUSES if k in statuses})
         parts.append(f"<details{'' if folded else ' open'}><summary>{esc(title)}"
                      + (f" — {esc(tally)}" if tally else "") + "</summary>"
-                     + (f"<p>{esc(note)}</p>" if note else "")
+                     + "".join(f"<p>{esc(note)}</p>" for note in notes)
                      + "<table><tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>")
         for r in rows:
             cls = f" class=\"{r[-1]}\"" if r[-1] in STATUSES else ""
@@ -591,22 +594,3 @@ def report_schema() -> dict:
         "additionalProperties": False,
         "$defs": {"value": _value(), "measurement": measurement, "candidate": candidate},
     }
-
-
-SCHEMA_FILES = {"report.schema.json": report_schema, "train.schema.json": train_schema}
-
-
-def write_schemas(directory) -> list[Path]:
-    """Write the JSON Schemas of report.json and of the train file into ``directory``; return their paths."""
-    out = Path(directory)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for name, make in SCHEMA_FILES.items():
-        (out / name).write_text(schema_text(make()), encoding="utf-8")
-        paths.append(out / name)
-    return paths
-
-
-if __name__ == "__main__":
-    for written in write_schemas(sys.argv[1] if len(sys.argv) > 1 else "schemas"):
-        print(written)

@@ -11,7 +11,7 @@ the parameter table of its model (:data:`gearcheck.lumped.mesh_stiffness.MODELS`
 
 What the schema cannot say, the loader still checks: the geometry, the assembly and power flow, member
 references, a list that must increase, NaN; and JSON Schema counts 3.0 as an integer where TOML does not.
-``python -m gearcheck.compare.report DIR`` writes this schema with the report's.
+``python -m gearcheck.compare.schemas DIR`` writes this schema with the report's.
 """
 
 from __future__ import annotations

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 import signal
 import sys
@@ -21,7 +22,9 @@ from pathlib import Path
 import numpy as np
 
 import gearcheck
+from gearcheck.compare import dashboard, history
 from gearcheck.compare.crosscheck import MODELS
+from gearcheck.compare.junit import write_junit
 from gearcheck.compare.progress import ProgressBar
 from gearcheck.compare.report import write_report
 from gearcheck.compare.summary import summary_row, write_summary
@@ -209,6 +212,13 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--baseline", type=str, metavar="FILE", nargs="?", const="shipped",
                    help="compare with a stored baseline (without FILE: the shipped one of the preset)")
     s.add_argument("--update-baseline", action="store_true", help="rewrite the baseline instead of checking it")
+    s.add_argument("--junit", type=Path, metavar="FILE",
+                   help="also write the verdicts as JUnit XML: a testcase per gated quantity and mode, for any CI")
+    s.add_argument("--history", type=Path, metavar="STORE",
+                   help="append each run's metrics, versions and wall times to this history store (SQLite), one "
+                        "record per commit and train (a rerun replaces it); draw it with `gearcheck dashboard`")
+    s.add_argument("--commit", metavar="SHA", help="the commit --history records (default: $GITHUB_SHA, else "
+                                                   "`git rev-parse HEAD` here)")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_crosscheck)
 
@@ -228,6 +238,13 @@ def _parser() -> argparse.ArgumentParser:
     _train_arg(s)
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)")
     s.set_defaults(func=cmd_stiffness)
+
+    s = sub.add_parser("dashboard", help="draw a history store as a static site: each metric over commits with "
+                                         "its tolerance and change points, wall times, what changed last")
+    s.add_argument("store", type=Path, metavar="STORE", help="the history store (crosscheck --history)")
+    s.add_argument("-o", "--output", type=Path, default=Path("site"), metavar="DIR",
+                   help="the site's folder (default site/); open DIR/index.html")
+    s.set_defaults(func=cmd_dashboard)
 
     s = sub.add_parser("export", help="write the reference lumped model as a file of matrices (.mat or .npz): the "
                                       "layout --model reads, with every convention of gearcheck's coordinates")
@@ -407,6 +424,37 @@ def cmd_stiffness(args) -> int:
     return 0
 
 
+def cmd_dashboard(args) -> int:
+    site = dashboard.render(args.store, args.output)
+    print(f"wrote {site / 'index.html'}")
+    return 0
+
+
+def head_commit() -> str:
+    """The commit checked out here (`git rev-parse HEAD`); --commit where there is none."""
+    import subprocess
+
+    try:
+        run = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        run = None
+    if run is None or run.returncode != 0:
+        raise GearcheckError("--history: no git commit here to record; give --commit SHA")
+    return run.stdout.strip()
+
+
+def commit_date(commit: str) -> str | None:
+    """The committer date of ``commit`` (ISO 8601), or None where git does not know it."""
+    import subprocess
+
+    try:
+        run = subprocess.run(["git", "show", "-s", "--format=%cI", commit], capture_output=True, text=True,
+                             timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return run.stdout.strip() or None if run.returncode == 0 else None
+
+
 def cmd_export(args) -> int:
     if args.output.suffix not in (".mat", ".npz"):
         raise GearcheckError(f"-o {args.output}: a model file is .mat or .npz")
@@ -460,7 +508,13 @@ def cmd_crosscheck(args) -> int:
     if args.all and args.speed is not None:
         raise GearcheckError("--speed applies to one train; --all runs each preset at its own speed")
     names = gearcheck.presets() if args.all else [args.train]
-    rows, lines = [], []
+    rows, lines, reports = [], [], []
+    if args.junit is not None:
+        check_place(args.junit, "--junit", folder=False)
+    commit = None
+    if args.history is not None:
+        history.check_store(args.history)
+        commit = args.commit or os.environ.get("GITHUB_SHA") or head_commit()
     with OutputDirectory(args.out) as place:
         for name in names:
             bar = ProgressBar(f"crosscheck {name}")
@@ -474,12 +528,19 @@ def cmd_crosscheck(args) -> int:
             data = write_report(result, place.path / name if args.all else place.path)
             lines.append(_verdict_line(result, args.out / name if args.all else args.out))
             rows.append(summary_row(data))
+            reports.append(data)
+            if args.history is not None:
+                history.append(args.history, data, commit, commit_date(commit))
         if args.all:
             write_summary(place.path, rows)
+    if args.junit is not None:
+        write_junit(reports, args.junit)
     for line in lines:
         print(line)
     if args.all:
         print(f"summary: {args.out / 'summary.md'}")
+    if args.junit is not None:
+        print(f"junit: {args.junit}")
     return exit_status([r["status"] for r in rows])
 
 

@@ -545,6 +545,7 @@ def cmd_crosscheck(args) -> int:
 
 
 EXIT_STATUS = {"PASS": 0, "FAIL": 1, "INCONCLUSIVE": 3}
+MOVED_SHOWN = 3  # baseline moves named on the verdict line (the report lists them all)
 
 
 def exit_status(verdicts) -> int:
@@ -558,7 +559,9 @@ def _verdict_line(result, out: Path) -> str:
     if result.failures:
         detail += f"; beyond tolerance: {', '.join(result.failures)}"
     if result.moved:
-        detail += f"; moved from baseline: {'; '.join(result.moved)}"
+        shown = "; ".join(result.moved[:MOVED_SHOWN])
+        more = f"; and {len(result.moved) - MOVED_SHOWN} more" if len(result.moved) > MOVED_SHOWN else ""
+        detail += f"; moved from baseline ({len(result.moved)}): {shown}{more}"
     if result.verdict == "INCONCLUSIVE":
         detail += f"; cannot decide: {', '.join(result.unresolved)}"
     return f"{result.spec.name}: {result.verdict}{detail} (report: {out / 'report.md'})"

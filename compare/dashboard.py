@@ -187,7 +187,7 @@ def _index(store_name: str, order: list[str], presets: list[Preset]) -> str:
         last = p.runs.iloc[-1]
         body.append(f"<tr><td><a href=\"{_e(p.page)}\">{_e(p.name)}</a></td><td>{_badge(last['verdict'])}</td>"
                     f"<td><code>{_e(last['commit'][:SHORT])}</code></td><td class=\"nowrap\">{_e(last['date'])}</td>"
-                    f"<td>{_list(last['failures'])}</td><td>{_list(last['unresolved'])}</td>"
+                    f"<td>{_failures(last)}</td><td>{_list(last['unresolved'])}</td>"
                     f"<td>{_strip(p.runs)}</td></tr>")
     body.append("</table><h2>Since the previous commit</h2>"
                 "<p class=\"muted\">Each preset's latest run against its previous one: a metric moved when it "
@@ -318,7 +318,7 @@ def _preset_page(p: Preset) -> str:
                 "</tr>")
     for _, run in p.runs.iloc[::-1].iloc[:RUNS_SHOWN].iterrows():
         body.append(f"<tr><td><code>{_e(run['commit'][:SHORT])}</code></td><td class=\"nowrap\">{_e(run['date'])}</td>"
-                    f"<td>{_badge(run['verdict'])}</td><td>{_list(run['failures'])}</td>"
+                    f"<td>{_badge(run['verdict'])}</td><td>{_failures(run)}</td>"
                     f"<td>{_list(run['unresolved'])}</td><td>{_e(run['machine'] or '')}</td>"
                     f"<td>{_e(run['gearcheck_version'] or '')}</td><td>{_e(run['mujoco_version'] or '')}</td>"
                     f"<td>{_e(run['numpy_version'] or '')}</td><td><code>{_e((run['train_sha256'] or '')[:12])}</code>"
@@ -518,6 +518,15 @@ def _color(verdict: str) -> str:
 
 def _list(items) -> str:
     return ", ".join(_e(str(i)) for i in items) if items else ""
+
+
+def _failures(run) -> str:
+    """A run's failures, and how many baseline metrics moved (a FAIL of its own)."""
+    moved = run["moved"] or []
+    parts = [_list(run["failures"])] if run["failures"] else []
+    if moved:
+        parts.append(f"baseline moved ({len(moved)} metrics)")
+    return "; ".join(parts)
 
 
 def _rel(change: dict) -> float:

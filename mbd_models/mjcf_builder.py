@@ -30,6 +30,11 @@ is the mesh deflection.  The coefficients are not written from a formula here: t
 taken by :func:`gearcheck.mbd_models.twin.compile_train` from MuJoCo's own Jacobians.  A backlash
 b = backlash/2 is the two-valued spring length "-b b" (a dead band).
 
+Visuals (:mod:`gearcheck.mbd_models.gear_visuals`): every gear is an involute mesh asset (identical planets
+share one), placed at its mesh phase, coloured by member, with a small marker box per body and a ``front``
+camera; all visual geoms are contact-free and, with ``inertiafromgeom="false"`` and explicit inertials,
+massless.  ``VISUALS = False`` writes the bodies bare (the same dynamics, to the last bit).
+
 Every number is written with full precision (the shortest repr that round-trips), angles in
 radian, so the text is deterministic and lossless.
 """
@@ -39,14 +44,18 @@ from __future__ import annotations
 import math
 
 from gearcheck.lumped.spec import TrainSpec
+from gearcheck.mbd_models import gear_visuals
 
 STAGE_SPACING = 0.12  # m along z between stages (visual only: stages do not touch)
 RGBA = {
     "sun": "0.95 0.6 0.1 1",
-    "ring": "0.6 0.6 0.65 0.35",
-    "carrier": "0.2 0.4 0.85 0.6",
+    "ring": "0.62 0.62 0.68 1",
+    "carrier": "0.2 0.4 0.85 1",
     "planet": "0.2 0.75 0.3 1",
 }
+MARKER_RGBA = "0.1 0.1 0.1 1"
+VISUALS = True  # gear meshes, markers and camera; off, the bodies carry no geoms (same dynamics)
+VISUAL = 'contype="0" conaffinity="0" group="1"'  # visual geoms: no contact (no mass: explicit inertials)
 CENTRAL_AXES = ("x", "y")
 PLANET_AXES = ("radial", "tangential")
 AXIAL = "z"
@@ -87,23 +96,65 @@ def _inertial(member) -> str:
             f'diaginertia="{vec(0.5 * polar, 0.5 * polar, polar)}"/>')
 
 
-def _visual_radius(spec: TrainSpec, member) -> float:
+def _gear_z(spec: TrainSpec) -> dict[tuple[str, str], float]:
+    """Axial offset (m, in the body) of every gear: a compound planet's gears side by side, each central gear
+    at the offset of the planet gear it meshes with."""
+    z = {}
+    for mid, member in spec.members.items():
+        if member.is_planet:
+            step = 1.5 * max(g.face_width for g in member.gears.values())
+            for i, name in enumerate(member.gears):
+                z[mid, name] = (i - 0.5 * (len(member.gears) - 1)) * step
+    for mesh in spec.meshes:
+        planet = spec.members[mesh.planet]
+        name = next(n for n, g in planet.gears.items() if g == mesh.planet_gear)
+        central = next(n for n, g in spec.members[mesh.central].gears.items() if g == mesh.central_gear)
+        z.setdefault((mesh.central, central), z[mesh.planet, name])
+    return z
+
+
+def _geoms(spec: TrainSpec, member, phase: dict, z: dict, meshes: dict) -> list[str]:
+    """The member's visual geoms: its gear meshes (or the carrier's plate) and a marker showing its rotation."""
+    rgba = RGBA[member.kind]
     if member.kind == "carrier":
-        return spec.stage_of(member.id).carrier_radius
-    return max(g.pitch_radius for g in member.gears.values())
+        stage = spec.stage_of(member.id)
+        back = min((z[p, n] - 0.5 * g.face_width for p in stage.planets for n, g in spec.members[p].gears.items()),
+                   default=0.0)
+        tip = max((g.tip_radius for p in stage.planets for g in spec.members[p].gears.values()), default=0.01)
+        h = max(0.25 * tip, 0.002)
+        zc = back - 2 * h
+        module = max((g.module for p in stage.planets for g in spec.members[p].gears.values()), default=0.005)
+        size, marker = vec(stage.carrier_radius + tip, h), (0.5 * stage.carrier_radius, zc + h)
+        return [f'<geom name="{member.label}_visual" type="cylinder" size="{size}" pos="{vec(0, 0, zc)}" '
+                f'rgba="{rgba}" {VISUAL}/>', _marker(member, *marker, 2 * module)]
+    lines = []
+    for name, gear in member.gears.items():
+        key = (member.id, name)
+        lines.append(f'<geom name="{member.label}_{name}_visual" type="mesh" mesh="{meshes[gear]}" '
+                     f'pos="{vec(0, 0, z[key])}" euler="{vec(0, 0, phase[key])}" rgba="{rgba}" {VISUAL}/>')
+    name, gear = next(iter(member.gears.items()))
+    r = gear.tip_radius + gear.module if gear.internal else 0.5 * gear.root_radius
+    return lines + [_marker(member, r, z[member.id, name] + 0.5 * gear.face_width, 0.8 * gear.module)]
 
 
-def _visual_halfwidth(member) -> float:
-    if member.gears:
-        return 0.5 * max(g.face_width for g in member.gears.values())
-    return 0.005
+def _marker(member, r: float, z: float, size: float) -> str:
+    """A small box on the member's +x axis (body frame): it turns with the body."""
+    return (f'<geom name="{member.label}_marker" type="box" size="{vec(size, size, size)}" pos="{vec(r, 0, z)}" '
+            f'rgba="{MARKER_RGBA}" {VISUAL}/>')
 
 
-def _geom(spec: TrainSpec, member, z: float = 0.0) -> str:
-    r = _visual_radius(spec, member)
-    h = _visual_halfwidth(member) if member.kind != "carrier" else 0.005
-    return (f'<geom name="{member.label}_visual" type="cylinder" size="{vec(r, h)}" pos="{vec(0, 0, z)}" '
-            f'rgba="{RGBA[member.kind]}" contype="0" conaffinity="0" group="1"/>')
+def mesh_names(spec: TrainSpec) -> dict:
+    """The visual mesh asset of every distinct gear (identical planets share one), named after its first member."""
+    names = {}
+    for member in spec.members.values():
+        for name, gear in member.gears.items():
+            names.setdefault(gear, f"{member.label}_{name}")
+    return names
+
+
+def _assets(spec: TrainSpec) -> list[str]:
+    return ["  <asset>"] + [f"    {gear_visuals.mesh_asset(name, gear)}" for gear, name in mesh_names(spec).items()] + [
+        "  </asset>"]
 
 
 def _joints(spec, member, support, joints, indent: str) -> list[str]:
@@ -113,21 +164,19 @@ def _joints(spec, member, support, joints, indent: str) -> list[str]:
     return [f"{indent}  {_joint(f'{member.label}_{name}', kind, axis, k, c)}" for name, kind, axis, k, c in joints]
 
 
-def _central_body(spec, member, z_stage: float, indent: str, children: list[str]) -> list[str]:
+def _central_body(spec, member, z_stage: float, indent: str, visuals: list[str], children: list[str]) -> list[str]:
     s = member.support
     lines = [f'{indent}<body name="{member.label}" pos="{vec(0, 0, z_stage)}">', f"{indent}  {_inertial(member)}"]
     lines += _joints(spec, member, s, [("x", "slide", (1, 0, 0), s.radial_stiffness, s.radial_damping),
                                        ("y", "slide", (0, 1, 0), s.radial_stiffness, s.radial_damping),
                                        ("rz", "hinge", (0, 0, 1), s.torsional_stiffness, s.torsional_damping)], indent)
-    z_geom = -2.0 * max((_visual_halfwidth(spec.members[p]) for p in spec.stage_of(member.id).planets),
-                        default=0.01) if member.kind == "carrier" else 0.0
-    lines.append(f"{indent}  {_geom(spec, member, z_geom)}")
+    lines += [f"{indent}  {g}" for g in visuals]
     lines += children
     lines.append(f"{indent}</body>")
     return lines
 
 
-def _planet_body(spec, member, indent: str) -> list[str]:
+def _planet_body(spec, member, indent: str, visuals: list[str]) -> list[str]:
     b = member.bearing
     c, s = math.cos(member.angle), math.sin(member.angle)
     lines = [f'{indent}<body name="{member.label}" pos="{vec(member.radius * c, member.radius * s, 0)}">',
@@ -135,21 +184,36 @@ def _planet_body(spec, member, indent: str) -> list[str]:
     lines += _joints(spec, member, b, [("radial", "slide", (c, s, 0), b.radial_stiffness, b.radial_damping),
                                        ("tangential", "slide", (-s, c, 0), b.radial_stiffness, b.radial_damping),
                                        ("rz", "hinge", (0, 0, 1), 0.0, 0.0)], indent)
-    return lines + [f"{indent}  {_geom(spec, member)}", f"{indent}</body>"]
+    return lines + [f"{indent}  {g}" for g in visuals] + [f"{indent}</body>"]
 
 
-def _worldbody(spec: TrainSpec) -> list[str]:
+def _camera(spec: TrainSpec) -> str:
+    """A camera on the axis, in front of the first stage, framing the largest gear (narrow: little perspective)."""
+    reach = max((g.root_radius + gear_visuals.RIM * g.normal_module if g.internal else g.tip_radius
+                 for m in spec.members.values() for g in m.gears.values()), default=0.1)
+    return f'<camera name="front" pos="{vec(0, 0, 6.5 * reach)}" fovy="20"/>'
+
+
+def _worldbody(spec: TrainSpec, visuals: bool) -> list[str]:
     lines = ["  <worldbody>"]
+    phase, z, meshes = (gear_visuals.phases(spec), _gear_z(spec), mesh_names(spec)) if visuals else ({}, {}, {})
+
+    def geoms(member) -> list[str]:
+        return _geoms(spec, member, phase, z, meshes) if visuals else []
+
+    if visuals:
+        lines.append(f"    {_camera(spec)}")
     for i, stage in enumerate(spec.stages):
-        z = -STAGE_SPACING * i
+        zs = -STAGE_SPACING * i
         lines.append(f"    <!-- {stage.name}: carrier radius {num(stage.carrier_radius)} m, "
                      f"{len(stage.planets)} planets -->")
         for mid in stage.centrals:
-            lines += _central_body(spec, spec.members[mid], z, "    ", [])
+            lines += _central_body(spec, spec.members[mid], zs, "    ", geoms(spec.members[mid]), [])
         planets = []
         for pid in stage.planets:
-            planets += _planet_body(spec, spec.members[pid], "      ")
-        lines += _central_body(spec, spec.members[stage.carrier], z, "    ", planets)
+            planets += _planet_body(spec, spec.members[pid], "      ", geoms(spec.members[pid]))
+        carrier = spec.members[stage.carrier]
+        lines += _central_body(spec, carrier, zs, "    ", geoms(carrier), planets)
     lines.append("  </worldbody>")
     return lines
 
@@ -254,13 +318,14 @@ def _sensors(spec: TrainSpec) -> list[str]:
 
 
 def document(spec: TrainSpec, tendons: list[str], timestep: float, header: list[str]) -> str:
-    """The whole MJCF text: ``header`` comment, compiler and option, bodies, ``tendons``, actuators, sensors."""
+    """The whole MJCF text: ``header`` comment, compiler, option and headlight, the gears' visual meshes (when ``VISUALS``),
+    bodies, ``tendons``, actuators, sensors."""
     lines = ["<!--"] + [f"  {h}" for h in header] + ["-->", f'<mujoco model="{spec.name}">',
              '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
              f'  <option timestep="{num(timestep)}" integrator="RK4" gravity="0 0 0">',
              '    <flag contact="disable"/>', "  </option>",
-             '  <visual><map znear="0.001"/></visual>']
-    lines += _worldbody(spec)
+             '  <visual><map znear="0.001"/><headlight ambient="0.4 0.4 0.4" diffuse="0.6 0.6 0.6"/></visual>']
+    lines += (_assets(spec) if VISUALS else []) + _worldbody(spec, VISUALS)
     if tendons:
         lines += ["  <tendon>"] + tendons + ["  </tendon>"]
     lines += _actuators(spec) + _sensors(spec) + ["</mujoco>"]

@@ -19,9 +19,15 @@ Packages: :mod:`gearcheck.lumped` (train description and reference solver),
 :mod:`gearcheck.shared` (what both solvers share).
 """
 
+import os
 from importlib import metadata
 
-from gearcheck.api import (
+# MuJoCo picks its OpenGL platform when it is imported: without a display, offscreen rendering (animations)
+# goes through EGL unless the user chose otherwise
+if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    os.environ["MUJOCO_GL"] = "egl"
+
+from gearcheck.api import (  # noqa: E402
                            SOLVERS,
                            campbell,
                            crosscheck,

@@ -239,6 +239,27 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)")
     s.set_defaults(func=cmd_stiffness)
 
+    s = sub.add_parser("animate", help="render the MuJoCo twin running (or a mode shape) offscreen as a GIF or MP4, "
+                                       "vibration magnified, with time and mesh-force overlays")
+    _train_arg(s)
+    s.add_argument("-o", "--output", type=Path, required=True, metavar="FILE", help="the .gif (or .mp4, with ffmpeg)")
+    s.add_argument("--duration", type=SECONDS, default=4.0, metavar="S", help="playback length (default 4 s)")
+    s.add_argument("--fps", type=float, default=15.0, metavar="N", help="frames per second (default 15)")
+    s.add_argument("--slow-motion", type=float, default=100.0, metavar="X",
+                   help="playback time per simulated time (default 100: 4 s show 40 ms)")
+    s.add_argument("--magnify", type=float, default=1000.0, metavar="X",
+                   help="vibration displacements (from the rigid-body motion) times X (default 1000)")
+    s.add_argument("--mode", type=int, metavar="K", help="animate mode shape K (1-based) instead of the running train")
+    s.add_argument("--solver", choices=("mujoco", "lumped"), default="mujoco", help="whose mode shape (--mode)")
+    s.add_argument("--size", type=int, nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (480 360)")
+    s.set_defaults(func=cmd_animate)
+
+    s = sub.add_parser("view", help="the MuJoCo viewer with the twin running live (needs a display)")
+    _train_arg(s)
+    s.add_argument("--slow-motion", type=float, default=100.0, metavar="X", help="wall time per simulated time")
+    s.add_argument("--magnify", type=float, default=1000.0, metavar="X", help="vibration displacements times X")
+    s.set_defaults(func=cmd_view)
+
     s = sub.add_parser("dashboard", help="draw a history store as a static site: each metric over commits with "
                                          "its tolerance and change points, wall times, what changed last")
     s.add_argument("store", type=Path, metavar="STORE", help="the history store (crosscheck --history)")
@@ -421,6 +442,39 @@ def cmd_stiffness(args) -> int:
     check_place(path, "-o", folder=False)
     write_file(path, mesh_stiffness(spec))
     print(f"wrote {path}")
+    return 0
+
+
+def cmd_animate(args) -> int:
+    from gearcheck.mbd_models.animate import animate, animate_mode, check_output
+
+    for name in ("fps", "slow_motion", "magnify"):
+        value = getattr(args, name)
+        if not (math.isfinite(value) and value > 0):
+            raise GearcheckError(f"--{name.replace('_', '-')} {value:g}: needs a positive number")
+    if min(args.size) < 16 or max(args.size) > 4096:
+        raise GearcheckError(f"--size {args.size[0]} {args.size[1]}: between 16 and 4096 pixels")
+    check_output(args.output)
+    check_place(args.output, "-o", folder=False)
+    spec = gearcheck.load(args.train)
+    bar = ProgressBar(f"animate {spec.name}")
+    width, height = args.size
+    if args.mode is None:
+        animate(spec, args.output, duration=args.duration, fps=args.fps, magnify=args.magnify,
+                slow_motion=args.slow_motion, width=width, height=height, progress=bar)
+    else:
+        modal = gearcheck.modes(spec, "lumped") if args.solver == "lumped" else None
+        animate_mode(spec, args.output, args.mode, solver=args.solver, modal=modal, duration=args.duration,
+                     fps=args.fps, width=width, height=height, progress=bar)
+    bar.close()
+    print(f"wrote {args.output}")
+    return 0
+
+
+def cmd_view(args) -> int:
+    from gearcheck.mbd_models.live_view import live_view
+
+    live_view(gearcheck.load(args.train), slow_motion=args.slow_motion, magnify=args.magnify)
     return 0
 
 

@@ -142,16 +142,6 @@ def modal_assurance(M: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return cross / np.outer(norm_a, norm_b)
 
 
-def paired_assurance(mac: np.ndarray, groups: list[list[int]]) -> np.ndarray:
-    """Per mode i of A, the share of its shape in the span of B's modes of the same frequency group (B's
-    shapes M-orthogonal): sum of MAC_ij over j in i's group.  A multiple frequency's shapes are any basis
-    of their space, so only this sum is defined; 1 means the pair spans the same modes."""
-    out = np.zeros(mac.shape[0])
-    for g in groups:
-        out[g] = mac[np.ix_(g, g)].sum(axis=1)
-    return out
-
-
 def _same(a: float, b: float) -> bool:
     return abs(a - b) <= DEGENERACY_TOLERANCE * max(abs(a), abs(b)) or (a == 0.0 and b == 0.0)
 

@@ -36,7 +36,9 @@ def complete(out: Path) -> bool:
 
 def interrupted_run(out: Path, signum: int, delay: float) -> int:
     """Start a cross-check into ``out``, signal it ``delay`` s after its partial folder appears."""
-    run = subprocess.Popen(COMMAND + [str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    # a shell's background job (CI started with &) ignores SIGINT, and a child inherits that: give it the default
+    run = subprocess.Popen(COMMAND + [str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                           preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while run.poll() is None and not list(out.parent.glob(f".{out.name}.*.partial")):
         assert time.monotonic() < deadline

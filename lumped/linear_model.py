@@ -54,38 +54,43 @@ class Periodic:
     def mean(self) -> np.ndarray:
         return self.samples.mean(axis=0) if self.samples is not None else self.mean_value
 
-    def __call__(self, t: float) -> np.ndarray:
+    def __call__(self, t) -> np.ndarray:
+        """The value at time ``t`` (s), or at each of an array of times (along the leading axes)."""
+        t = np.asarray(t, dtype=float)
         if self.samples is not None:
             n = len(self.samples)
             x = (t / self.period % 1.0) * n
-            i = int(x) % n
+            i = np.floor(x).astype(int) % n
             if self.interpolation == "hold":
                 return self.samples[i]
-            w = x - math.floor(x)
+            w = (x - np.floor(x))[(...,) + (None,) * (self.samples.ndim - 1)]
             return (1.0 - w) * self.samples[i] + w * self.samples[(i + 1) % n]
-        phase = 2.0 * math.pi * np.asarray(self.orders) * t / self.period
+        phase = 2.0 * math.pi * np.multiply.outer(t, np.asarray(self.orders)) / self.period
         return self.mean_value + np.tensordot(np.cos(phase), self.cos, 1) + np.tensordot(np.sin(phase), self.sin, 1)
 
     def over_period(self, points: int = 64) -> np.ndarray:
         """Values over one period: the samples themselves, or the series at ``points`` phases."""
         if self.samples is not None:
             return self.samples
-        return np.array([self(i * self.period / points) for i in range(points)])
+        return self(np.arange(points) * self.period / points)
 
 
 @dataclass(frozen=True)
 class Mesh:
     """A mesh of the model: deflection ``row`` . q along the line of action (m), stiffness k(t) (N/m, a
     :class:`Periodic` of scalars or a constant) and damping (N s/m).  ``id`` is the train's mesh id
-    (``stage1.sun-planet1``): the model then reports that mesh's force and transmission error."""
+    (``stage1.planet1.sun``): the model then reports that mesh's force and transmission error."""
 
     id: str
     row: np.ndarray
     stiffness: Periodic | float
     damping: float = 0.0
 
-    def k(self, t: float) -> float:
-        return float(self.stiffness(t)) if isinstance(self.stiffness, Periodic) else float(self.stiffness)
+    def k(self, t) -> np.ndarray:
+        """The stiffness at time ``t`` (s), or at each of an array of times."""
+        if isinstance(self.stiffness, Periodic):
+            return self.stiffness(t)
+        return np.full(np.shape(t), float(self.stiffness))
 
     @property
     def k_mean(self) -> float:

@@ -81,7 +81,7 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
     A = model.mesh_rows
     t = np.arange(steps + 1) * dt
     stage_t = t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt  # where every fixed-step solver samples its drive
-    k_mesh = np.array([[[m.k(s) for m in model.meshes] for s in row] for row in stage_t]).reshape(steps + 1, 3, -1)
+    k_mesh = np.moveaxis(np.reshape([m.k(stage_t) for m in model.meshes], (len(model.meshes), *stage_t.shape)), 0, -1)
 
     def acceleration(ti, s, q, v, k):
         stiffness_force = (model.K_at(ti) + K_omega) @ q + A.T @ (k * (A @ q))
@@ -160,7 +160,7 @@ def _train_signals(model, train, t, q, v, qdd):
     static = {}
     for m in model.meshes:
         row = np.asarray(m.row, dtype=float)
-        k = np.array([m.k(s) for s in t])
+        k = m.k(t)
         delta = q @ row
         force = k * delta + m.damping * (v @ row)
         static_force = m.k_mean * float(row @ q0)

@@ -18,7 +18,7 @@ K_samples              N x n x n (.npz),       K(t) at t = i period / N (mean mu
 K_cos, K_sin, orders   H x n x n, H            K(t) = K + sum K_cos cos(2 pi o t / period) + K_sin sin(..)
                        (.mat: n x n x H)
 F_samples              N x n (.mat: n x N)     F(t) over the period (mean must be F)
-mesh_ids               m strings               the train's mesh ids (``stage1.sun-planet1``)
+mesh_ids               m strings               the train's mesh ids (``stage1.planet1.sun``)
 mesh_rows              m x n                   each mesh's deflection row
 mesh_stiffness         m, or m x N             N/m: constant, or samples over the period
 mesh_period            m (optional)            s, each mesh's own cycle (default: period)

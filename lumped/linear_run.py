@@ -87,7 +87,8 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
         stiffness_force = (model.K_at(ti) + K_omega) @ q + A.T @ (k * (A @ q))
         return M_inv @ (model.F_at(ti) - D @ v - stiffness_force)
 
-    q, v = _start(model)
+    q0, v = _start(model)
+    q = q0
     n_out = steps // every + 1
     Q, V, Qdd = (np.empty((n_out, model.n)) for _ in range(3))
     for i in range(steps + 1):
@@ -108,7 +109,7 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
         progress(1.0)
     info = {"method": f"{model.name}, rk4", "dt_s": dt, "steps": steps,
             "wall_time_s": time.perf_counter() - started}
-    return linear_result(model, train, t[::every], Q, V, Qdd, info)
+    return linear_result(model, train, t[::every], Q, V, Qdd, q0, info)
 
 
 def _start(model) -> tuple[np.ndarray, np.ndarray]:
@@ -122,8 +123,9 @@ def _start(model) -> tuple[np.ndarray, np.ndarray]:
     return q, zero
 
 
-def linear_result(model, train, t, q, v, qdd, info) -> TimeResult:
-    """The named signals of a run (see the module docstring)."""
+def linear_result(model, train, t, q, v, qdd, q0, info) -> TimeResult:
+    """The named signals of a run (see the module docstring); ``q0`` its starting state, whose mesh forces are
+    the static ones the load factor divides by."""
     mapped = train is not None and bool(model.physical_map())
     signals, columns = coordinate_signals(model.coordinates, model.descriptions, model.name,
                                           compared=not mapped), []
@@ -131,12 +133,12 @@ def linear_result(model, train, t, q, v, qdd, info) -> TimeResult:
         columns += [qdd[:, j], q[:, j]]
     static = {}
     if mapped:
-        named, values, static = _train_signals(model, train, t, q, v, qdd)
+        named, values, static = _train_signals(model, train, t, q, v, qdd, q0)
         signals, columns = signals + named, columns + values
     return TimeResult(model.name, model.name, np.asarray(t), signals, np.column_stack(columns), 0.0, info, static=static)
 
 
-def _train_signals(model, train, t, q, v, qdd):
+def _train_signals(model, train, t, q, v, qdd, q0):
     """The train's signals the model has: a member's angular acceleration when its rotation is one of the
     model's coordinates, its translational accelerations when both its translations are, and its meshes'."""
     labels = train.dofs.labels()
@@ -156,7 +158,6 @@ def _train_signals(model, train, t, q, v, qdd):
         if has[th]:
             signals.append(by_name[f"{mid}.alpha"])
             columns.append(acc[:, j, 2])
-    q0, _ = _start(model)
     static = {}
     for m in model.meshes:
         row = np.asarray(m.row, dtype=float)
@@ -178,5 +179,5 @@ def unmapped(model, train) -> list[str]:
 
 def _names(model, train) -> list[str]:
     one = np.zeros((1, model.n))
-    return [s.name for s in _train_signals(model, train, np.zeros(1), one, one, one)[0]]
+    return [s.name for s in _train_signals(model, train, np.zeros(1), one, one, one, one[0])[0]]
 

@@ -46,7 +46,8 @@ PUBLISHED_DURATION = 0.02  # s, of the 4-DOF models' start-stop transient
 
 
 def crosscheck(train, *, speed: float | None = None, duration: float | None = None, model="general",
-               against: str = "lumped", results=None, columns=None, modes=None, dt_lumped: float | None = None, dt_mujoco: float | None = None, tolerances=None, measurements=None,
+               against: str = "lumped", results=None, columns=None, modes=None, dt_lumped: float | None = None,
+               dt_mujoco: float | None = None, tolerances=None, measurements=None,
                sensor_band: tuple[float, float] | None = None, baseline=None, update_baseline: bool = False,
                progress=None) -> CrosscheckResult:
     """Cross-check a train's lumped model against its MuJoCo twin.
@@ -114,7 +115,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         user = None
     elif isinstance(model, str) and ":" not in model and Path(model).suffix not in SUFFIXES:
         if Path(model).suffix:
-            raise GearcheckError(f"--model {model}: a model file is {' or '.join(SUFFIXES)}, not {Path(model).suffix!r}")
+            raise GearcheckError(f"--model {model}: a model file is {' or '.join(SUFFIXES)}, "
+                                 f"not {Path(model).suffix!r}")
         raise GearcheckError(f"unknown model {model!r}: choose one of {', '.join(MODELS)}, or give your own: a model "
                              f"file ({' or '.join(SUFFIXES)}), module:factory or file.py:factory")
     else:

@@ -42,7 +42,8 @@ def reference_linear_model(spec, samples: int = SAMPLES) -> LinearModel:
         cells = (np.arange(samples)[:, None] + (np.arange(SUB_SAMPLES) + 0.5) / SUB_SAMPLES) * period / samples
         k = exc.stiffness(cells)[..., j].mean(axis=1)
         k += exc.mean_stiffness[j] - k.mean()
-        meshes.append(Mesh(mesh.id, model.mesh_rows[j], Periodic(period, samples=k, interpolation="hold"), float(model.mesh_damping[j])))
+        meshes.append(Mesh(mesh.id, model.mesh_rows[j], Periodic(period, samples=k, interpolation="hold"),
+                           float(model.mesh_damping[j])))
     constant = not (exc.has_transmission_error or exc.ripple or spec.operating.ramp > 0
                     or spec.operating.torque_function or spec.operating.torque_profile is not None)
 

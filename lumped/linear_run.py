@@ -135,7 +135,8 @@ def linear_result(model, train, t, q, v, qdd, q0, info) -> TimeResult:
     if mapped:
         named, values, static = _train_signals(model, train, t, q, v, qdd, q0)
         signals, columns = signals + named, columns + values
-    return TimeResult(model.name, model.name, np.asarray(t), signals, np.column_stack(columns), 0.0, info, static=static)
+    return TimeResult(model.name, model.name, np.asarray(t), signals, np.column_stack(columns), 0.0, info,
+                      static=static)
 
 
 def _train_signals(model, train, t, q, v, qdd, q0):

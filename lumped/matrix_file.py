@@ -44,8 +44,8 @@ from gearcheck.shared.errors import TrainFileError
 
 SUFFIXES = (".mat", ".npz")
 KNOWN = {"coordinates", "M", "K", "C", "G", "K_omega", "F", "period", "K_samples", "K_cos", "K_sin", "orders",
-         "F_samples", "mesh_ids", "mesh_rows", "mesh_stiffness", "mesh_period", "mesh_damping", "physical_labels", "physical",
-         "name", "start", "units"}
+         "F_samples", "mesh_ids", "mesh_rows", "mesh_stiffness", "mesh_period", "mesh_damping", "physical_labels",
+         "physical", "name", "start", "units"}
 
 
 def read_matrix_file(path) -> LinearModel:

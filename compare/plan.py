@@ -51,10 +51,11 @@ class TrainPlan:
 
     def steady_groups(self, names) -> list[tuple[list[str], float]]:
         """The mesh-force signals among ``names`` with the cycle over which they repeat in steady state: all
-        of them over the train's common mesh period when its mesh frequencies are in small-integer ratios
-        (:func:`common_period`), else each stage's over its own slowest mesh cycle."""
+        of them over the common period of their meshes when its mesh frequencies are in small-integer ratios
+        (:func:`common_period`), else each stage's over its own slowest mesh cycle (an RV reducer's pin pass has
+        no mesh-force signal: its frequency does not set the cycle)."""
         forces = [n for n in names if n.endswith(".force") and n.rsplit(".", 1)[0] in self.mesh_frequency]
-        period = common_period(self.mesh_frequency.values())
+        period = common_period([self.mesh_frequency[n.rsplit(".", 1)[0]] for n in forces])
         if period is not None:
             return [(forces, period)]
         groups = []
@@ -94,7 +95,7 @@ class TrainPlan:
     def scale_from(self, name: str) -> list[tuple[str, float]]:
         """An angular acceleration alpha of a central member sets the translational scale r alpha."""
         member = name.rsplit(".", 1)[0]
-        if name.endswith(".alpha") and not self.spec.members[member].is_planet:
+        if name.endswith(".alpha") and not self.spec.members[member].orbits:
             return [("acceleration", central_radius(self.spec, member))]
         return []
 
@@ -142,10 +143,14 @@ def common_period(frequencies) -> float | None:
 
 
 def central_radius(spec, member: str) -> float:
-    """Pitch radius of a central gear, carrier radius of a carrier."""
+    """Pitch radius of a central gear, carrier radius of a carrier, an RV reducer's rolling-circle radius of
+    a cycloid disc and pin-circle radius of a pin wheel."""
     m = spec.members[member]
     if m.kind == "carrier":
         return spec.stage_of(member).carrier_radius
+    if m.kind in ("disc", "pin_wheel"):
+        g = spec.stage_of(member).cycloid.geometry
+        return g.rolling_radius if m.kind == "disc" else g.pin_circle_radius
     return next(iter(m.gears.values())).pitch_radius
 
 
@@ -155,6 +160,6 @@ def round_off_floor(spec, kin, omega_max: float, duration: float) -> dict[str, f
     stiffest mode, is an acceleration of omega_max^2 eps Omega t r (and omega_max^2 eps Omega t for
     angles).  The lumped model integrates small vibrations about nominal motion and has no such floor."""
     turn = max(abs(w) for w in kin.speeds.values()) * duration
-    radius = max(central_radius(spec, mid) for mid, m in spec.members.items() if not m.is_planet)
+    radius = max(central_radius(spec, mid) for mid, m in spec.members.items() if not m.orbits)
     angular = omega_max ** 2 * np.finfo(float).eps * turn
     return {"angular_acceleration": angular, "acceleration": angular * radius}

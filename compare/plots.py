@@ -7,11 +7,13 @@ pyplot, so writing a report never touches the user's matplotlib backend.
 from __future__ import annotations
 
 import io
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.figure import Figure
 
+from gearcheck.lumped.cycloid import conjugate_disc_angle, disc_profile
 from gearcheck.lumped.mesh_stiffness import stiffness_model
 
 REFERENCE_STYLE = {"color": "tab:blue", "lw": 1.2}
@@ -413,4 +415,135 @@ def mac_heatmap(pairing) -> bytes:
     ax.set_xlabel(f"{pairing.test} modes [Hz]")
     ax.set_title(f"{pairing.train}: modal assurance criterion, worst paired {pairing.paired.min():.9f}"
                  + (f"; {len(pairing.findings)} findings" if pairing.findings else ""), fontsize=9)
+    return _png(fig)
+
+
+
+DISC_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
+
+
+def pin_loads(loads, index: int = 0, title: str | None = None) -> bytes:
+    """PNG of a :class:`~gearcheck.lumped.pin_loads.PinLoads`: left, the pin circle at time ``times[index]`` with a
+    radial bar per loaded pin (length proportional to its force; a black tick where the rigid-disc share would end) and each
+    disc's profile and eccentric; right, the force against the pin's angle from its disc's eccentric over every
+    time, beside the rigid-disc share and the classical peak 4 T / (Z_p r_c)."""
+    g = loads.geometry
+    mm = 1e3
+    fig = Figure(figsize=(12.0, 5.6), layout="constrained")
+    ax, bx = fig.subplots(1, 2, width_ratios=(1.0, 1.25))
+    n_discs = loads.forces.shape[1]
+    # ---- pin circle
+    t = loads.times[index]
+    force, classical = loads.forces[index], loads.classical[index]
+    psi = loads.pin_angles[index]
+    scale = 0.45 * g.pin_circle_radius * mm / max(float(loads.forces.max()), float(loads.classical.max()), 1e-300)
+    circle = np.linspace(0, 2 * np.pi, 361)
+    ax.plot(g.pin_circle_radius * mm * np.cos(circle), g.pin_circle_radius * mm * np.sin(circle), color="0.6",
+            lw=0.8, ls="--")
+    for c in psi:
+        centre = g.pin_circle_radius * mm * np.array([math.cos(c), math.sin(c)])
+        ax.plot(centre[0] + g.pin_radius * mm * np.cos(circle), centre[1] + g.pin_radius * mm * np.sin(circle),
+                color="0.35", lw=0.7)
+    pitch = 2 * np.pi / g.pins
+    base = g.pin_circle_radius * mm + g.pin_radius * mm
+    for j in range(n_discs):
+        colour = DISC_COLOURS[j % len(DISC_COLOURS)]
+        phi = loads.eccentric_angles[index, j]
+        theta = float(conjugate_disc_angle(g, phi, loads.pin_angles[index, 0]))
+        rot = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
+        profile = (disc_profile(g, points_per_lobe=24) @ rot.T + g.eccentricity * np.array([math.cos(phi),
+                                                                                            math.sin(phi)])) * mm
+        ax.plot(np.r_[profile[:, 0], profile[0, 0]], np.r_[profile[:, 1], profile[0, 1]], color=colour, lw=0.6,
+                alpha=0.6)
+        ax.annotate("", xy=(0.55 * g.pin_circle_radius * mm * math.cos(phi),
+                            0.55 * g.pin_circle_radius * mm * math.sin(phi)), xytext=(0, 0),
+                    arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.2})
+        offset = (j - (n_discs - 1) / 2) * pitch / (n_discs + 1)
+        for i in np.nonzero(force[j] > 0)[0]:
+            a = psi[i] + offset
+            u = np.array([math.cos(a), math.sin(a)])
+            tip = base + scale * force[j, i]
+            ax.plot([base * u[0], tip * u[0]], [base * u[1], tip * u[1]], color=colour, lw=4.0,
+                    solid_capstyle="butt")
+        for i in np.nonzero(classical[j] > 0)[0]:
+            a = psi[i] + offset
+            u, w = np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
+            tip = (base + scale * classical[j, i]) * u
+            ax.plot(*np.array([tip - 2.0 * w, tip + 2.0 * w]).T, color="k", lw=0.9)
+        ax.plot([], [], color=colour, lw=4.0, label=f"disc {j + 1}: {int((force[j] > 0).sum())} pins, "
+                                                     f"peak {force[j].max():.0f} N")
+    ax.plot([], [], color="k", lw=0.9, label="rigid-disc share (tick)")
+    ref = 10 ** math.floor(math.log10(max(float(loads.forces.max()), 1e-300)))
+    reach = g.pin_circle_radius * mm + 0.5 * g.pin_circle_radius * mm
+    ax.plot([-reach, -reach + scale * ref], [-reach, -reach], color="k", lw=2.0)
+    ax.text(-reach + 0.5 * scale * ref, -reach + 3.0, f"{ref:g} N", ha="center", va="bottom", fontsize=8)
+    ax.set_aspect("equal")
+    lim = reach + 0.05 * g.pin_circle_radius * mm
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_xlabel("x (mm), carrier frame")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(f"pin forces at t = {t * 1e3:.3f} ms (arrows: eccentrics)", fontsize=10)
+    ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.1), ncol=2, fontsize=7.5, frameon=False)
+    # ---- force against the pin's angle from its eccentric
+    fine = np.linspace(-np.pi, np.pi, 721)
+    wrapped = np.degrees(np.mod(loads.relative_angles + np.pi, 2 * np.pi) - np.pi)  # (-180, 180]: one loaded zone
+    k1 = g.K1
+    arm = g.rolling_radius * np.sin(fine) / np.sqrt(1 + k1 * k1 - 2 * k1 * np.cos(fine))
+    for j in range(n_discs):
+        colour = DISC_COLOURS[j % len(DISC_COLOURS)]
+        on = loads.forces[:, j, :] > 0
+        bx.plot(wrapped[:, j, :][on], loads.forces[:, j, :][on], ls="none",
+                marker="o" if j == 0 else "x", ms=3.0, color=colour, alpha=0.7,
+                label=f"disc {j + 1}, {len(loads.times)} frozen times")
+    torque = float(np.mean(loads.disc_torque))
+    peak = float(np.mean(loads.classical_peak))
+    bx.plot(np.degrees(fine), np.where(np.sign(torque) * arm > 0, peak * np.abs(arm) / g.rolling_radius, 0.0),
+            color="k", lw=1.0, ls="--", label="rigid disc, 4 T/(Z_p r_c) |l| / r_c")
+    bx.axhline(peak, color="0.4", lw=0.8, ls=":", label=f"4 T/(Z_p r_c) = {peak:.0f} N")
+    bx.set_xlim(-180, 180)
+    bx.set_xticks(range(-180, 181, 45))
+    bx.set_xlabel("pin angle from its disc's eccentric, varphi (deg)")
+    bx.set_ylabel("pin force (N)")
+    s = loads.summary()
+    rigid = (loads.classical > 0).sum(axis=-1)
+    bx.set_title(f"{s['loaded_pins_min']}-{s['loaded_pins_max']} pins loaded per disc, disc torque "
+                 f"{s['disc_torque_nm']:.1f} N m\npeak {s['peak_force_n']:.0f} N = {s['peak_ratio_max']:.3f} x "
+                 f"4 T/(Z_p r_c) (rigid disc: {rigid.min()}-{rigid.max()} pins)", fontsize=10)
+    bx.legend(loc="upper left", fontsize=7.5, frameon=False)
+    bx.grid(True, lw=0.3)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return _png(fig)
+
+
+def sensitivity_map(frame, coordinate: str, title: str) -> bytes:
+    """PNG of a :func:`~gearcheck.compare.sensitivity.sensitivity_map` table: the amplitude of each harmonic of
+    ``coordinate`` over the mesh frequency, then per parameter its sensitivity d|Q|/d ln p (solid) and the paper's
+    Eq. (15) (dashed, when the table has it)."""
+    parameters = list(dict.fromkeys(frame["parameter"]))
+    harmonics = list(dict.fromkeys(frame["harmonic"]))[:6]
+    fig, axes = _figure(1 + len(parameters), 1, figsize=(9, 2.4 * (1 + len(parameters))), sharex=True,
+                        squeeze=False, layout="constrained")
+    colours = [f"C{i}" for i in range(len(harmonics))]
+    first = frame[frame["parameter"] == parameters[0]]
+    for h, colour in zip(harmonics, colours):
+        rows = first[first["harmonic"] == h]
+        axes[0, 0].semilogy(rows["mesh_frequency_hz"], rows["amplitude"], color=colour, lw=1.2, label=f"h = {h}")
+    axes[0, 0].set_ylabel(f"|Q_h| of {coordinate}", fontsize=8)
+    axes[0, 0].legend(fontsize=7, ncol=3)
+    for ax, parameter in zip(axes[1:, 0], parameters):
+        rows = frame[frame["parameter"] == parameter]
+        for h, colour in zip(harmonics, colours):
+            r = rows[rows["harmonic"] == h]
+            ax.plot(r["mesh_frequency_hz"], r["d_amplitude_d_ln_p"], color=colour, lw=1.2)
+            if r["eq15_d_amplitude_d_ln_p"].notna().all():
+                ax.plot(r["mesh_frequency_hz"], r["eq15_d_amplitude_d_ln_p"], color=colour, lw=0.9, ls="--")
+        ax.axhline(0.0, color="0.5", lw=0.6)
+        ax.set_ylabel(f"d|Q|/d ln p\n{parameter}", fontsize=8)
+    axes[-1, 0].set_xlabel("mesh frequency of the first stage (Hz)")
+    for ax in axes[:, 0]:
+        ax.grid(alpha=0.3)
+    fig.suptitle(title + "\nsolid: differentiated harmonic equations; dashed: Yang, Chen & Wang (2018) Eq. (15)",
+                 fontsize=9)
     return _png(fig)

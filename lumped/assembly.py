@@ -39,14 +39,17 @@ nothing here is specific to a stage layout.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from gearcheck.lumped.cycloid_rows import CycloidRows
 from gearcheck.lumped.excitation import Excitation
 from gearcheck.lumped.kinematics import Kinematics, kinematics
 from gearcheck.lumped.line_of_action import lever, line_of_action
 from gearcheck.lumped.spec import TrainSpec
+from gearcheck.lumped.static import mean_load
+from gearcheck.shared.errors import SolverError
 
 CENTRAL_DOFS = ("x", "y", "theta")
 PLANET_DOFS = ("radial", "tangential", "theta")
@@ -55,7 +58,7 @@ AXIAL_DOF = "z"  # members of a helical stage: translation along the stage axis 
 
 def member_dofs(spec: TrainSpec, member) -> tuple[str, ...]:
     """The coordinates of ``member``: two translations and a rotation, and z in a helical stage."""
-    planar = PLANET_DOFS if member.is_planet else CENTRAL_DOFS
+    planar = PLANET_DOFS if member.orbits else CENTRAL_DOFS
     return planar + (AXIAL_DOF,) if spec.stage_of(member.id).helical else planar
 
 
@@ -129,8 +132,6 @@ class LumpedModel:
         """The rotating-frame terms at another input speed (rad/s; 0 allowed): Coriolis and circulatory
         terms scale with the speed, centripetal ones with its square; nothing else depends on it.  For
         modal analysis (the excitation and the static loads stay those of the train's own speed)."""
-        from dataclasses import replace
-
         r = input_speed / self.spec.operating.input_speed
         return replace(self, G=r * self.G, K_centripetal=r * r * self.K_centripetal,
                        K_circulatory=r * self.K_circulatory)
@@ -156,11 +157,11 @@ class LumpedModel:
         return self.C_b + self.mesh_rows.T @ (self.mesh_damping[:, None] * self.mesh_rows)
 
     def without_rotating_frame_terms(self) -> "LumpedModel":
-        from dataclasses import replace
-
         zero = np.zeros_like(self.M)
-        return replace(self, G=zero, K_centripetal=zero, K_circulatory=zero, F_static=np.zeros(self.n),
-                       rotating_frame_terms=False)
+        turning = [replace(e, omega_orbit=0.0) if isinstance(e, CycloidRows) else e for e in self.turning]
+        gaps = sum((e.gap_load for e in turning if isinstance(e, CycloidRows)), np.zeros(self.n))
+        return replace(self, G=zero, K_centripetal=zero, K_circulatory=zero, F_static=gaps,
+                       rotating_frame_terms=False, turning=turning)
 
 
 @dataclass(frozen=True)
@@ -226,7 +227,7 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     K_circ = np.zeros((n, n))
     F = np.zeros(n)
     for mid, member in spec.members.items():
-        u, v = (PLANET_DOFS if member.is_planet else CENTRAL_DOFS)[:2]
+        u, v = (PLANET_DOFS if member.orbits else CENTRAL_DOFS)[:2]
         iu, iv, ith = dofs(mid, u), dofs(mid, v), dofs(mid, "theta")
         M[iu, iu] = M[iv, iv] = member.mass
         M[ith, ith] = member.inertia
@@ -238,21 +239,21 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
         G[iu, iv] -= 2.0 * member.mass * omega
         G[iv, iu] += 2.0 * member.mass * omega
         K_cent[iu, iu] = K_cent[iv, iv] = -member.mass * omega**2
-        if member.is_planet:
+        if member.orbits:
             F[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
             # m Omega^2 (r_c^2 theta_c^2 / 2 + r_c theta_c s_t): the potential in carrier coordinates
             e_c = _unit(n, (dofs(carrier, "theta"), 1.0))
             s_t = _pin_rows(spec, dofs, mid)[1]
             K_cent += member.mass * omega**2 * member.radius * (
                 member.radius * np.outer(e_c, e_c) + np.outer(e_c, s_t) + np.outer(s_t, e_c))
-        else:
+        elif member.support:
             c = member.support.radial_damping  # damping relative to the housing: -c (q' + Omega k x q)
             K_circ[iu, iv] -= c * omega
             K_circ[iv, iu] += c * omega
             F[ith] -= member.support.torsional_damping * kin.speeds[mid]  # drag of a turning member
 
     rows, turning = _coupling_rows(spec, dofs, kin)
-    rows = _support_rows(spec, dofs) + _bearing_rows(spec, dofs) + rows
+    rows = _support_rows(spec, dofs) + _bearing_rows(spec, dofs) + _spline_rows(spec, dofs) + rows
     if spec.operating.input_shaft_stiffness is not None:
         a = np.zeros(n)
         a[dofs(spec.input, "theta")] = 1.0
@@ -269,6 +270,9 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     b_out[dofs(spec.output, "theta")] = 1.0
     model = LumpedModel(spec, kin, dofs, M, G, K_cent, K_circ, rows, mesh_rows, damping, F, b_in, b_out, excitation,
                         turning=turning)
+    for stage in spec.stages:
+        if stage.cycloid:
+            model = _with_cycloid(model, stage)
     return model if rotating_frame_terms else model.without_rotating_frame_terms()
 
 
@@ -283,7 +287,7 @@ def _support_rows(spec, dofs) -> list[Row]:
     n = len(dofs)
     rows = []
     for mid, m in spec.members.items():
-        if m.is_planet:
+        if m.support is None:
             continue
         s = m.support
         rows.append(Row(f"{mid}.support_x", "support", _unit(n, (dofs(mid, "x"), 1.0)), s.radial_stiffness,
@@ -315,9 +319,11 @@ def _bearing_rows(spec, dofs) -> list[Row]:
     """Planet bearing: an isotropic spring-damper between the planet centre and its pin."""
     rows = []
     for stage in spec.stages:
-        for pid in stage.planets:
-            radial, tangential = _pin_rows(spec, dofs, pid)
+        for pid in stage.planets + (stage.cycloid.cranks if stage.cycloid else ()):
             b = spec.members[pid].bearing
+            if b is None:  # an RV reducer's planet: on its crank
+                continue
+            radial, tangential = _pin_rows(spec, dofs, pid)
             rows.append(Row(f"{pid}.bearing_radial", "bearing", radial, b.radial_stiffness, b.radial_damping))
             rows.append(Row(f"{pid}.bearing_tangential", "bearing", tangential, b.radial_stiffness,
                             b.radial_damping))
@@ -325,6 +331,96 @@ def _bearing_rows(spec, dofs) -> list[Row]:
                 axial = _unit(len(dofs), (dofs(pid, AXIAL_DOF), 1.0), (dofs(stage.carrier, AXIAL_DOF), -1.0))
                 rows.append(Row(f"{pid}.bearing_axial", "bearing", axial, b.axial_stiffness, b.axial_damping))
     return rows
+
+
+def _spline_rows(spec, dofs) -> list[Row]:
+    """An RV reducer's planet on its crankshaft: bending along the carrier's radial and tangential axes (both
+    members at the same place) and torsion."""
+    rows = []
+    for stage in spec.stages:
+        if not stage.cycloid:
+            continue
+        s = stage.cycloid.spline
+        for planet, crank in zip(stage.planets, stage.cycloid.cranks):
+            for dof, k, c in (("radial", s.radial_stiffness, s.radial_damping),
+                              ("tangential", s.radial_stiffness, s.radial_damping),
+                              ("theta", s.torsional_stiffness, s.torsional_damping)):
+                a = _unit(len(dofs), (dofs(planet, dof), 1.0), (dofs(crank, dof), -1.0))
+                rows.append(Row(f"{crank}.spline_{dof}", "coupling", a, k, c))
+    return rows
+
+
+def _with_cycloid(model: LumpedModel, stage) -> LumpedModel:
+    """The model with a cycloid-pin stage among its turning elements, placed at t = 0 (:func:`frozen_at`)."""
+    spec, dofs, kin, cyc = model.spec, model.dofs, model.kin, stage.cycloid
+    omega = kin.speeds[stage.carrier]
+    wheel = kin.speeds[cyc.pin_wheel] if cyc.pin_wheel else 0.0
+    index = lambda mid, names: np.array([dofs(mid, d) for d in names])  # noqa: E731
+    element = CycloidRows(
+        stage.name, model.n, np.array([index(c, PLANET_DOFS) for c in cyc.cranks]),
+        np.array([index(d, CENTRAL_DOFS) for d in cyc.discs]),
+        index(cyc.pin_wheel, CENTRAL_DOFS) if cyc.pin_wheel else None,
+        np.array([spec.members[c].angle for c in cyc.cranks]), np.array(cyc.phases),
+        kin.speeds[cyc.cranks[0]] - omega, wheel - omega, kin.speeds[cyc.cranks[0]], cyc.geometry,
+        stage.carrier_radius, cyc.needle.radial_stiffness, cyc.needle.radial_damping,
+        cyc.pin_stiffness(spec.operating.output_torque), cyc.contact_damping, cyc.clearance,
+        spec.members[cyc.discs[0]].mass, gap_load=np.zeros(model.n))
+    unplaced = replace(model, turning=model.turning + [element], F_static=model.F_static + element.static_load)
+    return _place(unplaced, element, 0.0)
+
+
+def frozen_at(model: LumpedModel, t: float, touching=None) -> LumpedModel:
+    """The model frozen at time ``t``: its cycloid stages' rows, orbit loads and static pin contact sets those
+    of ``t`` (the modal and static analyses of that configuration; the meshes stay at their mean).  ``touching``:
+    the contact sets to take instead, one boolean array (N * Z_p,) per cycloid stage (as :func:`contact_sets`
+    gives them)."""
+    elements = [e for e in model.turning if isinstance(e, CycloidRows)]
+    for element, sets in zip(elements, touching or [None] * len(elements)):
+        model = _place(model, element, t, sets)
+    return model
+
+
+def contact_sets(model: LumpedModel) -> list[np.ndarray]:
+    """Which pins touch, per cycloid stage, in the configuration ``model`` is placed at."""
+    names = {r.name for r in model.rows if r.kind == "contact"}
+    return [np.array([name in names for name, _ in e.pin_rows(e.placed_at)])
+            for e in model.turning if isinstance(e, CycloidRows)]
+
+
+def _place(model: LumpedModel, element: CycloidRows, t: float, touching=None) -> LumpedModel:
+    """``model`` with ``element``'s rows and loads of time ``t`` in place of those it had; the pins of
+    ``touching`` in contact, or those of the static solution."""
+    rows = [r for r in model.rows if r.name not in element.rows]
+    needles = [Row(name, "bearing", a, element.needle_stiffness, element.needle_damping)
+               for name, a in element.needle_rows(t)]
+    pins = element.pin_rows(t)
+    base = replace(model, rows=rows + needles,
+                   F_static=model.F_static - element.static_load + element.orbit_force(t))  # gaps: below
+    A = np.array([a for _, a in pins])
+    touching = _static_contact_set(base, A, element) if touching is None else np.asarray(touching, dtype=bool)
+    contacts = [Row(name, "contact", a, element.pin_stiffness, element.pin_damping)
+                for (name, a), on in zip(pins, touching) if on]
+    gap_load = element.pin_stiffness * element.clearance * A[touching].sum(axis=0)  # a row k (a.q - gap)
+    placed = replace(element, rows=tuple(r.name for r in needles + contacts), placed_at=t, gap_load=gap_load)
+    return replace(base, rows=base.rows + contacts, F_static=base.F_static + gap_load,
+                   turning=[placed if e is element else e for e in model.turning])
+
+
+def _static_contact_set(model: LumpedModel, A: np.ndarray, element) -> np.ndarray:
+    """Which pins (rows ``A``) touch in the static equilibrium under the mean load at t = 0 (active set, from
+    all of them touching)."""
+    K0 = model.K_b + model.K_mesh(model.excitation.mean_stiffness) + model.K_frame
+    F = mean_load(model)
+    active = np.ones(len(A), dtype=bool)
+    for _ in range(len(A) + 1):
+        K = K0 + element.pin_stiffness * A[active].T @ A[active]
+        q = np.linalg.lstsq(K, F + element.pin_stiffness * element.clearance * A[active].sum(axis=0),
+                            rcond=None)[0]
+        touching = A @ q - element.clearance > 0.0
+        if np.array_equal(touching, active):
+            return active
+        active = touching
+    raise SolverError(f"{element.stage}: the static pin contact set did not settle")  # pragma: no cover
 
 
 def _coupling_rows(spec, dofs, kin) -> tuple[list[Row], list[TurningCoupling]]:

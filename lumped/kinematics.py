@@ -29,7 +29,7 @@ MAX_PITCH_LINE_SPEED = 300.0  # m/s
 class Kinematics:
     speeds: dict[str, float]  # rad/s, absolute, positive counter-clockwise
     flanks: dict[str, int]  # mesh id -> +1/-1
-    mesh_frequency: dict[str, float]  # Hz
+    mesh_frequency: dict[str, float]  # Hz; an RV reducer's pin contacts under "STAGE.pins"
     mesh_phase: dict[str, float]  # cycles; mesh position xi = f t - phase
     ratio: float  # input speed / output speed
     input_torque: float  # N·m on the input member (power balance), signed
@@ -56,7 +56,35 @@ def _torsional_rows(spec):
         row[index[c.a]], row[index[c.b]] = 1.0, -1.0
         rows.append(row)
         labels.append(c.name)
+    for stage in spec.stages:
+        if stage.cycloid:
+            for row, label in _cycloid_rows(stage, index):
+                rows.append(row)
+                labels.append(label)
     return np.array(rows), labels, index
+
+
+def _cycloid_rows(stage, index):
+    """An RV reducer's rigid constraints: each planet turns with its crank; each disc translates relative to
+    the carrier (its eccentric bores on several cranks lock its rotation to the carrier's); and the disc rolls
+    on the pins (one tooth fewer): w_H - w_w + Z_c (w_d - w_w) = 0, w_H the crank's absolute speed, w_d the
+    disc's and w_w the pin wheel's (0 when it is fixed)."""
+    cyc = stage.cycloid
+    wheel = cyc.pin_wheel
+    for planet, crank in zip(stage.planets, cyc.cranks):
+        row = np.zeros(len(index))
+        row[index[planet]], row[index[crank]] = 1.0, -1.0
+        yield row, f"{crank}.spline"
+        row = np.zeros(len(index))
+        row[index[crank]] += 1.0
+        row[index[cyc.discs[0]]] += cyc.geometry.lobes
+        if wheel:
+            row[index[wheel]] -= 1.0 + cyc.geometry.lobes
+        yield row, f"{crank}.pins"
+    for disc in cyc.discs:
+        row = np.zeros(len(index))
+        row[index[disc]], row[index[stage.carrier]] = 1.0, -1.0
+        yield row, f"{disc}.orbit"
 
 
 def kinematics(spec) -> Kinematics:
@@ -112,6 +140,12 @@ def kinematics(spec) -> Kinematics:
         freq[mesh.id] = z * abs(rel) / (2 * math.pi)
         psi = spec.members[mesh.planet].angle
         phase[mesh.id] = (math.copysign(1.0, rel) * z * psi / (2 * math.pi) + _sun_ring_offset(spec, mesh)) % 1.0
+
+    for stage in spec.stages:
+        if stage.cycloid:  # the contact pattern moves on by one pin per pin pitch of the eccentric's turn
+            cyc = stage.cycloid
+            wheel = speeds[cyc.pin_wheel] if cyc.pin_wheel else 0.0
+            freq[stage.name + ".pins"] = cyc.geometry.pins * abs(speeds[cyc.cranks[0]] - wheel) / (2 * math.pi)
 
     ratio = spec.operating.input_speed / w_out
     t_in = -t_out / ratio if load > 0 else 0.0

@@ -366,7 +366,8 @@ PLANET_BEARING = Table(
                                        0.0, bound("stiffness")),
         "axial_damping": NonNegative("axial damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
     },
-    "planet bearing on the carrier pin",
+    "planet bearing on the carrier pin (an RV reducer's planets sit on their crankshafts instead)",
+    default=None,
 )
 
 STIFFNESS = Table(
@@ -438,6 +439,87 @@ PLANET = Table(
     "the planets of the stage (all identical)",
 )
 
+def _bearing(doc: str) -> Table:
+    return Table(
+        {
+            "radial_stiffness": Positive("stiffness in each of two perpendicular directions (isotropic)", "N/m",
+                                         REQUIRED, bound("stiffness")),
+            "radial_damping": NonNegative("damping in each of those directions", "N·s/m", 0.0, bound("damping")),
+        },
+        doc,
+    )
+
+
+CRANK = Table(
+    {
+        "mass": Positive("mass of one crankshaft", "kg", REQUIRED, bound("mass")),
+        "inertia": Positive("polar moment of inertia of one crankshaft about its axis", "kg·m²", REQUIRED,
+                            bound("inertia")),
+        "eccentricity_mm": Positive("eccentricity e of its eccentrics: the radius of the cycloid discs' orbit", "mm",
+                                    REQUIRED, bound("length", MM)),
+        "bearing": _bearing("the crankshaft's support bearings in the carrier, taken together"),
+        "spline": Table(
+            {
+                "radial_stiffness": Positive("bending stiffness between planet and crankshaft, radial and "
+                                             "tangential", "N/m", REQUIRED, bound("stiffness")),
+                "radial_damping": NonNegative("damping of that bending", "N·s/m", 0.0, bound("damping")),
+                "torsional_stiffness": Positive("torsional stiffness between planet and crankshaft", "N·m/rad",
+                                                REQUIRED, bound("stiffness")),
+                "torsional_damping": NonNegative("torsional damping", "N·m·s/rad", 0.0, bound("damping")),
+            },
+            "the planet's connection to its crankshaft (spline and shaft)",
+        ),
+    },
+    "RV reducer: one crankshaft per planet, at the planet's place on the carrier, carrying the planet and one "
+    "eccentric per cycloid disc ([stages.crank]); needs [stages.cycloid]",
+    default=None,
+)
+
+CYCLOID = Table(
+    {
+        "discs": Integer("number of cycloid discs", 2, 1, maximum=8),
+        "phases_deg": ListOf(Number("angle", "deg", REQUIRED, -3600.0, False, 3600.0),
+                             "angle of each disc's eccentric from the first disc's (default equally spaced)", None,
+                             unit="deg"),
+        "lobes": Integer("teeth (lobes) of each disc, Z_c", REQUIRED, 3, maximum=int(bound("teeth"))),
+        "pins": Integer("pins of the pin wheel, Z_p = Z_c + 1", REQUIRED, 4, maximum=int(bound("teeth"))),
+        "pin_circle_radius_mm": Positive("radius of the circle of the pin centres, R_p", "mm", REQUIRED,
+                                         bound("length", MM)),
+        "pin_radius_mm": Positive("radius of a pin (or of its roller), r_rp", "mm", REQUIRED, bound("length", MM)),
+        "thickness_mm": Positive("thickness of a disc: the length of each pin contact", "mm", REQUIRED,
+                                 bound("length", MM)),
+        "mass": Positive("mass of one disc", "kg", REQUIRED, bound("mass")),
+        "inertia": Positive("polar moment of inertia of one disc", "kg·m²", REQUIRED, bound("inertia")),
+        "bearing": _bearing("the needle (turning-arm) bearing between each eccentric and its disc"),
+        "contact": Table(
+            {
+                "stiffness": Positive("stiffness of one pin contact along its normal (default: Palmgren's line "
+                                      "contact linearised at the largest pin force of the rated load)", "N/m", None,
+                                      bound("stiffness")),
+                "damping": NonNegative("damping of one pin contact while it touches", "N·s/m", 0.0,
+                                       bound("damping")),
+                "clearance_um": NonNegative("gap between each pin and the disc profile at the nominal position "
+                                            "(profile modification)", "µm", 0.0, bound("displacement", UM)),
+            },
+            "the pin contacts: compression only, one per pin and disc",
+            default={},
+        ),
+    },
+    "RV reducer: the cycloid-pin stage driven by the cranks' eccentrics, its discs turning with the carrier "
+    "([stages.cycloid]); needs [stages.crank]",
+    default=None,
+)
+
+PIN_WHEEL = Table(
+    {
+        "mass": Positive("mass of the pin wheel with its pins", "kg", REQUIRED, bound("mass")),
+        "inertia": Positive("polar moment of inertia of the pin wheel", "kg·m²", REQUIRED, bound("inertia")),
+        "support": SUPPORT,
+    },
+    "the pin wheel (the housing's pins) on a support; without this table it is rigid and fixed",
+    default=None,
+)
+
 STAGE = Table(
     {
         "name": Text("stage name, used in member references (`stage1.sun`)", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
@@ -462,6 +544,9 @@ STAGE = Table(
         "planet": PLANET,
         "sun": CENTRAL_GEAR,
         "ring": CENTRAL_GEAR,
+        "crank": CRANK,
+        "cycloid": CYCLOID,
+        "pin_wheel": PIN_WHEEL,
     },
     "a planetary stage ([[stages]]); extra central gears may be named sun_* or ring_*",
     patterns=((r"(sun|ring)_[A-Za-z0-9_]+", CENTRAL_GEAR),),

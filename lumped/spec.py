@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gearcheck.lumped.cycloid import CycloidGeometry, cycloid_problem, palmgren_stiffness
 from gearcheck.lumped.files import read_text, read_toml
 from gearcheck.lumped.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
 from gearcheck.lumped.mesh_stiffness import MODELS
@@ -30,6 +31,10 @@ MAX_TOLERANCE = 1e6  # a relative error of a million is no tolerance
 MAX_ERROR = 0.1  # modules: a transmission error or an eccentricity that large is a broken or misplaced gear
 CENTRE_DISTANCE_TOLERANCE = 1e-6  # m: sun-planet and ring-planet operating centre distances must match
 CARRIER_RADIUS_TOLERANCE = 1e-6  # m: a stated carrier radius must be the operating centre distance
+CYCLOID_FIELDS = {"lobes": "cycloid.lobes", "pins": "cycloid.pins", "eccentricity": "crank.eccentricity_mm",
+                  "pin_circle_radius": "cycloid.pin_circle_radius_mm", "pin_radius": "cycloid.pin_radius_mm",
+                  "contact_length": "cycloid.thickness_mm"}  # the train file's keys of the geometry's fields
+HOLDABLE = ("sun", "ring", "carrier", "pin_wheel")  # members on the housing's axis: held, coupled, input, output
 
 
 @dataclass(frozen=True)
@@ -60,6 +65,12 @@ class Member:
     @property
     def is_planet(self) -> bool:
         return self.kind == "planet"
+
+    @property
+    def orbits(self) -> bool:
+        """Sits on a pin of its carrier (a planet, an RV reducer's crankshaft): its translations are along the
+        carrier's radial and tangential axes at its place."""
+        return self.kind in ("planet", "crank")
 
     @property
     def label(self) -> str:
@@ -129,6 +140,36 @@ class Operating:
 
 
 @dataclass(frozen=True)
+class CycloidStage:
+    """An RV reducer's cycloid-pin stage on a planetary stage's carrier: one crankshaft per planet, splined to
+    it and borne in the carrier; one eccentric per disc on every crankshaft; discs that orbit on the
+    eccentrics and mesh with the pin wheel's pins (Yang, Chen & Wang 2018; geometry in
+    :mod:`gearcheck.lumped.cycloid`)."""
+
+    geometry: CycloidGeometry
+    phases: tuple[float, ...]  # rad: each disc's eccentric from the cranks' first eccentric
+    cranks: tuple[str, ...]  # member ids, crank k at planet k's place
+    discs: tuple[str, ...]
+    pin_wheel: str | None  # member id; None: rigid and fixed
+    spline: Support  # planet to crank: radial (bending) and torsional
+    needle: Support  # eccentric to disc, radial
+    contact_stiffness: float | None  # N/m per pin contact; None: Palmgren's law at the rated load
+    contact_damping: float
+    clearance: float  # m
+
+    def pin_stiffness(self, output_torque: float) -> float:
+        """The stiffness of one pin contact: as given, or Palmgren's line contact linearised at the largest
+        pin force F_max = 4 T_c / (Z_p r_c) of a rigid disc carrying T_c about its centre: its share of the
+        output torque times Z_c / Z_p (the pins' arms about the pin wheel's centre are Z_p / Z_c times those
+        about the disc's; the input's share of the reaction, 1/ratio, neglected)."""
+        if self.contact_stiffness is not None:
+            return self.contact_stiffness
+        g = self.geometry
+        torque = abs(output_torque) / len(self.discs) * g.lobes / g.pins
+        return palmgren_stiffness(4.0 * torque / (g.pins * g.rolling_radius), g.contact_length)
+
+
+@dataclass(frozen=True)
 class Stage:
     name: str
     carrier_radius: float
@@ -138,6 +179,7 @@ class Stage:
     planets: tuple[str, ...]
     carrier: str
     helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
+    cycloid: CycloidStage | None = None  # an RV reducer's second stage on this carrier
 
 
 @dataclass(frozen=True)
@@ -201,8 +243,9 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
             raise fail(f"train.held[{j}]", f"{ref} is held twice")
         if ref not in members:
             raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
-        if members[ref].is_planet:
-            raise fail(f"train.held[{j}]", f"{ref} is a planet; only sun, ring or carrier can be held")
+        if members[ref].kind not in HOLDABLE:
+            raise fail(f"train.held[{j}]", f"{ref} is a {members[ref].kind}; only a sun, ring, carrier or pin wheel "
+                                           "can be held")
         if members[ref].support.torsional_stiffness <= 0.0:
             raise fail(f"train.held[{j}]", f"{ref} is held but its support.torsional_stiffness is 0; "
                                            "a held member is held by a support stiffness")
@@ -216,9 +259,9 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         for key in ("from", "to"):
             if c[key] not in members:
                 raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{_known(c[key], members)}")
-            if members[c[key]].is_planet:
-                raise fail(f"couplings[{j}].{key}", f"{c[key]} is a planet; a coupling joins central members "
-                                                    "(sun, ring, carrier)")
+            if members[c[key]].kind not in HOLDABLE:
+                raise fail(f"couplings[{j}].{key}", f"{c[key]} is a {members[c[key]].kind}; a coupling joins "
+                                                    "central members (sun, ring, carrier, pin wheel)")
         if members[c["from"]].stage == members[c["to"]].stage:
             raise fail(f"couplings[{j}]", "a coupling joins members of different stages")
         couplings.append(Coupling(c["name"], c["kind"], c["from"], c["to"], c["torsional_stiffness"],
@@ -235,6 +278,11 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     profile = _torque_profile(op["torque_csv"], source, fail) if op["torque_csv"] is not None else None
     if op["input_torque"] is not None and op["output_torque"] is not None:
         raise fail("operating.input_torque", "give input_torque or output_torque, not both")
+    for i, stage in enumerate(stages):
+        if stage.cycloid and stage.cycloid.contact_stiffness is None and not (op["output_torque"]
+                                                                              or op["input_torque"]):
+            raise fail(f"stages[{i}].cycloid.contact.stiffness", "missing: give it, or a load (operating."
+                                                                 "output_torque) to linearise Palmgren's law at")
     operating = Operating(op["input_speed"], op["output_torque"] or 0.0, op["input_shaft_stiffness"],
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
                           op["input_torque"])
@@ -483,6 +531,22 @@ def _build_stage(st: dict, path: str, fail):
                 raise fail(f"{gpath}.planet_gear", f"no planet gear {pg!r} (have {', '.join(planet_gears)})")
         centrals[key] = (gear, pg, raw)
 
+    # --- an RV reducer: crankshafts in place of planet pins, and no ring (the cranks set the planets' spin)
+    rv = st["crank"] is not None or st["cycloid"] is not None
+    if rv:
+        for key in ("crank", "cycloid"):
+            if st[key] is None:
+                raise fail(f"{path}.{key}", "missing: an RV reducer's stage needs both [crank] and [cycloid]")
+        rings = [key for key in central_keys if key.startswith("ring")]
+        if rings:
+            raise fail(f"{path}.{rings[0]}", "an RV reducer's planets are turned by their crankshafts: a ring "
+                                             "would lock them (remove the ring, or the crank and cycloid tables)")
+        if planet_raw["bearing"] is not None:
+            raise fail(f"{path}.planet.bearing", "an RV reducer's planets sit on their crankshafts (give the "
+                                                 "crank's bearing and spline instead)")
+    elif planet_raw["bearing"] is None:
+        raise fail(f"{path}.planet.bearing", "missing required field")
+
     # --- every gear an involute gear, every pair an involute mesh
     planet_paths = {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}"
                     for name in planet_gears}
@@ -558,8 +622,9 @@ def _build_stage(st: dict, path: str, fail):
         pid = f"{name}.planet{k + 1}"
         planet_ids.append(pid)
         members[pid] = Member(pid, name, "planet", planet_mass, planet_inertia,
-                              bearing=_support(planet_raw["bearing"]), gears=dict(planet_gears), angle=psi,
-                              radius=carrier_radius)
+                              bearing=None if rv else _support(planet_raw["bearing"]), gears=dict(planet_gears),
+                              angle=psi, radius=carrier_radius)
+    cycloid = _cycloid_stage(st, members, angles, carrier_radius, path, fail) if rv else None
 
     # --- meshes
     for layer, lpath in [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]:
@@ -592,9 +657,57 @@ def _build_stage(st: dict, path: str, fail):
     helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
     if helical:
         _check_helical(st, centrals, meshes, path, fail)
+    if helical and rv:
+        raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in central_keys),
-                  tuple(planet_ids), carrier_id, helical)
+                  tuple(planet_ids), carrier_id, helical, cycloid)
     return members, stage, meshes
+
+
+def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path: str, fail) -> CycloidStage:
+    """Crankshaft, disc and pin-wheel members of an RV reducer's stage (added to ``members``) and its
+    cycloid-pin stage, its geometry checked."""
+    name, crank, cyc = st["name"], st["crank"], st["cycloid"]
+    geometry = CycloidGeometry(lobes=cyc["lobes"], pins=cyc["pins"], eccentricity=crank["eccentricity"],
+                               pin_circle_radius=cyc["pin_circle_radius"], pin_radius=cyc["pin_radius"],
+                               contact_length=cyc["thickness"])
+    problem = cycloid_problem(geometry)
+    if problem:
+        field_name, message = problem
+        raise fail(f"{path}.{CYCLOID_FIELDS[field_name]}", message)
+    n_discs = cyc["discs"]
+    if cyc["phases"] is None:
+        phases = tuple(2.0 * math.pi * j / n_discs for j in range(n_discs))
+    else:
+        if len(cyc["phases"]) != n_discs:
+            raise fail(f"{path}.cycloid.phases_deg", f"has {len(cyc['phases'])} angles for {n_discs} discs")
+        phases = tuple(cyc["phases"])
+    cranks = []
+    for k, psi in enumerate(angles):
+        cid = f"{name}.crank{k + 1}"
+        cranks.append(cid)
+        members[cid] = Member(cid, name, "crank", crank["mass"], crank["inertia"],
+                              bearing=Support(crank["bearing"]["radial_stiffness"], crank["bearing"]["radial_damping"]),
+                              angle=psi, radius=carrier_radius)
+    discs = []
+    for j in range(n_discs):
+        did = f"{name}.disc{j + 1}"
+        discs.append(did)
+        members[did] = Member(did, name, "disc", cyc["mass"], cyc["inertia"])
+    wheel = None
+    if st["pin_wheel"] is not None:
+        wheel = f"{name}.pin_wheel"
+        raw = st["pin_wheel"]
+        members[wheel] = Member(wheel, name, "pin_wheel", raw["mass"], raw["inertia"],
+                                support=_support(raw["support"]))
+    spline = crank["spline"]
+    contact = cyc["contact"]
+    return CycloidStage(
+        geometry, phases, tuple(cranks), tuple(discs), wheel,
+        Support(spline["radial_stiffness"], spline["radial_damping"], spline["torsional_stiffness"],
+                spline["torsional_damping"]),
+        Support(cyc["bearing"]["radial_stiffness"], cyc["bearing"]["radial_damping"]),
+        contact["stiffness"], contact["damping"], contact["clearance"])
 
 
 SPUR_ONLY_STIFFNESS = {"rectangular": "its wave counts tooth pairs from the transverse contact ratio alone",

@@ -23,12 +23,18 @@ def input_torque_through_meshes(spec, static):
 
 def rigid_turn(model):
     """The mechanism advanced by one second of nominal motion: every member turned by its speed, every
-    planet carried r_c w_c along its orbit."""
+    planet (and RV crank) carried r_c w_c along its orbit, every cycloid disc e w_H along its orbit about
+    the pin wheel's centre (at t = 0, the carrier's axes)."""
     turn = np.zeros(model.n)
     for mid, member in model.spec.members.items():
         turn[model.dofs(mid, "theta")] = model.kin.speeds[mid]
-        if member.is_planet:
+        if member.orbits:
             turn[model.dofs(mid, "tangential")] = member.radius * model.kin.speeds[f"{member.stage}.carrier"]
+        if member.kind == "disc":
+            cyc = model.spec.stage_of(mid).cycloid
+            phi, w_h = cyc.phases[cyc.discs.index(mid)], model.kin.speeds[cyc.cranks[0]]
+            turn[model.dofs(mid, "x")] = -cyc.geometry.eccentricity * w_h * np.sin(phi)
+            turn[model.dofs(mid, "y")] = cyc.geometry.eccentricity * w_h * np.cos(phi)
     return turn
 
 

@@ -148,8 +148,9 @@ def units_of(path) -> dict:
 
 
 def bearing_names(spec) -> list[str]:
-    """``PLANET.bearing_radial`` and ``PLANET.bearing_tangential`` of every planet, in member order."""
-    planets = [mid for mid, m in spec.members.items() if m.is_planet]
+    """``MEMBER.bearing_radial`` and ``MEMBER.bearing_tangential`` of every member borne on a carrier pin (a
+    planet, an RV reducer's crankshaft), in member order."""
+    planets = [mid for mid, m in spec.members.items() if m.orbits and m.bearing is not None]
     return [f"{mid}.bearing_{axis}" for mid in planets for axis in ("radial", "tangential")]
 
 
@@ -171,7 +172,7 @@ def train_signals(spec) -> list[Signal]:
     """The signals of a gear train run, in the order :func:`train_result` holds them."""
     signals = []
     for mid, member in spec.members.items():
-        gated = not member.is_planet
+        gated = not member.orbits
         for frame in ("world", "carrier"):
             for axis in "xy":
                 signals.append(Signal(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
@@ -183,18 +184,28 @@ def train_signals(spec) -> list[Signal]:
                     Signal(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static", False),
                     Signal(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", False)]
     signals += [Signal(f"{name}.force", "bearing_force", "N", f"{name} force") for name in bearing_names(spec)]
+    for disc in disc_names(spec):
+        signals += [Signal(f"{disc}.pin_force_max", "pin_force", "N", f"{disc}: largest pin contact force"),
+                    Signal(f"{disc}.pins_loaded", "pin_count", "1", f"{disc}: pins in contact", False)]
     return signals
 
 
+def disc_names(spec) -> list[str]:
+    """An RV reducer's cycloid discs, stage by stage (the order of :func:`train_result`'s pin forces)."""
+    return [d for stage in spec.stages if stage.cycloid for d in stage.cycloid.discs]
+
+
 def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflection, mesh_force, mesh_stiffness,
-                 static_mesh_force, static_bearing_force, bearing_force, settle_time, info, raw) -> TimeResult:
+                 static_mesh_force, static_bearing_force, bearing_force, settle_time, info, raw,
+                 pin_force=None) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
     acc_carrier: (n_t, n_members, 3) inertial acceleration of each member's centre along its carrier's
     axes, and its angular acceleration; carrier_angle: (n_t, n_members) angle of those axes
     (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force
     (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and bearings are the
-    run's ``static`` values."""
+    run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
+    :func:`disc_names` order (an RV reducer's)."""
     columns = []
     for j in range(len(spec.members)):
         a = acc_carrier[:, j, :]
@@ -204,6 +215,8 @@ def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflecti
         columns += [mesh_force[:, j], mesh_deflection[:, j], mesh_force[:, j] / static_mesh_force[j],
                     mesh_stiffness[:, j]]
     columns += [bearing_force[:, j] for j in range(bearing_force.shape[1])]
+    for j in range(len(disc_names(spec))):
+        columns += [pin_force[:, j].max(axis=-1), (pin_force[:, j] > 0).sum(axis=-1).astype(float)]
     static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
     static.update({f"{name}.force": float(f) for name, f in zip(bearing_names(spec), static_bearing_force)})
     return TimeResult(spec.name, solver, np.asarray(t), train_signals(spec), np.column_stack(columns), settle_time,

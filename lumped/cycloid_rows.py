@@ -1,0 +1,169 @@
+"""The cycloid-pin stage of an RV reducer in the reference model: rows that turn with the eccentrics.
+
+Coordinates are those of the stage's carrier frame (turning at Omega, see :mod:`gearcheck.lumped.assembly`):
+crank k has (radial, tangential, theta) at its place psi_k on the carrier like a planet, disc j and the pin
+wheel have (x, y, theta) along the carrier's axes, every rotation absolute.  Disc j's eccentric points along
+e(phi_j), phi_j(t) = phase_j + (w_H - Omega) t in the carrier frame (the first disc's along the carrier's x
+axis at t = 0); pin i sits at beta_i(t) = 2 pi i / Z_p + (w_w - Omega) t on the pin circle.
+
+* Needle bearing of crank k in disc j: the eccentric's centre minus the disc's bore, two rows (x, y),
+      d = u_Hk + e theta_Hk e_perp(phi_j) - u_j - r_H theta_j e_t(psi_k),
+  the bore sitting at r_H e_r(psi_k) from the disc's centre whatever phi_j (Yang, Chen & Wang 2018 print this
+  block on a non-rotation matrix and with the eccentric frozen; see the audit in the documentation).
+* Pin contact i of disc j, compression only: the common normal passes through the pitch point (Willis),
+      delta = n . (u_j - u_w) + l theta_j - (C_i x n) theta_w - clearance,
+  n and l from :func:`gearcheck.lumped.cycloid.pin_contacts`; force k max(delta, 0) + c delta' while it
+  touches.
+* The disc's nominal orbit e(phi_j) at the crank's absolute speed w_H: its centrifugal load
+  m e w_H^2 e(phi_j(t)) on the disc, written in the carrier frame (the frame's own terms act on the
+  vibration only).
+
+The rows depend on time, and the pins' contact set on the state: the modal and static analyses take the rows
+of t = 0 with the contact set of the static solution (like a turning coupling), the time solver calls
+:meth:`CycloidRows.forces` at every stage.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearcheck.lumped.cycloid import pin_contacts
+
+
+@dataclass(frozen=True)
+class CycloidRows:
+    """The time-periodic rows and loads of one cycloid-pin stage (see the module docstring)."""
+
+    stage: str
+    n: int  # coordinates of the model
+    crank: np.ndarray  # (M, 3) indices of each crank's radial, tangential, theta
+    disc: np.ndarray  # (N, 3) indices of each disc's x, y, theta
+    wheel: np.ndarray | None  # (3,) indices of the pin wheel's x, y, theta; None: fixed
+    psi: np.ndarray  # (M,) crank places on the carrier
+    phases: np.ndarray  # (N,) eccentric phases at t = 0
+    omega_eccentric: float  # w_H - Omega, rad/s
+    omega_pins: float  # w_w - Omega
+    omega_orbit: float  # w_H, the orbit's absolute speed
+    geometry: object  # CycloidGeometry
+    carrier_radius: float
+    needle_stiffness: float
+    needle_damping: float
+    pin_stiffness: float
+    pin_damping: float
+    clearance: float
+    disc_mass: float
+    rows: tuple[str, ...] = ()  # names of its rows in the model, those of time placed_at (forces() in time)
+    placed_at: float = 0.0
+    gap_load: np.ndarray | None = None  # (n,) sum of k gap a over the pins touching at placed_at
+
+    @property
+    def static_load(self) -> np.ndarray:
+        """(n,) the loads of time ``placed_at`` that the model's static load holds: the orbit loads and the
+        pins' gap terms (a row k (a.q - gap) is the row k a.q and the load k gap a)."""
+        return self.orbit_force(self.placed_at) + self.gap_load
+
+    # ------------------------------------------------------------------ geometry at times t
+    def eccentric_angles(self, t) -> np.ndarray:
+        """(..., N) phi_j(t)."""
+        return self.phases + self.omega_eccentric * np.asarray(t, dtype=float)[..., None]
+
+    def pin_angles(self, t) -> np.ndarray:
+        """(...,) angle of pin 0 on the pin circle in the carrier frame."""
+        return self.omega_pins * np.asarray(t, dtype=float)
+
+    def needle_coefficients(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients (..., N, M, 2, 3) of the needle rows on the crank's and on the disc's coordinates."""
+        phi = self.eccentric_angles(t)[..., :, None]  # (..., N, 1)
+        e = self.geometry.eccentricity
+        c, s = np.cos(self.psi), np.sin(self.psi)
+        shape = np.broadcast_shapes(phi.shape, self.psi.shape) + (2, 3)
+        on_crank = np.zeros(shape)
+        on_crank[..., 0, 0], on_crank[..., 1, 0] = c, s  # radial axis e_r
+        on_crank[..., 0, 1], on_crank[..., 1, 1] = -s, c  # tangential axis e_t
+        on_crank[..., 0, 2], on_crank[..., 1, 2] = -e * np.sin(phi), e * np.cos(phi)
+        on_disc = np.zeros(shape)
+        on_disc[..., 0, 0] = on_disc[..., 1, 1] = -1.0
+        on_disc[..., 0, 2], on_disc[..., 1, 2] = self.carrier_radius * s, -self.carrier_radius * c
+        return on_crank, on_disc
+
+    def pin_coefficients(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients (..., N, Z_p, 3) of the pin rows on the disc's and on the pin wheel's coordinates."""
+        phi = self.eccentric_angles(t)
+        contacts = pin_contacts(self.geometry, phi, self.pin_angles(t)[..., None])
+        return contacts.disc_row, contacts.wheel_row
+
+    def orbit_force(self, t) -> np.ndarray:
+        """(..., n) the discs' centrifugal loads of their nominal orbits."""
+        phi = self.eccentric_angles(t)
+        scale = self.disc_mass * self.geometry.eccentricity * self.omega_orbit**2
+        out = np.zeros(np.shape(phi)[:-1] + (self.n,))
+        out[..., self.disc[:, 0]] = scale * np.cos(phi)
+        out[..., self.disc[:, 1]] = scale * np.sin(phi)
+        return out
+
+    # ------------------------------------------------------------------ rows and forces
+    def needle_rows(self, t: float) -> list[tuple[str, np.ndarray]]:
+        """The needle bearings' rows at one time, named."""
+        on_crank, on_disc = self.needle_coefficients(t)
+        out = []
+        for j, disc in enumerate(self.disc):
+            for k, crank in enumerate(self.crank):
+                for axis, name in enumerate("xy"):
+                    a = np.zeros(self.n)
+                    a[crank] += on_crank[j, k, axis]
+                    a[disc] += on_disc[j, k, axis]
+                    out.append((f"{self.stage}.crank{k + 1}.disc{j + 1}.needle_{name}", a))
+        return out
+
+    def pin_rows(self, t: float) -> list[tuple[str, np.ndarray]]:
+        """Every pin contact's row at one time, named (disc j, pin i)."""
+        on_disc, on_wheel = self.pin_coefficients(t)
+        out = []
+        for j, disc in enumerate(self.disc):
+            for i in range(on_disc.shape[-2]):
+                a = np.zeros(self.n)
+                a[disc] += on_disc[j, i]
+                if self.wheel is not None:
+                    a[self.wheel] += on_wheel[j, i]
+                out.append((f"{self.stage}.disc{j + 1}.pin{i + 1}", a))
+        return out
+
+    def pin_deflections(self, t, q) -> np.ndarray:
+        """(..., N, Z_p) compression of every pin contact (negative: apart), time along axis 0 allowed."""
+        return self._pins(self.pin_coefficients(t), q, np.zeros_like(np.asarray(q, dtype=float)))[0]
+
+    def pin_forces(self, t, q, v) -> np.ndarray:
+        """(..., N, Z_p) normal force of every pin contact, N (0 where apart)."""
+        return self._pins(self.pin_coefficients(t), q, v)[1]
+
+    def _pins(self, coefficients, q, v):
+        on_disc, on_wheel = coefficients
+        q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
+        delta = np.einsum("...jik,...jk->...ji", on_disc, q[..., self.disc]) - self.clearance
+        rate = np.einsum("...jik,...jk->...ji", on_disc, v[..., self.disc])
+        if self.wheel is not None:
+            delta = delta + np.einsum("...jik,...k->...ji", on_wheel, q[..., self.wheel])
+            rate = rate + np.einsum("...jik,...k->...ji", on_wheel, v[..., self.wheel])
+        return delta, np.where(delta > 0.0, self.pin_stiffness * delta + self.pin_damping * rate, 0.0)
+
+    def forces(self, t, q, v) -> np.ndarray:
+        """Generalized forces (time along axis 0 allowed) of the needle bearings, the pin contacts and the
+        orbit loads, less :attr:`static_load` (which the model's static load holds)."""
+        q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
+        out = self.orbit_force(t) - self.static_load
+        on_crank, on_disc = self.needle_coefficients(t)
+        d = (np.einsum("...jkal,...kl->...jka", on_crank, q[..., self.crank])
+             + np.einsum("...jkal,...jl->...jka", on_disc, q[..., self.disc]))
+        rate = (np.einsum("...jkal,...kl->...jka", on_crank, v[..., self.crank])
+                + np.einsum("...jkal,...jl->...jka", on_disc, v[..., self.disc]))
+        f = self.needle_stiffness * d + self.needle_damping * rate  # (..., N, M, 2)
+        out[..., self.crank] -= np.einsum("...jka,...jkal->...kl", f, on_crank)
+        out[..., self.disc] -= np.einsum("...jka,...jkal->...jl", f, on_disc)
+        coefficients = self.pin_coefficients(t)
+        p = self._pins(coefficients, q, v)[1]  # (..., N, Z_p)
+        out[..., self.disc] -= np.einsum("...ji,...jik->...jk", p, coefficients[0])
+        if self.wheel is not None:
+            out[..., self.wheel] -= np.einsum("...ji,...jik->...k", p, coefficients[1])
+        return out

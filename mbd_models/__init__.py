@@ -9,7 +9,9 @@ equations (a test keeps it so).
 * ``mjcf_builder`` -- the MJCF text;
 * ``twin`` -- :func:`~gearcheck.mbd_models.twin.compile_train`, the compiled twin with named indices;
 * ``linearise`` -- MuJoCo's own M and K, natural frequencies and the highest one;
-* ``runner`` -- the driven run and the static state;
+* ``runner`` -- the driven run;
+* ``static_state`` -- the steady rotating state at the operating point (the runner's start);
+* ``cycloid_twin`` -- an RV reducer's pin contacts, which follow the discs every step;
 * ``forces`` -- mesh and bearing forces read from MuJoCo's generalized forces;
 * ``published_twin`` -- the twin of the 4-DOF model of Matejic et al. (2021);
 * ``side`` -- both as the cross-check sees them.

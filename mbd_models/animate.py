@@ -27,6 +27,7 @@ from PIL import Image, ImageDraw, ImageFont
 from gearcheck.lumped.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.runner import _LeanStepper, _Stepper, static_state
+from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import GearcheckError, SolverError
@@ -100,27 +101,23 @@ def _add_spokes(model: mujoco.MjModel, data: mujoco.MjData, scene: mujoco.MjvSce
 
 def _reference(mb: MbdModel, hinge0: np.ndarray, t: float) -> np.ndarray:
     """The rigid-body qpos at time t: hinges at ``hinge0`` plus their kinematic speed times t, slides at 0."""
-    q = np.zeros(mb.model.nq)
-    for mid, member in mb.spec.members.items():
-        carrier = f"{member.stage}.carrier"
-        rz = mb.qadr[mid][2]
-        speed = mb.kin.speeds[mid] - (mb.kin.speeds[carrier] if member.is_planet else 0.0)
-        q[rz] = hinge0[rz] + speed * t
-    return q
+    m = mb.model
+    hinge = m.jnt_type == mujoco.mjtJoint.mjJNT_HINGE  # hinge and slide joints only: qpos and dof addresses coincide
+    return np.where(hinge, hinge0 + nominal_speeds(mb) * t, 0.0)
 
 
 @contextmanager
 def stepping_model(mb: MbdModel, dt: float):
     """The model set up for the runner's RK4 stepping, put back afterwards."""
     m = mb.model
-    saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy(), m.opt.timestep,
-             m.opt.integrator)
+    saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy(), m.tendon_damping.copy(),
+             m.opt.timestep, m.opt.integrator)
     m.opt.timestep, m.opt.integrator = dt, mujoco.mjtIntegrator.mjINT_RK4
     try:
         yield
     finally:
-        m.tendon_stiffness[:], m.tendon_lengthspring[:], m.wrap_prm[:] = saved[:3]
-        m.opt.timestep, m.opt.integrator = saved[3:]
+        m.tendon_stiffness[:], m.tendon_lengthspring[:], m.wrap_prm[:], m.tendon_damping[:] = saved[:4]
+        m.opt.timestep, m.opt.integrator = saved[4:]
 
 
 class TwinPlayer:
@@ -285,7 +282,7 @@ def _shape_scale(mb: MbdModel, shape: np.ndarray) -> float:
     for mid, member in mb.spec.members.items():
         body = mb.body[mid]
         rim = float(max(m.geom_rbound[m.body_geomadr[body]:m.body_geomadr[body] + m.body_geomnum[body]], default=0))
-        a, b = ("radial", "tangential") if member.is_planet else ("x", "y")
+        a, b = ("radial", "tangential") if member.orbits else ("x", "y")
         biggest = max(biggest, math.hypot(phys[f"{mid}.{a}"], phys[f"{mid}.{b}"]) + rim * abs(phys[f"{mid}.theta"]))
     return MODE_SIZE * m.stat.extent / biggest if biggest > 0 else 0.0
 

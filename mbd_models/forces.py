@@ -1,18 +1,16 @@
 """Mesh and bearing forces as MuJoCo computed them, read from its generalized forces.
 
 MuJoCo keeps no per-tendon force, only the generalized spring and damper forces
-(``qfrc_spring``, ``qfrc_damper``) that its tendons and joints add up to.  At a planet's three
-joints (radial and tangential slides, hinge) only two things act: the planet's bearing (the slides'
-joint stiffness and damping) and the planet's mesh tendons.  So:
+(``qfrc_spring``, ``qfrc_damper``) that its tendons and joints add up to.  Two probe copies of the model,
+evaluated by ``mj_passive`` on the same state, take them apart:
 
-* a probe copy of the model with every joint spring and damper and every coupling tendon removed
-  gives, through ``mj_passive`` on the same state, the mesh tendons' generalized forces alone,
-  J_P^T f at the planet joints (J_P: the mesh tendons' coefficients on those joints, which do not
-  turn with the carrier and are constant);
-* the mesh force F = -(f + g) with f = P (J_P^T f) for P the left inverse of J_P^T, and g the
-  runner's own damping correction (``qfrc_applied`` = J^T g; see :mod:`gearcheck.mbd_models.runner`);
-* the bearing force is minus the planet slides' joint forces: the model's generalized forces at the
-  slides less the probe's.
+* the mesh probe, with every joint spring and damper and every tendon but the meshes removed, gives the mesh
+  tendons' generalized forces alone, J_P^T f at the planets' joints (J_P: the mesh tendons' coefficients on
+  those joints, which do not turn with the carrier and are constant); the mesh force is F = -(f + g) with
+  f = P (J_P^T f) for P the left inverse of J_P^T, and g the runner's own damping correction
+  (``qfrc_applied`` = J^T g; see :mod:`gearcheck.mbd_models.runner`);
+* the bearing probe, with every tendon removed, gives the joints' own springs and dampers: a bearing force
+  (of a planet, or of an RV reducer's crankshaft on its carrier) is minus its slides' joint forces.
 
 Nothing here restates a force law: the dead band, the spring and the damper are MuJoCo's.
 """
@@ -39,9 +37,13 @@ class ForceReader:
         self.probe.dof_damping[:] = 0.0
         self.probe.tendon_stiffness[self.n_mesh:] = 0.0
         self.probe.tendon_damping[self.n_mesh:] = 0.0
+        self.joints_only = copy.copy(m)
+        self.joints_only.tendon_stiffness[:] = 0.0
+        self.joints_only.tendon_damping[:] = 0.0
         planets = [mid for mid, member in mb.spec.members.items() if member.is_planet]
         self.dofs = np.array([dof for mid in planets for dof in mb.dadr[mid]], dtype=int)
-        self.slides = np.array([3 * i + axis for i in range(len(planets)) for axis in (0, 1)], dtype=int)
+        self.slides = np.array([dof for mid, member in mb.spec.members.items() if member.orbits and member.bearing
+                                for dof in mb.dadr[mid][:2]], dtype=int)
         J_P = mb.mesh_jacobian()[:, self.dofs]
         if np.linalg.matrix_rank(J_P) < self.n_mesh:
             raise SolverError(f"{mb.spec.name}: the mesh forces cannot be told apart at the planets' joints "
@@ -56,24 +58,25 @@ class ForceReader:
 
     @property
     def width(self) -> int:
-        return 3 * len(self.dofs)
+        return 2 * len(self.dofs) + len(self.slides)
 
     def sample(self, out: np.ndarray) -> None:
-        """After ``mj_forward``: write the planet joints' (model, mesh-only, applied) generalized forces
-        into ``out`` (one row of :attr:`width`), for :meth:`forces`.  Leaves the data's passive forces those
-        of the probe (nothing that ``mj_RungeKutta`` reads)."""
+        """After ``mj_forward``: write the planet joints' (mesh-only, applied) generalized forces and the bearing
+        slides' joint forces into ``out`` (one row of :attr:`width`), for :meth:`forces`.  Leaves the data's
+        passive forces those of a probe (nothing that ``mj_RungeKutta`` reads)."""
         n, dofs, total = len(self.dofs), self.dofs, self._sum
-        np.add(self._spring, self._damper, out=total)
-        out[:n] = total[dofs]
         self._probe_stiffness[:] = self._stiffness
         self._probe_lengths[:] = self._lengths
         mujoco.mj_passive(self.probe, self.d)
         np.add(self._spring, self._damper, out=total)
-        out[n:2 * n] = total[dofs]
-        out[2 * n:] = self._applied[dofs]
+        out[:n] = total[dofs]
+        out[n:2 * n] = self._applied[dofs]
+        mujoco.mj_passive(self.joints_only, self.d)
+        np.add(self._spring, self._damper, out=total)
+        out[2 * n:] = total[self.slides]
 
     def forces(self, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(mesh forces (n, n_mesh), bearing forces (n, n_bearing)) from rows written by :meth:`sample`."""
         n = len(self.dofs)
-        model, mesh, applied = samples[:, :n], samples[:, n:2 * n], samples[:, 2 * n:]
-        return -(mesh + applied) @ self.P.T, -(model - mesh)[:, self.slides]
+        mesh, applied, bearing = samples[:, :n], samples[:, n:2 * n], samples[:, 2 * n:]
+        return -(mesh + applied) @ self.P.T, -bearing

@@ -1,4 +1,5 @@
-"""Visual meshes of the involute gears of a train, for MuJoCo's viewer and offscreen renders.
+"""Visual meshes of the involute gears of a train (and of an RV reducer's cycloid discs: their exact profile,
+:func:`gearcheck.lumped.cycloid.disc_profile`), for MuJoCo's viewer and offscreen renders.
 
 Visual only: the geoms that carry these meshes are contact-free (contype = conaffinity = 0) and the
 bodies' mass and inertia come from their explicit ``<inertial>`` (the compiler has
@@ -28,6 +29,7 @@ import math
 
 import numpy as np
 
+from gearcheck.lumped.cycloid import CycloidGeometry, disc_profile
 from gearcheck.lumped.geometry import Gear, base_tooth_thickness
 from gearcheck.lumped.spec import TrainSpec
 
@@ -35,6 +37,7 @@ FLANK_POINTS = 4  # per flank, evenly spaced in roll length
 HELIX_SLICES = 4  # extrusion slices of a helical gear
 RIM = 2.0  # ring rim outside the root circle, in modules
 UNIT = 1e-6  # vertex coordinates are written in integer micrometres (mesh scale)
+DISC_POINTS = 8  # profile points per lobe of a cycloid disc
 
 
 def relief(gear: Gear, r: np.ndarray) -> np.ndarray:
@@ -175,9 +178,31 @@ def phases(spec: TrainSpec) -> dict[tuple[str, str], float]:
     return placed
 
 
+def disc_mesh(geometry: CycloidGeometry, points_per_lobe: int = DISC_POINTS) -> tuple[np.ndarray, np.ndarray]:
+    """Closed, outward-oriented triangle mesh of a cycloid disc (its exact profile, star-shaped about its centre,
+    extruded over its thickness and fanned from the axis on each end), centred on z = 0; no bores."""
+    x, y = disc_profile(geometry, points_per_lobe=points_per_lobe).T
+    n, half = len(x), 0.5 * geometry.contact_length
+    vertices = np.vstack([np.column_stack([x, y, np.full(n, z)]) for z in (-half, half)] + [[[0.0, 0.0, -half],
+                                                                                             [0.0, 0.0, half]]])
+    faces = []
+    for i in range(n):
+        k = (i + 1) % n
+        faces += [(i, k, n + k), (i, n + k, n + i), (n + i, n + k, 2 * n + 1), (i, 2 * n, k)]
+    return vertices, np.array(faces, dtype=int)
+
+
+def disc_asset(name: str, geometry: CycloidGeometry) -> str:
+    """``<mesh>`` element of a cycloid disc (:func:`disc_mesh`)."""
+    return _mesh_element(name, *disc_mesh(geometry))
+
+
 def mesh_asset(name: str, gear: Gear) -> str:
     """``<mesh>`` element of ``gear`` with inline vertices (integer micrometres, scaled) and faces."""
-    vertices, faces = gear_mesh(gear)
+    return _mesh_element(name, *gear_mesh(gear))
+
+
+def _mesh_element(name: str, vertices: np.ndarray, faces: np.ndarray) -> str:
     v = " ".join(str(int(x)) for x in np.rint(vertices / UNIT).ravel())
     f = " ".join(str(int(x)) for x in faces.ravel())
     return f'<mesh name="{name}" scale="{UNIT!r} {UNIT!r} {UNIT!r}" vertex="{v}" face="{f}"/>'

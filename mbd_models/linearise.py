@@ -19,16 +19,24 @@ M q_r'' = (A + B P - M P^2) q_r + (B - 2 M P) q_r', P = Omega J on those slides.
 Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions of the central
 members' slides (translation) and hinges (rotation), classified by
 :func:`gearcheck.shared.modal.mode_types`; they do not depend on MuJoCo's choice of coordinates
-(planet slides relative to the carrier).
+(planet slides relative to the carrier).  An RV reducer's cycloid discs sit in polar joints, which mix
+translation and rotation: their x, y along the carrier's axes and their rotation take those joints' place
+(:func:`_disc_axes`; at speed with the rates of that change of coordinates, as for the world-frame slides),
+and its pins are those of its static contact set of t = 0, linear springs at the nominal configuration as
+every other connection.
 
 Every function takes a compiled twin (:class:`gearcheck.mbd_models.twin.MbdModel`).
 """
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import mujoco
 import numpy as np
 
+from gearcheck.mbd_models.mjcf_builder import CENTRAL_AXES, member_axes
+from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
 from gearcheck.shared.units import rad_s_to_rpm
@@ -55,62 +63,86 @@ def mass_matrix(mb, qpos: np.ndarray | None = None) -> np.ndarray:
     return M
 
 
+@contextmanager
+def _frozen(mb, qpos: np.ndarray, every_pin: bool = False):
+    """An RV reducer's pin contacts as linear springs at ``qpos`` on its static contact set of t = 0 (or on
+    every pin: the stiffest the twin can be), their coefficients MuJoCo's Jacobians there; the tendon fields are
+    restored afterwards.  Nothing for other trains."""
+    if mb.cycloid is None:
+        yield
+        return
+    m = mb.model
+    saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.tendon_damping.copy(), m.wrap_prm.copy())
+    try:
+        d = mujoco.MjData(m)
+        d.qpos[:] = qpos
+        mb.cycloid.refresh(d, np.ones_like(mb.cycloid.contacts) if every_pin else mb.cycloid.contacts)
+        yield
+    finally:
+        m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.wrap_prm[:] = saved
+
+
 def stiffness_matrix(mb, tendon_stiffness: np.ndarray | None = None,
-                     qpos: np.ndarray | None = None) -> np.ndarray:
+                     qpos: np.ndarray | None = None, every_pin: bool = False) -> np.ndarray:
     """-d(qfrc_passive + qfrc_actuator)/dqpos by central differences, at rest.
 
     tendon_stiffness: optional stiffness of the mesh tendons (one per mesh) used
     instead of the model's own values (which are restored afterwards).  A backlash
     dead band is closed for the linearisation (the teeth in contact on their loaded
-    flank), so a mesh contributes its stiffness k and not the 0 of the band's inside.
+    flank), so a mesh contributes its stiffness k and not the 0 of the band's inside;
+    an RV reducer's pins are those of its static contact set of t = 0 (``every_pin``: all).
     """
     m = mb.model
     saved = m.tendon_stiffness.copy()
     saved_length = m.tendon_lengthspring.copy()
+    q0 = (m.qpos0 if qpos is None else qpos).copy()
     try:
         m.tendon_lengthspring[mb.mesh_tendon] = 0.0
         if tendon_stiffness is not None:
             m.tendon_stiffness[mb.mesh_tendon] = tendon_stiffness
         d = mujoco.MjData(m)
-        q0 = (m.qpos0 if qpos is None else qpos).copy()
         K = np.zeros((m.nv, m.nv))
-        for j in range(m.nv):  # hinge and slide joints only: qpos and dof addresses coincide
-            forces = []
-            for sign in (1.0, -1.0):
-                q = q0.copy()
-                q[j] += sign * FD_STEP
-                _set_rest(mb, d, q)
-                mujoco.mj_forward(m, d)
-                forces.append(d.qfrc_passive + d.qfrc_actuator)
-            K[:, j] = -(forces[0] - forces[1]) / (2.0 * FD_STEP)
+        with _frozen(mb, q0, every_pin):
+            for j in range(m.nv):  # hinge and slide joints only: qpos and dof addresses coincide
+                forces = []
+                for sign in (1.0, -1.0):
+                    q = q0.copy()
+                    q[j] += sign * FD_STEP
+                    _set_rest(mb, d, q)
+                    mujoco.mj_forward(m, d)
+                    forces.append(d.qfrc_passive + d.qfrc_actuator)
+                K[:, j] = -(forces[0] - forces[1]) / (2.0 * FD_STEP)
     finally:
         m.tendon_stiffness[:] = saved
         m.tendon_lengthspring[:] = saved_length
     return 0.5 * (K + K.T)
 
 
-def damping_matrix(mb, qpos: np.ndarray | None = None) -> np.ndarray:
+def damping_matrix(mb, qpos: np.ndarray | None = None, every_pin: bool = False) -> np.ndarray:
     """-d(qfrc_passive + qfrc_actuator)/dqvel by central differences, at rest: the joints' and tendons'
-    damping and the input shaft's damper."""
+    damping, the input shaft's damper and an RV reducer's needle bearings and pins (as in
+    :func:`stiffness_matrix`)."""
     m = mb.model
     d = mujoco.MjData(m)
     q0 = m.qpos0 if qpos is None else qpos
     C = np.zeros((m.nv, m.nv))
-    for j in range(m.nv):
-        forces = []
-        for sign in (1.0, -1.0):
-            _set_rest(mb, d, q0)
-            d.qvel[j] = sign * FD_STEP
-            mujoco.mj_forward(m, d)
-            forces.append(d.qfrc_passive + d.qfrc_actuator)
-        C[:, j] = -(forces[0] - forces[1]) / (2.0 * FD_STEP)
+    with _frozen(mb, q0, every_pin):
+        for j in range(m.nv):
+            forces = []
+            for sign in (1.0, -1.0):
+                _set_rest(mb, d, q0)
+                d.qvel[j] = sign * FD_STEP
+                mujoco.mj_forward(m, d)
+                forces.append(d.qfrc_passive + d.qfrc_actuator)
+            C[:, j] = -(forces[0] - forces[1]) / (2.0 * FD_STEP)
     return C
 
 
 def step_limits(mb) -> stepping.StepLimits:
-    """RK4 step limits of the MuJoCo model with every mesh at its cycle-maximum stiffness, damping included."""
-    return stepping.StepLimits.of(mass_matrix(mb), stiffness_matrix(mb, mb.excitation.max_stiffness),
-                                  damping_matrix(mb))
+    """RK4 step limits of the MuJoCo model with every mesh at its cycle-maximum stiffness (and every pin of an
+    RV reducer touching), damping included."""
+    return stepping.StepLimits.of(mass_matrix(mb), stiffness_matrix(mb, mb.excitation.max_stiffness, every_pin=True),
+                                  damping_matrix(mb, every_pin=True))
 
 
 def joint_labels(mb) -> list[str]:
@@ -120,14 +152,17 @@ def joint_labels(mb) -> list[str]:
 
 def modes(mb) -> ModalResult:
     """Natural frequencies and mode types of the MuJoCo model at mean mesh stiffness (solver "mujoco")."""
-    return modal_result(mb.spec.name, "mujoco", stiffness_matrix(mb, mb.excitation.mean_stiffness), mass_matrix(mb),
-                        joint_labels(mb), *_central(mb))
+    S = _disc_axes(mb)[0]
+    result = modal_result(mb.spec.name, "mujoco", S.T @ stiffness_matrix(mb, mb.excitation.mean_stiffness) @ S,
+                          S.T @ mass_matrix(mb) @ S, joint_labels(mb), *_central(mb))
+    result.shapes = S @ result.shapes  # in MuJoCo's joints
+    return result
 
 
 def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
     """(labels, T): the train's physical coordinates as MuJoCo moves them, T (n, nv) mapping a small joint
     motion to them, read from MuJoCo's own Jacobians at rest: each member's centre moves along x, y (a
-    planet: along its radial and tangential axes), it turns about z, and in a helical stage it moves
+    planet or a crankshaft: along its radial and tangential axes), it turns about z, and in a helical stage it moves
     along z.  The labels are ``member.x`` ... as the lumped model names its coordinates."""
     m = mb.model
     d = mujoco.MjData(m)
@@ -138,7 +173,7 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
         body = mb.body[mid]
         jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
         mujoco.mj_jac(m, d, jp, jr, d.xipos[body], body)
-        if member.is_planet:
+        if member.orbits:
             c, s = np.cos(member.angle), np.sin(member.angle)
             axes = {"radial": np.array([c, s, 0.0]), "tangential": np.array([-s, c, 0.0])}
         else:
@@ -154,10 +189,34 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
 
 def _central(mb) -> tuple[list[int], list[int]]:
     """(translation, rotation) dofs of the central members; an axial slide goes with the rotation (a helical
-    mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes)."""
-    central = [mid for mid, member in mb.spec.members.items() if not member.is_planet]
+    mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes).  A cycloid disc's are
+    its x, y and rotation in place of its polar joints (:func:`_disc_axes`)."""
+    central = [mid for mid, member in mb.spec.members.items() if not member.orbits]
     axial = [dof for mid in central if (dof := _axial_dof(mb, mid)) is not None]
     return [i for mid in central for i in mb.dadr[mid][:2]], [mb.dadr[mid][2] for mid in central] + axial
+
+
+def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(S, S', S''): MuJoCo's joint deviations q = S x, x a cycloid disc's displacement along its carrier's axes and
+    its rotation in place of its polar joints (orbit, radial, own hinge), the identity elsewhere; and S's first
+    two time derivatives with the train turning at ``speed_ratio`` times its nominal speeds (the eccentric, at
+    angle psi from the carrier's x axis, turning at w_H - Omega).  With (r, t) = x . (e_r(psi), e_t(psi)): radial
+    slide r, orbit t / e, own hinge rotation - t / e."""
+    n = mb.model.nv
+    S, dS, ddS = np.eye(n), np.zeros((n, n)), np.zeros((n, n))
+    for mid, member in mb.spec.members.items():
+        if member.kind != "disc":
+            continue
+        stage = mb.spec.stage_of(mid)
+        cyc = stage.cycloid
+        e, psi = cyc.geometry.eccentricity, cyc.phases[cyc.discs.index(mid)]
+        rate = speed_ratio * (mb.kin.speeds[cyc.cranks[0]] - mb.kin.speeds[stage.carrier])
+        i = np.ix_(mb.dadr[mid], mb.dadr[mid])
+        for out, scale, angle in ((S, 1.0, psi), (dS, rate, psi + 0.5 * np.pi), (ddS, rate**2, psi + np.pi)):
+            c, s = np.cos(angle), np.sin(angle)  # d/dpsi (cos, sin) = (cos, sin) of psi + pi/2
+            out[i] = scale * np.array([[-s / e, c / e, 0.0], [c, s, 0.0], [s / e, -c / e, 0.0]])
+        S[mb.dadr[mid][2], mb.dadr[mid][2]] = 1.0
+    return S, dS, ddS
 
 
 def _axial_dof(mb, mid: str) -> int | None:
@@ -181,14 +240,18 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
         if "input_shaft_damper" in mb.actuator:
             m.actuator_gainprm[mb.actuator["input_shaft_damper"], 0] = 0.0
             m.actuator_biasprm[mb.actuator["input_shaft_damper"], 2] = 0.0
+        q0, v0 = m.qpos0.copy(), ratio * nominal_speeds(mb)
         d = mujoco.MjData(m)
-        q0, v0 = m.qpos0.copy(), np.zeros(m.nv)
-        P = np.zeros((m.nv, m.nv))
+        if mb.cycloid:  # the pins of t = 0 frozen, undamped, as the needle bearings
+            d.qpos[:] = q0
+            mb.cycloid.refresh(d, mb.cycloid.contacts)
+            m.tendon_damping[mb.cycloid.tendons] = 0.0
+            m.actuator_biasprm[mb.cycloid.needles.ravel(), 2] = 0.0
+        P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier
         for mid, member in mb.spec.members.items():
-            ix, iy, ir = mb.dadr[mid]
-            omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
-            v0[ir] = ratio * mb.kin.speeds[mid] - (omega if member.is_planet else 0.0)  # planet hinges: relative
-            if not member.is_planet:
+            if member_axes(member) == CENTRAL_AXES:
+                ix, iy, _ = mb.dadr[mid]
+                omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
                 P[ix, iy], P[iy, ix] = -omega, omega
 
         def force(q, v):
@@ -197,6 +260,7 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
             mujoco.mj_forward(m, d)
             return d.qfrc_passive + d.qfrc_actuator - d.qfrc_bias
 
+        unbalanced = force(q0, v0)  # the orbits' centripetal loads, which no spring carries at the nominal pose
         A, B = np.zeros((m.nv, m.nv)), np.zeros((m.nv, m.nv))
         for j in range(m.nv):  # hinge and slide joints only: qpos and dof addresses coincide
             e = np.zeros(m.nv)
@@ -208,6 +272,27 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
     finally:
         (m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.dof_damping[:],
          m.actuator_gainprm[:], m.actuator_biasprm[:], m.wrap_prm[:]) = saved
-    # in the carriers' axes: M s^2 + D s + K with D = -(B - 2 M P), K = -(A + B P - M P^2)
-    return speed_modal_result(mb.spec.name, "mujoco", M, 2 * M @ P - B, M @ P @ P - A - B @ P,
-                              joint_labels(mb), *_central(mb), rad_s_to_rpm(input_speed))
+    # in the carriers' axes, q = S(t) x (world-frame slides: S = R(Omega t), S' = P, S'' = P^2; discs: _disc_axes):
+    # S^T (M S x'' + (2 M S' - B S) x' + (M S'' - B S' - A S) x) = 0
+    # (a disc's polar joints are curved in x: its unbalanced load f adds - sum_k f_k d2q_k/dx2)
+    S, dS, ddS = _disc_axes(mb, ratio)
+    dS, ddS = dS + P, ddS + P @ P
+    return speed_modal_result(mb.spec.name, "mujoco", S.T @ M @ S, S.T @ (2 * M @ dS - B @ S),
+                              S.T @ (M @ ddS - B @ dS - A @ S) + _disc_curvature(mb, unbalanced), joint_labels(mb),
+                              *_central(mb), rad_s_to_rpm(input_speed))
+
+
+def _disc_curvature(mb, force: np.ndarray) -> np.ndarray:
+    """-sum_k f_k d2q_k/dx2 over a disc's polar joints k (:func:`_disc_axes`), ``force`` the generalized force f on
+    them: with (r, t) its displacement along and across its eccentric, radial slide sqrt((e + r)^2 + t^2) - e and
+    orbit atan2(t, e + r) (own hinge: minus that) have the second derivatives 1/e in t^2 and -1/e^2 in r t."""
+    K = np.zeros((mb.model.nv, mb.model.nv))
+    for mid, member in mb.spec.members.items():
+        if member.kind == "disc":
+            cyc = mb.spec.stage_of(mid).cycloid
+            e, psi = cyc.geometry.eccentricity, cyc.phases[cyc.discs.index(mid)]
+            orbit, radial, own = force[list(mb.dadr[mid])]
+            axes = np.array([[np.cos(psi), np.sin(psi)], [-np.sin(psi), np.cos(psi)]])  # rows e_r, e_t
+            curvature = np.array([[0.0, (orbit - own) / e**2], [(orbit - own) / e**2, -radial / e]])
+            K[np.ix_(mb.dadr[mid][:2], mb.dadr[mid][:2])] = axes.T @ curvature @ axes
+    return K

@@ -12,6 +12,8 @@ Per step (fixed step h, MuJoCo's RK4 integrator):
   any input torque into the ``output_load`` / ``input_torque`` motors;
 * the mesh tendons' world-frame slide coefficients turned to the carrier's current angle
   (:class:`~gearcheck.mbd_models.twin.TurningCoefficients`; the angle-0 values came from ``mj_jac``);
+  an RV reducer's pin tendons set to the discs' current poses
+  (:meth:`~gearcheck.mbd_models.cycloid_twin.CycloidTwin.refresh`);
 * the damping correction, a generalized force J^T g with g = c (de/dt - m): a fixed tendon's
   velocity J qvel misses the part m = (dc/dphi) phi' q of its coefficients turning with the carrier,
   and the transmission error's rate de/dt belongs to the mesh's damping force too, so the mesh
@@ -36,29 +38,30 @@ included (``MbdModel.limits``); the rule of :mod:`gearcheck.shared.stepping`, th
 solver's.
 
 Start: the steady rotating state at the nominal operating point of the MuJoCo model
-itself (:func:`static_state`): a Newton solve on MuJoCo's forward dynamics for the
-deflections at which every body turns at its nominal speed with the deflection pattern
-turning with its carrier.
+itself (:func:`~gearcheck.mbd_models.static_state.static_state`): a Newton solve on MuJoCo's
+forward dynamics for the deflections at which every body turns at its nominal speed with the
+deflection pattern turning with its carrier.
 
 Outputs: accelerations from MuJoCo's ``framelinacc``/``frameangacc`` sensors, mesh deflections from
 its tendon lengths, mesh and bearing forces from its generalized forces
-(:class:`~gearcheck.mbd_models.forces.ForceReader`).
+(:class:`~gearcheck.mbd_models.forces.ForceReader`); an RV reducer's pin forces from its pin tendons and its
+needle bearings' forces from their actuators.
 """
 
 from __future__ import annotations
 
 import math
 import time as clock
-from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
 from gearcheck.mbd_models.forces import ForceReader
+from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
-from gearcheck.shared.results import TimeResult, train_result
+from gearcheck.shared.results import Signal, TimeResult, train_result
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
@@ -132,145 +135,6 @@ class _ToothContacts:
                                                                   where=total > 0))[:, None]
 
 
-# --------------------------------------------------------------------------- damping correction
-
-
-class _DampingCorrection:
-    """g = c (de/dt - m) per mesh as the generalized force J^T g (``qfrc_applied``), J the mesh tendons'
-    current coefficients, m the deflection rate their turning coefficients add (see the module doc)."""
-
-    def __init__(self, mb: MbdModel, d: mujoco.MjData):
-        self.mb, self.d = mb, d
-        tc = mb.turning
-        self.c = mb.mesh_damping
-        self.J = mb.mesh_jacobian()
-        self.c_wrap = np.zeros((len(mb.mesh_tendon), len(tc.wraps)))  # mesh damping per turning wrap
-        self.c_wrap[tc.tendon, np.arange(len(tc.wraps))] = self.c[tc.tendon]
-        self.half = len(tc.wraps) // 2
-
-    def apply(self, de) -> None:
-        tc, d, n = self.mb.turning, self.d, self.half
-        coef = self.mb.model.wrap_prm[tc.wraps]
-        self.J[tc.tendon, tc.slide_dof] = coef
-        turned = np.concatenate([-coef[n:], coef[:n]])  # dc/dphi: the pair (x, y) turns as (-y, x)
-        g = -(self.c_wrap @ (turned * d.qvel[tc.carrier_qadr] * d.qpos[tc.slide_qadr]))
-        if de is not None:
-            g += self.c * de
-        d.qfrc_applied[:] = g @ self.J
-
-
-# --------------------------------------------------------------------------- static state
-
-
-@dataclass
-class StaticState:
-    qpos: np.ndarray
-    qvel: np.ndarray
-    mesh_deflection: np.ndarray
-    mesh_force: np.ndarray
-    bearing_force: np.ndarray  # in gearcheck.shared.results.bearing_names order
-    iterations: int
-    residual: float
-
-
-def _nominal(mb: MbdModel, q: np.ndarray):
-    """State (qpos, qvel) and the steady-rotation acceleration of deflection q at t = 0.
-
-    Every body turns at its nominal speed (planet hinges relative to their carrier),
-    and a central member's world-frame deflection turns with its carrier: x' = Omega k x x,
-    x'' = -Omega^2 x.
-    """
-    spec, kin = mb.spec, mb.kin
-    qvel = np.zeros_like(q)
-    target = np.zeros_like(q)
-    for mid, member in spec.members.items():
-        ix, iy, ir = mb.dadr[mid]
-        omega = kin.speeds[f"{member.stage}.carrier"]
-        if member.is_planet:
-            qvel[ir] = kin.speeds[mid] - omega
-        else:
-            qvel[ix], qvel[iy] = -omega * q[iy], omega * q[ix]
-            target[ix], target[iy] = -omega**2 * q[ix], -omega**2 * q[iy]
-            qvel[ir] = kin.speeds[mid]
-    return q.copy(), qvel, target
-
-
-def _set_static_drive(mb: MbdModel, d: mujoco.MjData, load_scale: float) -> None:
-    kin, a = mb.kin, mb.actuator
-    d.ctrl[:] = 0.0
-    if "input_shaft_damper" in a:
-        d.ctrl[a["input_shaft_damper"]] = mb.spec.operating.input_speed
-    if "input_shaft" not in a:
-        d.ctrl[a["input_torque"]] = kin.input_torque * load_scale
-    d.ctrl[a["output_load"]] = kin.output_torque * load_scale
-
-
-def static_state(mb: MbdModel, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int = 40) -> StaticState:
-    """Steady rotating equilibrium of the MuJoCo model under the mean load (times ``load_scale``).
-
-    Newton's method on r(q) = qacc(q) - qacc_steady(q), with MuJoCo's forward dynamics
-    evaluated at the nominal speeds, every mesh at its mean stiffness, the damping acting on the
-    true deflection rate (zero in steady rotation) and the Jacobian dr/dq by central differences;
-    minimum-norm steps where a free rotation makes it singular.  Backlash: solved first without it,
-    then with every mesh on its drive flank.
-    """
-    m = mb.model
-    d = mujoco.MjData(m)
-    saved_k, saved_l, saved_prm = m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy()
-    t = mb.mesh_tendon
-    correction = _DampingCorrection(mb, d)
-    try:
-        m.tendon_stiffness[t] = mb.excitation.mean_stiffness
-        _set_static_drive(mb, d, load_scale)
-
-        def residual(q):
-            qpos, qvel, target = _nominal(mb, q)
-            d.qpos[:], d.qvel[:] = qpos, qvel
-            mb.refresh(d.qpos)
-            correction.apply(None)
-            mujoco.mj_forward(m, d)
-            return d.qacc - target
-
-        q = m.qpos0.copy()
-        iterations, res = 0, math.inf
-        for band in (False, True):
-            # with backlash the loaded teeth sit on their drive flanks: a spring whose rest length is
-            # +b (the dead band's upper edge) has the same force there and no flat zero-stiffness
-            # region for Newton to wander in (the lumped static solution does the same)
-            m.tendon_lengthspring[t, 0] = mb.half_backlash if band else 0.0
-            m.tendon_lengthspring[t, 1] = mb.half_backlash if band else 0.0
-            if band and not np.any(mb.half_backlash):
-                break
-            for _ in range(max_iter):
-                iterations += 1
-                r0 = residual(q)
-                J = np.empty((m.nv, m.nv))
-                h = 1e-7
-                for j in range(m.nv):
-                    dq = np.zeros(m.nv)
-                    dq[j] = h
-                    J[:, j] = (residual(q + dq) - residual(q - dq)) / (2 * h)
-                step = np.linalg.lstsq(J, -r0, rcond=1e-12)[0]
-                q = q + step
-                res = float(np.max(np.abs(residual(q))))
-                if np.max(np.abs(step)) < tol:
-                    break
-            else:
-                raise SolverError(f"MuJoCo static state of {mb.spec.name}: Newton did not converge "
-                                  f"(residual {res:.3g} m/s^2)")
-        residual(q)
-        reader = ForceReader(mb, d)
-        sample = np.empty((1, reader.width))
-        reader.sample(sample[0])
-        force, bearing = (f[0] for f in reader.forces(sample))
-        qpos, qvel, _ = _nominal(mb, q)
-        return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res)
-    finally:
-        m.tendon_stiffness[:] = saved_k
-        m.tendon_lengthspring[:] = saved_l
-        m.wrap_prm[:] = saved_prm
-
-
 # --------------------------------------------------------------------------- stepping
 
 
@@ -285,7 +149,7 @@ class _Stepper:
         self.n_mesh = len(mb.mesh_tendon)
         self.drive = _Drive(mb)
         self.reader = ForceReader(mb, d)
-        self.correction = _DampingCorrection(mb, d)
+        self.correction = DampingCorrection(mb, d)
         self.lo_hi = np.stack([-mb.half_backlash, mb.half_backlash], axis=1)
         self.clock = _body_clock(mb) if bodies else None
         self.contacts = _ToothContacts(mb) if mb.excitation.relieved.size else None
@@ -293,7 +157,15 @@ class _Stepper:
         self.forces = np.empty((n_samples, self.reader.width))
         self.stiffness = np.empty((n_samples, self.n_mesh)) if bodies or self.contacts else None
         self.energy = np.empty((n_samples, 2)) if energy else None
+        self.cycloid = mb.cycloid
+        self.pins = np.empty((n_samples, len(mb.cycloid.tendons))) if mb.cycloid else None
         self.j = 0
+
+    def refresh(self) -> None:
+        """Turn the mesh tendons' coefficients with their carriers and set the pin tendons to the discs' poses."""
+        self.mb.refresh(self.d.qpos)
+        if self.cycloid is not None:
+            self.cycloid.refresh(self.d)
 
     def set_stage(self, k, u, e, de, pairs=None) -> None:
         """Drive values for the coming stage(s): stiffness, controls, spring lengths, tooth contacts, damping
@@ -315,6 +187,8 @@ class _Stepper:
             self.stiffness[j] = self.m.tendon_stiffness[:self.n_mesh]
         if self.energy is not None:
             self.energy[j] = self.d.energy
+        if self.pins is not None:
+            self.pins[j] = self.cycloid.pin_forces(self.d)
         self.j += 1
 
     def run(self, start: int, stop: int, every: int, values, split) -> None:
@@ -330,7 +204,7 @@ class _Stepper:
             if start + i in split:
                 self.split_step(start + i, split[start + i], (start + i) % every == 0)
                 continue
-            self.mb.refresh(d.qpos)
+            self.refresh()
             if self.clock is not None:
                 k_now, k_later = _body_stiffness(self.mb, self.clock, d.qpos, d.qvel, self.h)
             else:
@@ -349,7 +223,7 @@ class _Stepper:
         for j, (a, length) in enumerate(zip(*stepping.sub_steps(step * self.h, self.h, inner))):
             m.opt.timestep = length
             first, later = zip(*self.drive.steps(np.array([a]), length))
-            self.mb.refresh(d.qpos)
+            self.refresh()
             self.set_stage(*(None if x is None else x[0] for x in first))
             mujoco.mj_forward(m, d)
             if sample and j == 0:
@@ -360,7 +234,7 @@ class _Stepper:
 
     def finish(self, t_end: float) -> None:
         """Sample the final state (the drive of the step that would start there)."""
-        self.mb.refresh(self.d.qpos)
+        self.refresh()
         k, u, e, de, pairs = self.drive.at(np.array([t_end + STAGE_OFFSETS[0] * self.h]))
         if self.clock is not None:
             k = _body_stiffness(self.mb, self.clock, self.d.qpos, self.d.qvel, self.h)[0][None]
@@ -372,7 +246,8 @@ class _Stepper:
 class _LeanStepper(_Stepper):
     """The same contract for the common case (one carrier, no transmission error, the nominal clock,
     no energy), kept lean: per step one cos/sin pair turns every coefficient and gives their
-    derivatives, and the damping correction is written out in that single-carrier form."""
+    derivatives, and the damping correction is written out in that single-carrier form (an RV reducer's
+    pin tendons set to the discs' poses as in the general stepper)."""
 
     def __init__(self, *args):
         super().__init__(*args)
@@ -393,10 +268,13 @@ class _LeanStepper(_Stepper):
         cs, coef, rate, base, turned = self.cs, self.coef, self.rate, self.base, self.turned
         dot, multiply, cos, sin = np.dot, np.multiply, math.cos, math.sin
         forward, rk = mujoco.mj_forward, mujoco.mj_RungeKutta
+        pins = None if self.cycloid is None else self.cycloid.refresh
         for i in range(stop - start):
             if start + i in split:
                 self.split_step(start + i, split[start + i], (start + i) % every == 0)
                 continue
+            if pins is not None:
+                pins(d)
             phi = qpos[phi_adr]
             cs[0] = cos(phi)
             cs[1] = sin(phi)
@@ -446,7 +324,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
 
     d = mujoco.MjData(m)
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy(), m.opt.enableflags,
-             m.opt.timestep, m.opt.integrator)
+             m.opt.timestep, m.opt.integrator, m.tendon_damping.copy())
     m.opt.timestep = dt  # mj_RungeKutta steps by the model's own timestep
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if record_energy:
@@ -473,6 +351,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     finally:
         m.tendon_stiffness[:], m.tendon_lengthspring[:], m.wrap_prm[:] = saved[0], saved[1], saved[2]
         m.opt.enableflags, m.opt.timestep, m.opt.integrator = saved[3], saved[4], saved[5]
+        m.tendon_damping[:] = saved[6]
     t = dt * every * np.arange(stepper.j)
     info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
             "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
@@ -553,6 +432,28 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     if stepper.energy is not None:  # MuJoCo's d.energy is (potential, kinetic)
         raw["energy_potential"] = stepper.energy[:stepper.j, 0]
         raw["energy_kinetic"] = stepper.energy[:stepper.j, 1]
-    return train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force, static.bearing_force,
-                        bearing_force, settle,
-                        info, raw)
+    pins = None if mb.cycloid is None else stepper.pins[:stepper.j]
+    by_disc = None if pins is None else np.concatenate(
+        [pins[:, g.rows].reshape(len(t), len(g.bodies), -1) for g in mb.cycloid.stages], axis=1)
+    result = train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force,
+                          static.bearing_force, bearing_force, settle, info, raw, by_disc)
+    return result if pins is None else _with_cycloid(result, mb, pins, series, static)
+
+
+def _with_cycloid(result: TimeResult, mb: MbdModel, pins: np.ndarray, series, static: StaticState) -> TimeResult:
+    """``result`` with an RV reducer's every pin contact force ``STAGE.discJ.pinI.force`` (the load
+    distribution) and its needle bearings' forces ``STAGE.crankK.discJ.needle_x.force`` and ``..._y`` (the
+    spring-damper force from the bore to the eccentric, along the bore's axes, which turn with the disc: the
+    carrier's up to the disc's vibration), named as the reference model names their rows; reported, not gated."""
+    cyc = mb.cycloid
+    signals = [Signal(f"{name}.force", "pin_force", "N", f"{name} contact force", False) for name in cyc.names]
+    columns = list(pins.T)
+    for name, actuators in zip(cyc.needle_names, cyc.needles):
+        for axis, actuator in zip("xy", actuators):
+            label = mujoco.mj_id2name(mb.model, mujoco.mjtObj.mjOBJ_ACTUATOR, int(actuator))
+            signals.append(Signal(f"{name}_{axis}.force", "bearing_force", "N", f"{name} force along {axis}", False))
+            columns.append(-series(f"{label}_force")[:, 0])
+    static_values = {f"{name}.force": float(f) for name, f in zip(cyc.names, static.pin_force)}
+    return TimeResult(result.train, result.solver, result.t, result.signals + signals,
+                      np.column_stack([result.values] + columns), result.settle_time, result.info, result.raw,
+                      {**result.static, **static_values})

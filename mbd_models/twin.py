@@ -15,6 +15,11 @@ runs stably in MuJoCo's viewer.
 The coefficients of the world-frame slides (central members and the carrier) depend on the
 carrier's angle; :class:`TurningCoefficients` keeps their angle-0 values so that the runner can turn
 them every step.
+
+An RV reducer's cycloid-pin stage (:mod:`gearcheck.mbd_models.cycloid_twin`) adds the splines between planets
+and crankshafts, its needle bearings and one pin tendon per pin and disc, whose coefficients of t = 0 come
+from MuJoCo's Jacobians likewise; its pins touching at t = 0, which the linearisation takes, are those of the
+twin's own static equilibrium (:func:`gearcheck.mbd_models.static_state.static_state`), solved here once.
 """
 
 from __future__ import annotations
@@ -30,15 +35,20 @@ from gearcheck.lumped.kinematics import Kinematics, kinematics
 from gearcheck.lumped.line_of_action import line_of_action
 from gearcheck.lumped.spec import TrainSpec
 from gearcheck.mbd_models import linearise
+from gearcheck.mbd_models.cycloid_twin import CycloidTwin
 from gearcheck.mbd_models.mjcf_builder import (
-    CENTRAL_AXES,
-    PLANET_AXES,
     coupling_tendons,
     document,
     header,
+    member_axes,
     mesh_joints,
     mesh_tendons,
+    pin_joints,
+    pin_list,
+    pin_tendons,
+    spline_tendons,
 )
+from gearcheck.mbd_models.static_state import static_state
 from gearcheck.shared import stepping
 
 PLACEHOLDER_STEP = 1e-5  # s, the compiled model's step until its own default is known
@@ -92,7 +102,7 @@ class MbdModel:
     model: mujoco.MjModel
     limits: stepping.StepLimits  # of MuJoCo's linearisation, every mesh at its cycle-maximum stiffness
     body: dict[str, int]  # member id -> body id
-    qadr: dict[str, tuple[int, int, int]]  # member id -> qpos addresses (x|radial, y|tangential, rz)
+    qadr: dict[str, tuple[int, int, int]]  # member id -> qpos addresses (:func:`member_axes`, then rz)
     dadr: dict[str, tuple[int, int, int]]  # member id -> dof addresses
     mesh_tendon: np.ndarray  # tendon id per spec.meshes entry (the first tendons of the model)
     mesh_damping: np.ndarray
@@ -100,6 +110,7 @@ class MbdModel:
     actuator: dict[str, int]
     sensor: dict[str, tuple[int, int]]  # name -> (address, dimension)
     turning: TurningCoefficients
+    cycloid: CycloidTwin | None = None  # an RV reducer's pin contacts and needle bearings
 
     @property
     def omega_max(self) -> float:
@@ -198,9 +209,10 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     joints = [mesh_joints(spec, mesh) for mesh in spec.meshes]
     placeholder = [[(j, 0.0) for j in names] for names in joints]
     zeros = np.zeros(len(spec.meshes))
-    couplings = coupling_tendons(spec)
-    model = mujoco.MjModel.from_xml_string(
-        document(spec, mesh_tendons(spec, placeholder, k, zeros) + couplings, PLACEHOLDER_STEP, []))
+    couplings = coupling_tendons(spec) + spline_tendons(spec)
+    pins = [[(j, 0.0) for j in pin_joints(spec, disc)] for _, disc, _ in pin_list(spec)]
+    tendons = mesh_tendons(spec, placeholder, k, zeros) + couplings + pin_tendons(spec, pins, [(0.0, 0.0)] * len(pins))
+    model = mujoco.MjModel.from_xml_string(document(spec, tendons, PLACEHOLDER_STEP, []))
 
     # MuJoCo's own coefficients at the reference configuration, into the compiled model
     data = mujoco.MjData(model)
@@ -219,11 +231,19 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     model.tendon_damping[:len(spec.meshes)] = damping
 
     mb = _indices(spec, kin, exc, model)
+    if pins:  # the pin contacts of t = 0, as MuJoCo's own Jacobians give them
+        mb.cycloid = CycloidTwin(spec, model)
+        mb.cycloid.refresh(data)
+        pins = [[(name, float(model.wrap_prm[model.tendon_adr[t] + i])) for i, (name, _) in enumerate(coefs)]
+                for coefs, t in zip(pins, mb.cycloid.tendons)]
     mb.limits = linearise.step_limits(mb)
     model.opt.timestep = mb.default_step
+    if mb.cycloid:
+        mb.cycloid.contacts = static_state(mb).contacts
     stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
-    mb.xml = document(spec, mesh_tendons(spec, coefficients, k, damping) + couplings, model.opt.timestep,
-                      header(spec, stiffness_label))
+    bands = [tuple(band) for band in model.tendon_lengthspring[mb.cycloid.tendons]] if mb.cycloid else []
+    mb.xml = document(spec, mesh_tendons(spec, coefficients, k, damping) + couplings + pin_tendons(spec, pins, bands),
+                      model.opt.timestep, header(spec, stiffness_label))
     return mb
 
 
@@ -234,8 +254,7 @@ def _indices(spec, kin, exc, model) -> MbdModel:
     body, qadr, dadr = {}, {}, {}
     for mid, member in spec.members.items():
         body[mid] = _id(model, B, member.label)
-        axes = PLANET_AXES if member.is_planet else CENTRAL_AXES
-        joints = [_id(model, J, f"{member.label}_{a}") for a in axes + ("rz",)]
+        joints = [_id(model, J, f"{member.label}_{a}") for a in member_axes(member) + ("rz",)]
         qadr[mid] = tuple(int(model.jnt_qposadr[j]) for j in joints)
         dadr[mid] = tuple(int(model.jnt_dofadr[j]) for j in joints)
     mesh_tendon = np.array([_id(model, T, m.label) for m in spec.meshes], dtype=int)

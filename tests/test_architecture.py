@@ -20,7 +20,7 @@ ROOT = Path(gearcheck.__file__).parent
 LAYERS = ["shared", "lumped", "mbd_models", "compare"]  # each may import those before it, never after
 DESCRIPTION = {  # the modules of gearcheck.lumped that describe the train: what the MuJoCo side may use
     "schema", "loader", "spec", "geometry", "line_of_action", "kinematics", "mesh_stiffness", "tooth_stiffness",
-    "iso6336", "excitation", "published_parameters",
+    "iso6336", "excitation", "published_parameters", "cycloid",
 }
 
 

@@ -1,0 +1,200 @@
+"""The steady rotating state of a MuJoCo twin at its nominal operating point, and the mesh damping correction
+that both the static solve and the runner apply.
+
+:func:`static_state`: a Newton solve on MuJoCo's forward dynamics for the deflections at which every body
+turns at its nominal speed with the deflection pattern turning with its carrier (a cycloid disc orbiting on
+its eccentrics), frozen at t = 0.  An RV reducer's pin contacts are solved as an active set on MuJoCo's own
+equilibrium: every pin touching at first, then those in compression, until the set settles (its t = 0
+contact set, which the linearisation takes).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from gearcheck.mbd_models.forces import ForceReader
+from gearcheck.shared.errors import SolverError
+
+# --------------------------------------------------------------------------- damping correction
+
+
+class DampingCorrection:
+    """g = c (de/dt - m) per mesh as the generalized force J^T g (``qfrc_applied``), J the mesh tendons'
+    current coefficients, m the deflection rate their turning coefficients add
+    (see :mod:`gearcheck.mbd_models.runner`)."""
+
+    def __init__(self, mb, d: mujoco.MjData):
+        self.mb, self.d = mb, d
+        tc = mb.turning
+        self.c = mb.mesh_damping
+        self.J = mb.mesh_jacobian()
+        self.c_wrap = np.zeros((len(mb.mesh_tendon), len(tc.wraps)))  # mesh damping per turning wrap
+        self.c_wrap[tc.tendon, np.arange(len(tc.wraps))] = self.c[tc.tendon]
+        self.half = len(tc.wraps) // 2
+
+    def apply(self, de) -> None:
+        tc, d, n = self.mb.turning, self.d, self.half
+        coef = self.mb.model.wrap_prm[tc.wraps]
+        self.J[tc.tendon, tc.slide_dof] = coef
+        turned = np.concatenate([-coef[n:], coef[:n]])  # dc/dphi: the pair (x, y) turns as (-y, x)
+        g = -(self.c_wrap @ (turned * d.qvel[tc.carrier_qadr] * d.qpos[tc.slide_qadr]))
+        if de is not None:
+            g += self.c * de
+        d.qfrc_applied[:] = g @ self.J
+
+
+# --------------------------------------------------------------------------- static state
+
+
+@dataclass
+class StaticState:
+    qpos: np.ndarray
+    qvel: np.ndarray
+    mesh_deflection: np.ndarray
+    mesh_force: np.ndarray
+    bearing_force: np.ndarray  # in gearcheck.shared.results.bearing_names order
+    iterations: int
+    residual: float
+    contacts: np.ndarray | None = None  # an RV reducer's pins touching at t = 0 (its twin's pin tendons' order)
+    pin_force: np.ndarray | None = None  # their forces, N
+
+
+def nominal_speeds(mb) -> np.ndarray:
+    """The joints' speeds in the rigid train's nominal motion: every hinge at its member's nominal speed (a planet's
+    or a crankshaft's relative to its carrier; a cycloid disc's orbit hinge at its cranks' speed and its own hinge
+    the rest), every slide at rest."""
+    spec, kin = mb.spec, mb.kin
+    qvel = np.zeros(mb.model.nv)
+    for mid, member in spec.members.items():
+        ix, _, ir = mb.dadr[mid]
+        omega = kin.speeds[f"{member.stage}.carrier"]
+        if member.kind == "disc":
+            orbit = kin.speeds[spec.stage_of(mid).cycloid.cranks[0]]
+            qvel[ix], qvel[ir] = orbit, kin.speeds[mid] - orbit
+        else:
+            qvel[ir] = kin.speeds[mid] - (omega if member.orbits else 0.0)
+    return qvel
+
+
+def _nominal(mb, q: np.ndarray):
+    """State (qpos, qvel) and the steady-rotation acceleration of deflection q at t = 0.
+
+    Every body turns at its nominal speed (:func:`nominal_speeds`), and a central member's world-frame
+    deflection turns with its carrier: x' = Omega k x x, x'' = -Omega^2 x.
+    """
+    spec, kin = mb.spec, mb.kin
+    qvel = nominal_speeds(mb)
+    target = np.zeros_like(q)
+    for mid, member in spec.members.items():
+        if member.orbits or member.kind == "disc":
+            continue
+        ix, iy, _ = mb.dadr[mid]
+        omega = kin.speeds[f"{member.stage}.carrier"]
+        qvel[ix], qvel[iy] = -omega * q[iy], omega * q[ix]
+        target[ix], target[iy] = -omega**2 * q[ix], -omega**2 * q[iy]
+    return q.copy(), qvel, target
+
+
+def _set_static_drive(mb, d: mujoco.MjData, load_scale: float) -> None:
+    kin, a = mb.kin, mb.actuator
+    d.ctrl[:] = 0.0
+    if "input_shaft_damper" in a:
+        d.ctrl[a["input_shaft_damper"]] = mb.spec.operating.input_speed
+    if "input_shaft" not in a:
+        d.ctrl[a["input_torque"]] = kin.input_torque * load_scale
+    d.ctrl[a["output_load"]] = kin.output_torque * load_scale
+
+
+def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int = 40) -> StaticState:
+    """Steady rotating equilibrium of the MuJoCo model under the mean load (times ``load_scale``).
+
+    Newton's method on r(q) = qacc(q) - qacc_steady(q), with MuJoCo's forward dynamics
+    evaluated at the nominal speeds, every mesh at its mean stiffness, the damping acting on the
+    true deflection rate (zero in steady rotation) and the Jacobian dr/dq by central differences;
+    minimum-norm steps where a free rotation makes it singular.  Backlash: solved first without it,
+    then with every mesh on its drive flank.  Pin contacts: linear springs on an active set, from all pins
+    to those in compression at the solution, until it settles.
+    """
+    m = mb.model
+    d = mujoco.MjData(m)
+    saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.tendon_damping.copy(), m.wrap_prm.copy())
+    t = mb.mesh_tendon
+    correction = DampingCorrection(mb, d)
+    touching = None if mb.cycloid is None else np.ones(len(mb.cycloid.tendons), dtype=bool)
+    gaps = True
+    try:
+        m.tendon_stiffness[t] = mb.excitation.mean_stiffness
+        _set_static_drive(mb, d, load_scale)
+
+        def residual(q):
+            qpos, qvel, target = _nominal(mb, q)
+            d.qpos[:], d.qvel[:] = qpos, qvel
+            mb.refresh(d.qpos)
+            if touching is not None:
+                mb.cycloid.refresh(d, touching, gaps)
+            correction.apply(None)
+            mujoco.mj_forward(m, d)
+            return d.qacc - target
+
+        def newton(q):
+            nonlocal iterations, res
+            for _ in range(max_iter):
+                iterations += 1
+                r0 = residual(q)
+                J = np.empty((m.nv, m.nv))
+                h = 1e-7
+                for j in range(m.nv):
+                    dq = np.zeros(m.nv)
+                    dq[j] = h
+                    J[:, j] = (residual(q + dq) - residual(q - dq)) / (2 * h)
+                step = np.linalg.lstsq(J, -r0, rcond=1e-12)[0]
+                q = q + step
+                res = float(np.max(np.abs(residual(q))))
+                if np.max(np.abs(step)) < tol:
+                    return q
+            raise SolverError(f"MuJoCo static state of {mb.spec.name}: Newton did not converge "
+                              f"(residual {res:.3g} m/s^2)")
+
+        q = m.qpos0.copy()
+        iterations, res = 0, math.inf
+        for band in (False, True):
+            # with backlash the loaded teeth sit on their drive flanks: a spring whose rest length is
+            # +b (the dead band's upper edge) has the same force there and no flat zero-stiffness
+            # region for Newton to wander in (the lumped static solution does the same)
+            m.tendon_lengthspring[t, 0] = mb.half_backlash if band else 0.0
+            m.tendon_lengthspring[t, 1] = mb.half_backlash if band else 0.0
+            if band and not np.any(mb.half_backlash):
+                break
+            if touching is None:
+                q = newton(q)
+                continue
+            # the pins' clearances last: the contact set without them (every pin touching at first) is the
+            # loaded half, whence the set with them follows (from all pins in tension, none might touch)
+            for gaps in (False, True) if np.any(mb.cycloid.clearance) else (True,):
+                q = newton(q)
+                for rounds in itertools.count():
+                    residual(q)
+                    compressed = mb.cycloid.refresh(d, touching, gaps) > 0.0
+                    if np.array_equal(compressed, touching):
+                        break
+                    if rounds == len(touching):
+                        raise SolverError(f"MuJoCo static state of {mb.spec.name}: the pin contact set did not "
+                                          "settle")
+                    touching[:] = compressed
+                    q = newton(q)
+        residual(q)
+        reader = ForceReader(mb, d)
+        sample = np.empty((1, reader.width))
+        reader.sample(sample[0])
+        force, bearing = (f[0] for f in reader.forces(sample))
+        qpos, qvel, _ = _nominal(mb, q)
+        pins = None if touching is None else mb.cycloid.pin_forces(d)
+        return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res, touching, pins)
+    finally:
+        m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.wrap_prm[:] = saved
+

@@ -12,6 +12,8 @@ The front door:
 * :func:`simulate` -- a time run, either solver: a :class:`TimeResult` with named signals;
 * :func:`mjcf` -- the MuJoCo model of a train;
 * :func:`crosscheck` -- both solvers compared, with measurements, tolerances and baselines;
+* :func:`harmonic_response`, :func:`sensitivity` -- the steady forced response by harmonic methods and its
+  derivatives to the numbers of a train file;
 * :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check.
 
 Packages: :mod:`gearcheck.lumped` (train description and reference solver),
@@ -32,11 +34,13 @@ from gearcheck.api import (  # noqa: E402
                            campbell,
                            crosscheck,
                            export_model,
+                           harmonic_response,
                            load,
                            mjcf,
                            mode_pairing,
                            modes,
                            presets,
+                           sensitivity,
                            simulate,
                            write_report,
 )
@@ -50,5 +54,7 @@ from gearcheck.shared.results import TimeResult
 __version__ = metadata.version("gearcheck")
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "LinearModel", "Mesh", "ModalResult",
-           "Periodic", "SolverError", "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell", "crosscheck",
-           "export_model", "load", "mjcf", "mode_pairing", "modes", "presets", "simulate", "write_report"]
+           "Periodic", "SolverError", "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell",
+           "crosscheck",
+           "export_model", "harmonic_response", "load", "mjcf", "mode_pairing", "modes", "presets", "sensitivity",
+           "simulate", "write_report"]

@@ -14,9 +14,13 @@ from gearcheck.compare.campbell import campbell as campbell_diagram
 from gearcheck.compare.crosscheck import crosscheck
 from gearcheck.compare.mode_pairing import ModePairing, pair_modes
 from gearcheck.compare.report import write_report
+from gearcheck.compare.sensitivity import field_sensitivity
 from gearcheck.compare.user_model import user_side
+from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
-from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.lumped.forced_response import parametric_problem
+from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
+from gearcheck.lumped.loader import load_train, preset_names, read_train_text
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.lumped.spec import TrainSpec
 from gearcheck.mbd_models.side import MujocoSide
@@ -27,8 +31,8 @@ from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rpm_to_rad_s
 
-__all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "load", "mjcf", "mode_pairing", "modes", "presets",
-           "simulate", "write_report"]
+__all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "harmonic_response", "load", "mjcf", "mode_pairing",
+           "modes", "presets", "sensitivity", "simulate", "write_report"]
 
 SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
 
@@ -187,6 +191,29 @@ def export_model(train, path) -> None:
     user's own model is read in (:mod:`gearcheck.lumped.matrix_file`): every coordinate, sign and row of
     gearcheck's conventions, to compare with or to start from."""
     write_matrix_file(reference_linear_model(load(train)), path)
+
+
+def harmonic_response(train, method: str = "harmonic balance", orders=(5, 4), speed: float | None = None):
+    """The steady forced response of the reference model by harmonic balance or by the Fourier-series method of
+    Yang, Chen & Wang (2018), on ``orders`` harmonics of each clock (one mesh group, and an RV reducer's
+    eccentrics): a :class:`~gearcheck.lumped.fourier_response.HarmonicResponse` over the model's coordinates
+    (``.at(t)``, ``.harmonic(h)``).  Trains with backlash, tip relief, transmission error or a varying torque
+    are refused (time marching holds them)."""
+    methods = {"harmonic balance": harmonic_balance_response, "Fourier series": fourier_series_response}
+    if method not in methods:
+        raise GearcheckError(f"method {method!r}: one of {', '.join(methods)}")
+    return methods[method](parametric_problem(build_model(load(train, speed))), orders)
+
+
+def sensitivity(train, parameter: str, method: str = "Fourier series", orders=(3, 2), speed: float | None = None):
+    """d|Q_h|/dp of the steady response of ``train`` (a preset name or a train file) to the number at
+    ``parameter`` (``stages[0].crank.eccentricity_mm``), in closed form with its finite-difference check and,
+    for the Fourier-series method, the paper's Eq. (15) beside it
+    (:class:`~gearcheck.compare.sensitivity.FieldSensitivity`)."""
+    if isinstance(train, TrainSpec):
+        raise GearcheckError("sensitivity needs the train file (a preset name or a path), not a loaded TrainSpec: "
+                             "it moves a number of the file")
+    return field_sensitivity(*read_train_text(train), parameter, orders, method, speed)
 
 
 def mjcf(train, speed: float | None = None) -> str:

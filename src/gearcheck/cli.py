@@ -234,6 +234,30 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_calibrate)
 
+    s = sub.add_parser("sensitivity", help="derivatives of the steady harmonic response to train-file numbers "
+                                           "(closed form, checked by finite differences; maps over speed)")
+    _train_arg(s)
+    s.add_argument("--parameter", action="append", required=True, metavar="PATH",
+                   help="a number of the train file, e.g. stages[0].crank.eccentricity_mm (repeatable)")
+    s.add_argument("--coordinate", metavar="NAME", help="the coordinate whose harmonics are reported (default: the "
+                                                        "output's rotation, e.g. rv.carrier.theta)")
+    s.add_argument("--method", choices=("hb", "fourier"), default="fourier",
+                   help="harmonic balance, or the paper's Fourier-series method (default; shows its Eq. 15 beside)")
+    s.add_argument("--orders", type=int, nargs="+", default=(3, 2), metavar="H",
+                   help="harmonics kept per clock (mesh, eccentric), default 3 2")
+    s.add_argument("--speeds", type=SPEED_RANGE, metavar="A:B:N", help="a map over input speeds (rpm) instead of "
+                                                                       "the train's speed")
+    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
+    s.set_defaults(func=cmd_sensitivity)
+
+    s = sub.add_parser("pins", help="an RV reducer's static pin loads over a pin pitch or an eccentric turn (PNG)")
+    _train_arg(s)
+    s.add_argument("--span", choices=("pitch", "turn"), default="pitch",
+                   help="frozen configurations over one pin pitch (default) or a whole turn of the eccentrics")
+    s.add_argument("--samples", type=int, default=16, metavar="N", help="frozen times (default 16)")
+    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-pins.png)")
+    s.set_defaults(func=cmd_pins)
+
     s = sub.add_parser("stiffness", help="plot the mesh stiffness over the mesh cycle (PNG)")
     _train_arg(s)
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)")
@@ -318,6 +342,16 @@ def cmd_show(args) -> int:
             helix = f"  beta={g['helix_angle_deg']:+.6g} deg" if g["helix_angle_deg"] else ""
             print(f"    {name:<16} z={g['teeth']:<4d} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
                   f"r_base={g['base_radius_m'] * 1e3:.6g} mm  r_tip={g['tip_radius_m'] * 1e3:.6g} mm{helix}")
+        if "cycloid" in st:
+            c = st["cycloid"]
+            print(f"    cycloid: {c['cranks']} cranks, {c['discs']} discs at "
+                  f"{', '.join(f'{a:.6g}' for a in c['eccentric_phases_deg'])} deg, Z_c={c['lobes']}, Z_p={c['pins']}, "
+                  f"e={c['eccentricity_m'] * 1e3:.6g} mm, R_p={c['pin_circle_radius_m'] * 1e3:.6g} mm, "
+                  f"r_rp={c['pin_radius_m'] * 1e3:.6g} mm, K1={c['K1']:.4f}, "
+                  f"rho_min={c['min_curvature_radius_m'] * 1e3:.4g} mm")
+            print(f"    pins: f_pin={c['pin_frequency_hz']:.6g} Hz  k={c['pin_stiffness_n_per_m']:.4g} N/m per contact  "
+                  f"{c['pins_touching_at_rest']} contacts loaded at t = 0  clearance "
+                  f"{c['clearance_m'] * 1e6:.4g} um")
     print("  meshes:")
     for m in info["meshes"]:
         face = f"+{m['face_contact_ratio']:.4f}" if m["face_contact_ratio"] else ""
@@ -431,6 +465,88 @@ def cmd_run(args) -> int:
           f"dt = {result.info['dt_s']:.4g} s, wall {result.info['wall_time_s']:.3g} s")
     for name in written:
         print(f"  wrote {args.out / name}")
+    return 0
+
+
+def cmd_sensitivity(args) -> int:
+    from gearcheck.compare import plots, sensitivity
+    from gearcheck.lumped.loader import read_train_text
+
+    text, source = read_train_text(args.train)
+    spec = gearcheck.load(args.train)
+    coordinate = args.coordinate or f"{spec.output}.theta"
+    method = sensitivity.METHODS[0] if args.method == "hb" else sensitivity.METHODS[1]
+    if args.speeds and min(args.speeds) <= 0:
+        raise GearcheckError(f"--speeds: every speed must be positive, got {min(args.speeds):g} rpm")
+    _coordinate(spec, coordinate)
+    with OutputDirectory(args.out) as place:
+        if args.speeds:
+            bar = ProgressBar(f"sensitivity map {spec.name}")
+            frame = sensitivity.sensitivity_map(text, source, args.parameter, args.speeds, coordinate,
+                                                tuple(args.orders), method, progress=bar)
+            bar.close()
+            frame.to_csv(place.path / "sensitivity_map.csv", index=False, float_format="%.10g")
+            mesh = [h for h in dict.fromkeys(frame["harmonic"]) if h.endswith(", 0)") or "," not in h.strip("(,)")]
+            write_file(place.path / "sensitivity_map.png", plots.sensitivity_map(
+                frame[frame["harmonic"].isin(mesh[:3])], coordinate, f"{spec.name}: sensitivity of {coordinate}, "
+                                                                     "mesh harmonics"))
+            written = ["sensitivity_map.csv", "sensitivity_map.png"]
+        else:
+            rows = []
+            for parameter in args.parameter:
+                result = sensitivity.field_sensitivity(text, source, parameter, tuple(args.orders), method)
+                index = _coordinate(spec, coordinate)
+                for j, h in enumerate(result.response.harmonics):
+                    rows.append({"parameter": parameter, "value": result.value,
+                                 "harmonic": str(tuple(int(x) for x in h)),
+                                 "frequency_hz": result.response.frequencies[j] / (2 * np.pi),
+                                 "amplitude": abs(result.response.amplitudes[j, index]),
+                                 "closed_form": result.closed_form[j, index],
+                                 "finite_difference": result.finite_difference[j, index],
+                                 "eq15": None if result.truncated is None else result.truncated[j, index]})
+                print(f"{parameter} = {result.value:.6g}: closed form against finite differences, largest "
+                      f"relative difference {result.relative_error():.1e} ({method})")
+            import pandas as pd
+
+            frame = pd.DataFrame(rows)
+            frame.to_csv(place.path / "sensitivity.csv", index=False, float_format="%.10g")
+            top = frame.sort_values("amplitude", ascending=False).drop_duplicates("parameter")
+            for _, r in top.iterrows():
+                eq15 = "" if r["eq15"] is None else f", Eq. 15 {r['eq15']:.4g}"
+                print(f"  {r['parameter']}: largest harmonic {r['harmonic']} of {coordinate} at "
+                      f"{r['frequency_hz']:.6g} Hz, |Q| {r['amplitude']:.4g}, d|Q|/dp {r['closed_form']:.4g}{eq15}")
+            written = ["sensitivity.csv"]
+    for name in written:
+        print(f"  wrote {args.out / name}")
+    return 0
+
+
+def _coordinate(spec, name: str) -> int:
+    from gearcheck.lumped.assembly import build_model
+
+    labels = build_model(spec).dofs.labels()
+    if name not in labels:
+        raise GearcheckError(f"--coordinate {name!r}: not a coordinate of {spec.name} (e.g. {', '.join(labels[:4])})")
+    return labels.index(name)
+
+
+def cmd_pins(args) -> int:
+    from gearcheck.compare.plots import pin_loads as figure
+    from gearcheck.lumped.assembly import build_model
+    from gearcheck.lumped.pin_loads import pin_loads
+
+    spec = gearcheck.load(args.train)
+    path = args.output or Path("out") / f"{spec.name}-pins.png"
+    check_place(path, "-o", folder=False)
+    loads = pin_loads(build_model(spec), span=args.span, samples=args.samples)
+    s = loads.summary()
+    write_file(path, figure(loads, title=f"{spec.name}: static pin loads at {abs(loads.output_torque):.6g} N·m over "
+                                         f"one {'pin pitch' if args.span == 'pitch' else 'eccentric turn'}"))
+    print(f"{spec.name}: {s['loaded_pins_min']}-{s['loaded_pins_max']} pins loaded per disc, peak "
+          f"{s['peak_force_n']:.6g} N = {s['peak_ratio_max']:.4f} x the rigid disc's 4 T/(Z_p r_c) = "
+          f"{s['classical_peak_n']:.6g} N; pins hold {s['wheel_torque_nm']:.6g} N·m "
+          f"(balance error {s['torque_balance_error_max']:.1e})")
+    print(f"wrote {path}")
     return 0
 
 

@@ -1,0 +1,133 @@
+"""The reference model as a parametric problem: its steady forced response by harmonic methods.
+
+A train whose stiffness varies with at most two clocks -- the mesh position of one group of meshes with a common
+mesh frequency, and an RV reducer's eccentric angle in its carrier (or a second mesh group) -- is
+
+    M q'' + (C + G) q' + (K_b + K_frame + sum_m k_m(theta_1) a_m a_m^T + K_cycloid(theta_2)) q = F,
+
+the mean load F, the damping of t = 0.  The stiffness is a sum of functions of one clock each, so each clock's
+part is sampled on its own and the lattice of :mod:`gearcheck.lumped.fourier_response` needs no common period
+(an RV reducer's mesh and pin-pass frequencies are the 69th and 39th harmonics of the cranks' turn, and the
+two-clock lattice holds them without a 69 x 9-harmonic fundamental).  What the harmonic methods cannot hold is
+refused: backlash and tip relief (contact nonlinearity), transmission error and torque ripple (forcing not in
+F), pin clearance (a load that depends on the contact set).  The discs' orbit loads (m e w_H^2, a few newtons)
+are left out and said so.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from gearcheck.lumped.assembly import LumpedModel, contact_sets, frozen_at
+from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.fourier_response import ParametricProblem
+from gearcheck.lumped.static import mean_load
+from gearcheck.shared.errors import SolverError
+
+SAME_FREQUENCY = 1e-9  # relative: meshes whose frequencies agree this well run on one clock
+
+
+def parametric_problem(model: LumpedModel, mesh_grid: int = 4096, eccentric_grid: int = 2048,
+                       alias: float = 2e-3, contacts: dict | None = None) -> ParametricProblem:
+    """The steady forced problem of ``model`` at its operating point (see the module docstring): each clock's
+    stiffness sampled at ``mesh_grid`` or ``eccentric_grid`` points per turn (an eccentric sample is a static
+    solve for the pins' contact set), ``alias`` the aliasing accepted
+    (:class:`~gearcheck.lumped.fourier_response.ParametricProblem`).  ``contacts``: a dict the pins' contact
+    sets of each eccentric sample are recorded in, or taken from where it holds them (a derivative by
+    differences of two problems is one at a fixed contact pattern)."""
+    _check_linear(model)
+    cycloids = [e for e in model.turning if isinstance(e, CycloidRows)]
+    exc = model.excitation
+    varies = exc.max_stiffness > exc.mean_stiffness * (1 + 1e-12)
+    groups = _mesh_groups(exc.frequency, varies)
+    clocks = [("mesh", 2 * math.pi * exc.frequency[g[0]], g) for g in groups]
+    if cycloids:
+        if len({round(e.omega_eccentric, 9) for e in cycloids}) > 1:
+            raise SolverError(f"{model.spec.name}: cycloid stages with different crank speeds need more than two "
+                              "clocks; use time marching")
+        clocks.append(("eccentric", abs(cycloids[0].omega_eccentric), None))
+    if not clocks or len(clocks) > 2:
+        raise SolverError(f"{model.spec.name}: the harmonic methods take one or two clocks, this train has "
+                          f"{len(clocks)} (mesh groups {len(groups)}, cycloid stages {len(cycloids)}); use time "
+                          "marching")
+    owned = {name for e in cycloids for name in e.rows}
+    base = replace(model, rows=[r for r in model.rows if r.name not in owned])
+    K_const = base.K_b + model.K_frame + model.K_mesh(np.where(varies, 0.0, exc.mean_stiffness))
+    contacts = {} if contacts is None else contacts
+    parts = [_mesh_part(model, omega, group) if kind == "mesh" else _cycloid_part(model, cycloids, omega, contacts)
+             for kind, omega, group in clocks]  # each angle -> (K, C) of its rows
+    F = mean_load(model) - sum((e.static_load for e in cycloids), np.zeros(model.n))
+    return ParametricProblem(model.M, base.C + model.G,
+                             lambda theta: K_const + sum(p(a)[0] for p, a in zip(parts, theta)),
+                             tuple(omega for _, omega, _ in clocks), F,
+                             grid=tuple(mesh_grid if kind == "mesh" else eccentric_grid for kind, _, _ in clocks),
+                             separable=True, alias=alias,
+                             C_of=(lambda theta: sum(p(a)[1] for p, a in zip(parts, theta))) if cycloids else None)
+
+
+def _check_linear(model: LumpedModel) -> None:
+    exc, spec = model.excitation, model.spec
+    reasons = []
+    if np.any(exc.backlash > 0):
+        reasons.append("backlash")
+    if exc.relieved.size:
+        reasons.append("tip relief")
+    if exc.has_transmission_error:
+        reasons.append("transmission error")
+    if spec.operating.ripple or spec.operating.torque_function or spec.operating.torque_profile:
+        reasons.append("a torque that varies")
+    if any(not isinstance(e, CycloidRows) for e in model.turning):
+        reasons.append("a radial coupling between frames that turn apart")
+    if any(s.cycloid.clearance > 0 for s in spec.stages if s.cycloid):
+        reasons.append("pin clearance")
+    if reasons:
+        raise SolverError(f"{spec.name}: the harmonic methods solve a linear problem with constant load; this train "
+                          f"has {', '.join(reasons)}: use time marching")
+
+
+def _mesh_groups(frequencies, varies) -> list[list[int]]:
+    """The meshes whose stiffness ``varies``, in groups of one mesh frequency, in order of first appearance."""
+    groups: list[list[int]] = []
+    for j, f in enumerate(frequencies):
+        if not varies[j]:
+            continue
+        for g in groups:
+            if abs(frequencies[g[0]] - f) <= SAME_FREQUENCY * f:
+                g.append(j)
+                break
+        else:
+            groups.append([j])
+    return groups
+
+
+def _mesh_part(model: LumpedModel, omega: float, group: list[int]):
+    """(K, C) of the meshes of one group as a function of their clock's angle (their damping is constant: in
+    the problem's C)."""
+    rows = model.mesh_rows[group]
+    zero = np.zeros((model.n, model.n))
+
+    def part(theta: float) -> tuple[np.ndarray, np.ndarray]:
+        k = model.excitation.stiffness(np.array([theta / omega]))[0][group]
+        return rows.T @ (k[:, None] * rows), zero
+    return part
+
+
+def _cycloid_part(model: LumpedModel, cycloids, omega: float, contacts: dict):
+    """(K, C) of the cycloid stages' rows (needle bearings, pins of the static contact set, or of ``contacts``)
+    at the eccentric angle: the rows turn with the eccentrics, their damping with them."""
+    cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+
+    def part(theta: float) -> tuple[np.ndarray, np.ndarray]:
+        key = round(float(theta), 12)
+        if key not in cache:
+            frozen = frozen_at(model, theta / omega, contacts.get(key))
+            contacts.setdefault(key, contact_sets(frozen))
+            names = {name for e in frozen.turning if isinstance(e, CycloidRows) for name in e.rows}
+            rows = [r for r in frozen.rows if r.name in names]
+            cache[key] = tuple(sum((getattr(r, attr) * np.outer(r.a, r.a) for r in rows), np.zeros((model.n,) * 2))
+                               for attr in ("stiffness", "damping"))
+        return cache[key]
+    return part

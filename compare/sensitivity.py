@@ -94,11 +94,13 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=(5, 4), met
 def _derivative(base: ParametricProblem, plus: ParametricProblem, minus: ParametricProblem, h: float):
     """The central difference of two problems' data (sampled like ``base``, whose aliasing was checked)."""
     difference = lambda a, b: (a - b) / (2 * h)  # noqa: E731
-    dC_of = None if base.C_of is None else (lambda theta: difference(plus.C_of(theta), minus.C_of(theta)))
+    periodic = {name: None if getattr(base, name) is None else
+                (lambda theta, name=name: difference(getattr(plus, name)(theta), getattr(minus, name)(theta)))
+                for name in ("C_of", "F_of")}
     return replace(parameter_derivative(
         base, dM=difference(plus.M, minus.M), dC=difference(plus.C, minus.C),
         dK_of=lambda theta: difference(plus.K_of(theta), minus.K_of(theta)), dF=difference(plus.F, minus.F),
-        dC_of=dC_of), alias=1.0)
+        dC_of=periodic["C_of"], dF_of=periodic["F_of"]), alias=1.0)
 
 
 def _problem(text, source, field: FitParameter | None, value, speed, contacts: dict, grids) -> ParametricProblem:

@@ -10,8 +10,8 @@ part is sampled on its own and the lattice of :mod:`gearcheck.lumped.fourier_res
 (an RV reducer's mesh and pin-pass frequencies are the 69th and 39th harmonics of the cranks' turn, and the
 two-clock lattice holds them without a 69 x 9-harmonic fundamental).  What the harmonic methods cannot hold is
 refused: backlash and tip relief (contact nonlinearity), transmission error and torque ripple (forcing not in
-F), pin clearance (a load that depends on the contact set).  The discs' orbit loads (m e w_H^2, a few newtons)
-are left out and said so.
+F), pin clearance (a load that depends on the contact set).  The rows of a cycloid stage turn with the
+eccentrics with their damping, and the discs' orbit loads m e w_H^2 e(phi) with them (periodic C and F).
 """
 
 from __future__ import annotations
@@ -60,12 +60,17 @@ def parametric_problem(model: LumpedModel, mesh_grid: int = 4096, eccentric_grid
     parts = [_mesh_part(model, omega, group) if kind == "mesh" else _cycloid_part(model, cycloids, omega, contacts)
              for kind, omega, group in clocks]  # each angle -> (K, C) of its rows
     F = mean_load(model) - sum((e.static_load for e in cycloids), np.zeros(model.n))
+    orbit = None
+    if cycloids:
+        omega = clocks[-1][1]
+        orbit = lambda theta: sum(e.orbit_force(theta[-1] / omega) for e in cycloids)  # noqa: E731
     return ParametricProblem(model.M, base.C + model.G,
                              lambda theta: K_const + sum(p(a)[0] for p, a in zip(parts, theta)),
                              tuple(omega for _, omega, _ in clocks), F,
                              grid=tuple(mesh_grid if kind == "mesh" else eccentric_grid for kind, _, _ in clocks),
                              separable=True, alias=alias,
-                             C_of=(lambda theta: sum(p(a)[1] for p, a in zip(parts, theta))) if cycloids else None)
+                             C_of=(lambda theta: sum(p(a)[1] for p, a in zip(parts, theta))) if cycloids else None,
+                             F_of=orbit)
 
 
 def _check_linear(model: LumpedModel) -> None:

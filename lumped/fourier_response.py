@@ -8,7 +8,8 @@ is each coordinate's amplitude at omega_h.
 
 * :func:`fourier_series_response` -- the "Fourier series method" (Yang, Chen & Wang 2018, Eqs. 5-6), here with
   damping: the variation acts on the static deflection only, (K_mean - omega_h^2 M + i omega_h C) Q_h =
-  -2 K_h q_mean with K_mean q_mean = F.  The product of the variation and the dynamic response is dropped.
+  2 (F_h - K_h q_mean) with K_mean q_mean = F_mean.  The product of the variation and the dynamic response is
+  dropped.
 * :func:`harmonic_balance_response` -- Hill's method / harmonic balance (Bolotin 1964; Nayfeh & Mook 1979): the
   whole parametric problem, balanced on the truncated lattice |h_k| <= H_k as one sparse linear system.
 """
@@ -37,7 +38,8 @@ class ParametricProblem:
     half band must be below ``alias`` (default ``tol``) times it (else :class:`SolverError`): a stiffness with
     jumps (a rectangular mesh wave, a pin entering contact) has harmonics that fall as 1/h, and ``alias`` is
     then the aliasing error accepted on the harmonics kept.  ``C_of``, like ``K_of``, adds a periodic part to the
-    damping C (rows that turn with a clock); the Fourier-series method keeps only its mean."""
+    damping C (rows that turn with a clock); the Fourier-series method keeps only its mean.  ``F_of`` likewise
+    adds a periodic part to the force F (loads that turn with a clock)."""
 
     M: np.ndarray
     C: np.ndarray
@@ -50,6 +52,7 @@ class ParametricProblem:
     separable: bool = False
     alias: float | None = None
     C_of: Callable[[tuple[float, ...]], np.ndarray] | None = None
+    F_of: Callable[[tuple[float, ...]], np.ndarray] | None = None
 
     def __post_init__(self):
         n = len(self.F)
@@ -87,6 +90,18 @@ class ParametricProblem:
         out[zero] = out.get(zero, 0) + self.C
         return out
 
+    @cached_property
+    def force_harmonics(self) -> dict[tuple[int, ...], np.ndarray]:
+        """{h: F_h} like :attr:`stiffness_harmonics`: F alone, or F plus the harmonics of ``F_of``."""
+        out = {} if self.F_of is None else self._harmonics(self.F_of, "force")
+        zero = (0,) * self.dim
+        out[zero] = out.get(zero, 0) + self.F
+        return out
+
+    @property
+    def F_mean(self) -> np.ndarray:
+        return self.force_harmonics[(0,) * self.dim].real
+
     def _harmonics(self, of, what: str) -> dict[tuple[int, ...], np.ndarray]:
         h, K_hat = self._spectrum(of)
         scale = np.abs(K_hat).max()
@@ -105,13 +120,14 @@ class ParametricProblem:
     def _spectrum(self, of) -> tuple[np.ndarray, np.ndarray]:
         """(h, X_h) rows over the FFT grid of the matrix function ``of``: the whole torus, or only its axes when
         separable, X(theta) = sum_k X_k(theta_k), whose mean is the sum of the axes' means less (d - 1) X(0)."""
-        g, d, n = self.grids[0], self.dim, self.n
+        g, d = self.grids[0], self.dim
         angles = 2 * np.pi * np.arange(g) / g
         freq = np.fft.fftfreq(g, 1 / g).astype(int)
         if not self.separable or d == 1:
             samples = np.array([of(theta) for theta in itertools.product(angles, repeat=d)], dtype=float)
-            K_hat = np.fft.fftn(samples.reshape((g,) * d + (n, n)), axes=tuple(range(d))) / g**d
-            return np.stack(np.meshgrid(*[freq] * d, indexing="ij"), -1).reshape(-1, d), K_hat.reshape(-1, n, n)
+            shape = samples.shape[1:]
+            K_hat = np.fft.fftn(samples.reshape((g,) * d + shape), axes=tuple(range(d))) / g**d
+            return np.stack(np.meshgrid(*[freq] * d, indexing="ij"), -1).reshape(-1, d), K_hat.reshape((-1,) + shape)
         probe = 2 * np.pi * (np.arange(d) + 1) / min(self.grids)
         origin, corner = (np.asarray(of(theta), dtype=float) for theta in ((0.0,) * d, tuple(probe)))
         edges = [of(tuple(a * (j == k) for j, a in enumerate(probe))) for k in range(d)]
@@ -126,6 +142,9 @@ class ParametricProblem:
         h = np.concatenate(h)
         mean = sum(part[0] for part in axes) - (d - 1) * origin
         return h, np.concatenate([[mean]] + [part[1:] for part in axes])
+
+    def force_harmonic(self, h) -> np.ndarray:
+        return self.force_harmonics.get(tuple(int(x) for x in h), np.zeros(self.n))
 
     def stiffness_harmonic(self, h) -> np.ndarray:
         return self.stiffness_harmonics.get(tuple(int(x) for x in h), np.zeros((self.n, self.n)))
@@ -194,9 +213,14 @@ def hill_operator(problem: ParametricProblem, orders) -> sparse.csc_matrix:
 
 
 def hill_force(problem: ParametricProblem, orders) -> np.ndarray:
-    """The right-hand side of :func:`hill_operator`: F on h = 0."""
-    P = len(harmonic_lattice(_orders(problem, orders)))
-    return np.kron(np.eye(P)[P // 2], problem.F).astype(complex)
+    """The right-hand side of :func:`hill_operator`: each force harmonic F_h on its lattice point."""
+    orders = _orders(problem, orders)
+    P = len(harmonic_lattice(orders))
+    out = np.zeros((P, problem.n), dtype=complex)
+    for h, F_h in problem.force_harmonics.items():
+        if all(abs(hk) <= H for hk, H in zip(h, orders)):
+            out[np.ravel_multi_index(tuple(np.asarray(h) + orders), tuple(2 * np.asarray(orders) + 1))] += F_h
+    return out.ravel()
 
 
 def fourier_series_response(problem: ParametricProblem, harmonics) -> HarmonicResponse:
@@ -204,8 +228,9 @@ def fourier_series_response(problem: ParametricProblem, harmonics) -> HarmonicRe
     (H for one frequency, (H1, H2) for two: every h != 0 with |h_k| <= H_k) or explicit (m, d) rows h."""
     h = _harmonics(problem, harmonics)
     w = h @ problem.omegas
-    q = dense_solve(problem.K_mean, problem.F)
-    Q = [dense_solve(problem.dynamic_stiffness(wj), -2 * problem.stiffness_harmonic(hj) @ q)
+    q = dense_solve(problem.K_mean, problem.F_mean)
+    Q = [dense_solve(problem.dynamic_stiffness(wj),
+                     2 * (problem.force_harmonic(hj) - problem.stiffness_harmonic(hj) @ q))
          for hj, wj in zip(h, w)]
     return HarmonicResponse("Fourier series", _fs_truncation(problem, h), h, w, q, np.reshape(Q, (len(h), problem.n)))
 

@@ -3,7 +3,7 @@
 A parameter enters through dM, dC, dK(theta) and dF, given as a :class:`ParametricProblem` of derivatives
 (:func:`parameter_derivative`); the base frequencies are held.  Differentiating the harmonic equations:
 
-* Fourier series method, L_h Q_h = A_h with L_h = K_mean - omega_h^2 M + i omega_h C, A_h = -2 K_h q_mean,
+* Fourier series method, L_h Q_h = A_h with L_h = K_mean - omega_h^2 M + i omega_h C, A_h = 2 (F_h - K_h q_mean),
   K_mean q_mean = F: dQ_h = L_h^-1 (dA_h - dL_h Q_h), dA_h = -2 (dK_h q_mean + K_h dq_mean),
   dq_mean = K_mean^-1 (dF - dK_mean q_mean).  With ``truncated`` the dA_h term is dropped, as in Yang, Chen &
   Wang (2018), Eqs. (14)-(15): exact only where the forcing -Delta K q_mean does not depend on xi.
@@ -47,12 +47,12 @@ class ResponseSensitivity:
 
 
 def parameter_derivative(problem: ParametricProblem, dM=None, dC=None, dK_of=None, dF=None,
-                         dC_of=None) -> ParametricProblem:
+                         dC_of=None, dF_of=None) -> ParametricProblem:
     """The derivatives of ``problem``'s data with respect to one parameter (None: independent of it)."""
     zero = np.zeros((problem.n, problem.n))
     return replace(problem, M=zero if dM is None else dM, C=zero if dC is None else dC,
                    K_of=(lambda theta: zero) if dK_of is None else dK_of, F=np.zeros(problem.n) if dF is None else dF,
-                   C_of=dC_of)
+                   C_of=dC_of, F_of=dF_of)
 
 
 def fourier_series_sensitivity(problem: ParametricProblem, derivative: ParametricProblem, harmonics,
@@ -60,10 +60,11 @@ def fourier_series_sensitivity(problem: ParametricProblem, derivative: Parametri
     """d/d xi of :func:`fourier_series_response`; ``truncated``: Yang, Chen & Wang's Eq. (15), dA_h dropped."""
     response = fourier_series_response(problem, harmonics)
     q = response.mean
-    dq = dense_solve(problem.K_mean, derivative.F - derivative.K_mean @ q)
+    dq = dense_solve(problem.K_mean, derivative.F_mean - derivative.K_mean @ q)
     dQ = []
     for h, w, Q in zip(response.harmonics, response.frequencies, response.amplitudes):
-        dA = 0 if truncated else -2 * (derivative.stiffness_harmonic(h) @ q + problem.stiffness_harmonic(h) @ dq)
+        dA = 0 if truncated else 2 * (derivative.force_harmonic(h) - derivative.stiffness_harmonic(h) @ q
+                                      - problem.stiffness_harmonic(h) @ dq)
         dQ.append(dense_solve(problem.dynamic_stiffness(w), dA - derivative.dynamic_stiffness(w) @ Q))
     method = "Fourier series, dA dropped (Yang, Chen & Wang 2018, Eq. 15)" if truncated else "Fourier series"
     return ResponseSensitivity(response, replace(response, method=method, mean=dq,

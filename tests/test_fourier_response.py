@@ -283,3 +283,19 @@ def test_eq15_over_the_true_derivative_is_one_over_two_minus_r_squared(r):
         assert ratio == pytest.approx(1 / (2 - r**2 + 2j * zeta * r), rel=1e-12)
         if c == 0:
             assert eq15.d_modulus[0, 0] / true.d_modulus[0, 0] == pytest.approx(1 / (2 - r**2), rel=1e-12)
+
+
+def test_a_turning_load_is_a_force_harmonic():
+    """A load f cos(omega t) on a constant spring: both methods give the forced oscillator's exact amplitude
+    f / (k - omega^2 m + i omega c) (to round-off), and time-varying damping C(t) = c (1 + cos omega t) on a
+    static deflection alone exerts no force (harmonic balance's mean and harmonics stay those of the statics)."""
+    m, c, k, f, w = 1.0, 0.1, 1.0, 0.3, 0.7
+    problem = replace(one_dof(0.0, w, m, c, k), F_of=lambda th: np.array([f * np.cos(th[0])]))
+    exact = f / (k - w * w * m + 1j * w * c)
+    for solve in (fourier_series_response, harmonic_balance_response):
+        r = solve(problem, 3)
+        assert r.harmonic(1)[0] == pytest.approx(exact, rel=1e-12)
+        assert abs(r.harmonic(2)[0]) < 1e-14 and r.mean[0] == pytest.approx(1.0 / k, rel=1e-12)
+    still = replace(one_dof(0.0, w, m, c, k), C_of=lambda th: np.array([[c * np.cos(th[0])]]))
+    r = harmonic_balance_response(still, 3)
+    assert r.mean[0] == pytest.approx(1.0 / k, rel=1e-12) and np.abs(r.amplitudes).max() < 1e-14

@@ -424,7 +424,8 @@ DISC_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 
 def pin_loads(loads, index: int = 0, title: str | None = None) -> bytes:
     """PNG of a :class:`~gearcheck.lumped.pin_loads.PinLoads`: left, the pin circle at time ``times[index]`` with a
-    radial bar per loaded pin (length proportional to its force; a black tick where the rigid-disc share would end) and each
+    radial bar per loaded pin (length proportional to its force; a black tick where the rigid-disc share would
+    end) and each
     disc's profile and eccentric; right, the force against the pin's angle from its disc's eccentric over every
     time, beside the rigid-disc share and the classical peak 4 T / (Z_p r_c)."""
     g = loads.geometry

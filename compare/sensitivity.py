@@ -36,6 +36,7 @@ from gearcheck.lumped.response_sensitivity import (
 from gearcheck.shared.errors import GearcheckError
 
 METHODS = ("harmonic balance", "Fourier series")
+ORDERS = (3, 2)  # harmonics kept per clock by default: the mesh's, then an RV reducer's eccentrics'
 STEP = 1e-4  # relative: the matrices are linear in most numbers, so round-off (1e-12) rules, not the step
 MAP_GRIDS = {"mesh_grid": 1024, "eccentric_grid": 512, "alias": 1e-2}  # a map's samples per clock: 1e-2 aliasing
 
@@ -62,11 +63,12 @@ class FieldSensitivity:
         return float(np.nanmax(np.abs(cf[big] - fd[big]) / np.abs(fd[big])))
 
 
-def field_sensitivity(text: str, source: str, parameter: str, orders=(5, 4), method: str = METHODS[0],
+def field_sensitivity(text: str, source: str, parameter: str, orders=None, method: str = METHODS[0],
                       speed: float | None = None, step: float = STEP, **grids) -> FieldSensitivity:
     """The sensitivity of the steady response of the train file ``text`` to the number at ``parameter``
     (a path such as ``stages[0].crank.eccentricity_mm``), at ``speed`` rpm (default the file's), on the
-    harmonic lattice ``orders``; ``grids`` go to :func:`~gearcheck.lumped.forced_response.parametric_problem`."""
+    harmonic lattice ``orders`` (default :data:`ORDERS`, one per clock); ``grids`` go to
+    :func:`~gearcheck.lumped.forced_response.parametric_problem`."""
     if method not in METHODS:
         raise GearcheckError(f"--method {method!r}: one of {', '.join(METHODS)}")
     field = FitParameter.parse(parameter, option="--parameter")
@@ -74,6 +76,7 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=(5, 4), met
     h = step * value
     contacts: dict = {}
     base = _problem(text, source, field, value, speed, contacts, grids)
+    orders = lattice(base, orders)
     plus, minus = (_problem(text, source, field, value + s, speed, contacts, grids) for s in (h, -h))
     derivative = _derivative(base, plus, minus, h)
     if method == METHODS[0]:
@@ -89,6 +92,18 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=(5, 4), met
           for a, b, d in ((plus, minus, h), (*half, h / 2))]
     return FieldSensitivity(parameter, value, method, closed.response, closed.d_modulus, truncated,
                             (4 * fd[1] - fd[0]) / 3)  # Richardson: O(h^4)
+
+
+def lattice(problem: ParametricProblem, orders) -> tuple[int, ...]:
+    """``orders`` checked against the problem's clocks, or :data:`ORDERS` cut to them."""
+    if orders is None:
+        return ORDERS[:problem.dim]
+    orders = tuple(orders)
+    if len(orders) != problem.dim or min(orders) < 0:
+        raise GearcheckError(f"--orders {' '.join(map(str, orders))}: give {problem.dim} non-negative number"
+                             f"{'s' if problem.dim > 1 else ''}, one per clock of this train (mesh"
+                             f"{', eccentrics' if problem.dim > 1 else ''})")
+    return orders
 
 
 def _derivative(base: ParametricProblem, plus: ParametricProblem, minus: ParametricProblem, h: float):
@@ -112,7 +127,7 @@ def _problem(text, source, field: FitParameter | None, value, speed, contacts: d
     return parametric_problem(build_model(spec), contacts=contacts, **grids)
 
 
-def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, coordinate: str, orders=(3, 2),
+def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, coordinate: str, orders=None,
                     method: str = METHODS[1], progress=None, **grids):
     """d|Q_h|/d ln p of ``coordinate`` (a model coordinate, ``rv.carrier.theta``) for each parameter at each input
     speed (the paper's Figs. 5-10 over the mesh frequency), with the paper's Eq. (15) beside it for the
@@ -131,6 +146,7 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
     rows = []
     for k, rpm in enumerate(speeds_rpm):
         base = _problem(text, source, None, None, rpm, contacts, grids)
+        orders = lattice(base, orders)
         model = build_model(load_train(load_text(text, source), rpm))
         try:
             index = model.dofs.labels().index(coordinate)

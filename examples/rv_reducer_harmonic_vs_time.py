@@ -2,7 +2,8 @@
 
 Runs the reference model 0.16 s from its static start (the free vibration has decayed to 1e-3 by 0.053 s) and
 compares the last 40 ms of five coordinates with the two harmonic solutions, as rms(harmonic - time) over the
-time response's own AC content.  About 10 minutes on one core (the (45, 4) lattice is most of it).  Yang, Chen & Wang (2018) Eqs. 5-6.
+time response's own AC content.  About 10 minutes on one core (the (45, 4) lattice is most of it).
+Yang, Chen & Wang (2018) Eqs. 5-6.
 """
 
 import numpy as np

@@ -315,6 +315,18 @@ OPTIONS = [
      "argument --fit-speed: must be a positive number of rpm"),
     (["calibrate", "hub-drive", "--fit", "operating.output_torque", "--fit-speed", "700"],
      "no measurement at the fit speeds [700.0] rpm"),
+    (["sensitivity", "rv-reducer", "--parameter", "stages[0].crank.nothing"],
+     "--parameter stages[0].crank.nothing: no such field"),
+    (["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--orders", "3", "2"],
+     "--orders 3 2: give 1 non-negative number, one per clock of this train (mesh)"),
+    (["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--coordinate", "sun.x"],
+     "--coordinate 'sun.x': not a coordinate of demo-3p"),
+    (["sensitivity", "hub-drive", "--parameter", "stages[0].sun.mass"],
+     "hub-drive: the harmonic methods solve a linear problem with constant load; this train has backlash"),
+    (["sensitivity", "rv-reducer", "--parameter", "stages[0].sun.mass", "--speeds", "0:1000:3"],
+     "--speeds: every speed must be positive, got 0 rpm"),
+    (["pins", "demo-3p"], "demo-3p has no cycloid-pin stage"),
+    (["pins", "rv-reducer", "--samples", "0"], "--samples 0: need at least one frozen time"),
 ]
 
 
@@ -322,8 +334,8 @@ OPTIONS = [
                          ids=[" ".join(a[:4]) + f" #{i}" for i, (a, _) in enumerate(OPTIONS)])
 def test_a_bad_option_is_refused_with_one_line(argv, expected, tmp_path, capsys):
     out = tmp_path / "out"
-    assert_refused(argv + (["--out", str(out)] if argv[0] in ("run", "crosscheck", "calibrate") else []), expected,
-                   capsys, out)
+    assert_refused(argv + (["--out", str(out)] if argv[0] in ("run", "crosscheck", "calibrate", "sensitivity")
+                           else ["-o", str(out)] if argv[0] == "pins" else []), expected, capsys, out)
 
 
 def places(tmp: Path):

@@ -45,7 +45,8 @@ def disc_angle_from_rolling(g, phi, w):
 def locus_in_disc_frame(g, phi, w, i):
     """Pin i's centre seen from the disc, and its derivative in phi (the disc frame's tangent of the locus)."""
     theta = disc_angle_from_rolling(g, phi, w)
-    centre = g.pin_circle_radius * np.array([math.cos(2 * math.pi * i / g.pins + w), math.sin(2 * math.pi * i / g.pins + w)])
+    angle = 2 * math.pi * i / g.pins + w
+    centre = g.pin_circle_radius * np.array([math.cos(angle), math.sin(angle)])
     y = rot(-theta) @ (centre - g.eccentricity * np.array([math.cos(phi), math.sin(phi)]))
     j = np.array([[0.0, -1.0], [1.0, 0.0]])
     dtheta = -1.0 / g.lobes

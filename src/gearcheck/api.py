@@ -14,7 +14,7 @@ from gearcheck.compare.campbell import campbell as campbell_diagram
 from gearcheck.compare.crosscheck import crosscheck
 from gearcheck.compare.mode_pairing import ModePairing, pair_modes
 from gearcheck.compare.report import write_report
-from gearcheck.compare.sensitivity import field_sensitivity
+from gearcheck.compare.sensitivity import field_sensitivity, lattice
 from gearcheck.compare.user_model import user_side
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
@@ -193,19 +193,21 @@ def export_model(train, path) -> None:
     write_matrix_file(reference_linear_model(load(train)), path)
 
 
-def harmonic_response(train, method: str = "harmonic balance", orders=(5, 4), speed: float | None = None):
+def harmonic_response(train, method: str = "harmonic balance", orders=None, speed: float | None = None):
     """The steady forced response of the reference model by harmonic balance or by the Fourier-series method of
     Yang, Chen & Wang (2018), on ``orders`` harmonics of each clock (one mesh group, and an RV reducer's
-    eccentrics): a :class:`~gearcheck.lumped.fourier_response.HarmonicResponse` over the model's coordinates
+    eccentrics; default 3 and 2): a :class:`~gearcheck.lumped.fourier_response.HarmonicResponse` over the
+    model's coordinates
     (``.at(t)``, ``.harmonic(h)``).  Trains with backlash, tip relief, transmission error or a varying torque
     are refused (time marching holds them)."""
     methods = {"harmonic balance": harmonic_balance_response, "Fourier series": fourier_series_response}
     if method not in methods:
         raise GearcheckError(f"method {method!r}: one of {', '.join(methods)}")
-    return methods[method](parametric_problem(build_model(load(train, speed))), orders)
+    problem = parametric_problem(build_model(load(train, speed)))
+    return methods[method](problem, lattice(problem, orders))
 
 
-def sensitivity(train, parameter: str, method: str = "Fourier series", orders=(3, 2), speed: float | None = None):
+def sensitivity(train, parameter: str, method: str = "Fourier series", orders=None, speed: float | None = None):
     """d|Q_h|/dp of the steady response of ``train`` (a preset name or a train file) to the number at
     ``parameter`` (``stages[0].crank.eccentricity_mm``), in closed form with its finite-difference check and,
     for the Fourier-series method, the paper's Eq. (15) beside it

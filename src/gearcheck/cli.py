@@ -243,8 +243,8 @@ def _parser() -> argparse.ArgumentParser:
                                                         "output's rotation, e.g. rv.carrier.theta)")
     s.add_argument("--method", choices=("hb", "fourier"), default="fourier",
                    help="harmonic balance, or the paper's Fourier-series method (default; shows its Eq. 15 beside)")
-    s.add_argument("--orders", type=int, nargs="+", default=(3, 2), metavar="H",
-                   help="harmonics kept per clock (mesh, eccentric), default 3 2")
+    s.add_argument("--orders", type=int, nargs="+", metavar="H",
+                   help="harmonics kept per clock (mesh, then an RV reducer's eccentrics), default 3 2")
     s.add_argument("--speeds", type=SPEED_RANGE, metavar="A:B:N", help="a map over input speeds (rpm) instead of "
                                                                        "the train's speed")
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
@@ -349,7 +349,8 @@ def cmd_show(args) -> int:
                   f"e={c['eccentricity_m'] * 1e3:.6g} mm, R_p={c['pin_circle_radius_m'] * 1e3:.6g} mm, "
                   f"r_rp={c['pin_radius_m'] * 1e3:.6g} mm, K1={c['K1']:.4f}, "
                   f"rho_min={c['min_curvature_radius_m'] * 1e3:.4g} mm")
-            print(f"    pins: f_pin={c['pin_frequency_hz']:.6g} Hz  k={c['pin_stiffness_n_per_m']:.4g} N/m per contact  "
+            print(f"    pins: f_pin={c['pin_frequency_hz']:.6g} Hz  k={c['pin_stiffness_n_per_m']:.4g} N/m per "
+                  "contact  "
                   f"{c['pins_touching_at_rest']} contacts loaded at t = 0  clearance "
                   f"{c['clearance_m'] * 1e6:.4g} um")
     print("  meshes:")
@@ -483,7 +484,7 @@ def cmd_sensitivity(args) -> int:
         if args.speeds:
             bar = ProgressBar(f"sensitivity map {spec.name}")
             frame = sensitivity.sensitivity_map(text, source, args.parameter, args.speeds, coordinate,
-                                                tuple(args.orders), method, progress=bar)
+                                                args.orders, method, progress=bar)
             bar.close()
             frame.to_csv(place.path / "sensitivity_map.csv", index=False, float_format="%.10g")
             mesh = [h for h in dict.fromkeys(frame["harmonic"]) if h.endswith(", 0)") or "," not in h.strip("(,)")]
@@ -494,7 +495,7 @@ def cmd_sensitivity(args) -> int:
         else:
             rows = []
             for parameter in args.parameter:
-                result = sensitivity.field_sensitivity(text, source, parameter, tuple(args.orders), method)
+                result = sensitivity.field_sensitivity(text, source, parameter, args.orders, method)
                 index = _coordinate(spec, coordinate)
                 for j, h in enumerate(result.response.harmonics):
                     rows.append({"parameter": parameter, "value": result.value,

@@ -85,17 +85,17 @@ class ParametricProblem:
     @cached_property
     def damping_harmonics(self) -> dict[tuple[int, ...], np.ndarray]:
         """{h: C_h} like :attr:`stiffness_harmonics`: C alone, or C plus the harmonics of ``C_of``."""
-        out = {} if self.C_of is None else self._harmonics(self.C_of, "damping")
-        zero = (0,) * self.dim
-        out[zero] = out.get(zero, 0) + self.C
-        return out
+        return self._constant_plus(self.C, self.C_of, "damping")
 
     @cached_property
     def force_harmonics(self) -> dict[tuple[int, ...], np.ndarray]:
         """{h: F_h} like :attr:`stiffness_harmonics`: F alone, or F plus the harmonics of ``F_of``."""
-        out = {} if self.F_of is None else self._harmonics(self.F_of, "force")
+        return self._constant_plus(self.F, self.F_of, "force")
+
+    def _constant_plus(self, constant, of, what: str) -> dict[tuple[int, ...], np.ndarray]:
+        out = {} if of is None else self._harmonics(of, what)
         zero = (0,) * self.dim
-        out[zero] = out.get(zero, 0) + self.F
+        out[zero] = out.get(zero, 0) + constant
         return out
 
     @property

@@ -69,8 +69,7 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=None, metho
     (a path such as ``stages[0].crank.eccentricity_mm``), at ``speed`` rpm (default the file's), on the
     harmonic lattice ``orders`` (default :data:`ORDERS`, one per clock); ``grids`` go to
     :func:`~gearcheck.lumped.forced_response.parametric_problem`."""
-    if method not in METHODS:
-        raise GearcheckError(f"--method {method!r}: one of {', '.join(METHODS)}")
+    _check(method)
     field = FitParameter.parse(parameter, option="--parameter")
     value = field.get(tomllib.loads(text))
     h = step * value
@@ -78,20 +77,26 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=None, metho
     base = _problem(text, source, field, value, speed, contacts, grids)
     orders = lattice(base, orders)
     plus, minus = (_problem(text, source, field, value + s, speed, contacts, grids) for s in (h, -h))
-    derivative = _derivative(base, plus, minus, h)
-    if method == METHODS[0]:
-        closed = harmonic_balance_sensitivity(base, derivative, orders)
-        truncated = None
-        solve = harmonic_balance_response
-    else:
-        closed = fourier_series_sensitivity(base, derivative, orders)
-        truncated = fourier_series_sensitivity(base, derivative, orders, truncated=True).d_modulus
-        solve = fourier_series_response
+    closed, truncated = _closed_form(base, _derivative(base, plus, minus, h), orders, method)
+    solve = harmonic_balance_response if method == METHODS[0] else fourier_series_response
     half = [_problem(text, source, field, value + s, speed, contacts, grids) for s in (h / 2, -h / 2)]
     fd = [(np.abs(solve(a, orders).amplitudes) - np.abs(solve(b, orders).amplitudes)) / (2 * d)
           for a, b, d in ((plus, minus, h), (*half, h / 2))]
     return FieldSensitivity(parameter, value, method, closed.response, closed.d_modulus, truncated,
                             (4 * fd[1] - fd[0]) / 3)  # Richardson: O(h^4)
+
+
+def _check(method: str) -> None:
+    if method not in METHODS:
+        raise GearcheckError(f"--method {method!r}: one of {', '.join(METHODS)}")
+
+
+def _closed_form(base: ParametricProblem, derivative: ParametricProblem, orders, method: str):
+    """(the closed-form sensitivity, the paper's Eq. (15) form of its modulus or None) by ``method``."""
+    if method == METHODS[0]:
+        return harmonic_balance_sensitivity(base, derivative, orders), None
+    return (fourier_series_sensitivity(base, derivative, orders),
+            fourier_series_sensitivity(base, derivative, orders, truncated=True).d_modulus)
 
 
 def lattice(problem: ParametricProblem, orders) -> tuple[int, ...]:
@@ -120,11 +125,15 @@ def _derivative(base: ParametricProblem, plus: ParametricProblem, minus: Paramet
 
 def _problem(text, source, field: FitParameter | None, value, speed, contacts: dict, grids) -> ParametricProblem:
     """The train file's problem at ``speed`` with ``field`` (if any) set to ``value``."""
+    return parametric_problem(_model(text, source, field, value, speed), contacts=contacts, **grids)
+
+
+def _model(text, source, field: FitParameter | None, value, speed):
+    """The train file's reference model at ``speed`` with ``field`` (if any) set to ``value``."""
     document = tomllib.loads(text)
     if field is not None:
         field.set(document, value)
-    spec = load_train(load_text(tomli_w.dumps(document), source), speed)
-    return parametric_problem(build_model(spec), contacts=contacts, **grids)
+    return build_model(load_train(load_text(tomli_w.dumps(document), source), speed))
 
 
 def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, coordinate: str, orders=None,
@@ -137,32 +146,26 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
     import pandas as pd
 
     grids = grids or MAP_GRIDS
-    if method not in METHODS:
-        raise GearcheckError(f"--method {method!r}: one of {', '.join(METHODS)}")
+    _check(method)
     fields = [FitParameter.parse(p, option="--parameter") for p in parameters]
     document = tomllib.loads(text)
     values = [f.get(document) for f in fields]
     contacts: dict = {}
     rows = []
     for k, rpm in enumerate(speeds_rpm):
-        base = _problem(text, source, None, None, rpm, contacts, grids)
-        orders = lattice(base, orders)
-        model = build_model(load_train(load_text(text, source), rpm))
-        try:
-            index = model.dofs.labels().index(coordinate)
-        except ValueError:
+        model = _model(text, source, None, None, rpm)
+        labels = model.dofs.labels()
+        if coordinate not in labels:
             raise GearcheckError(f"--coordinate {coordinate!r}: not a coordinate of {model.spec.name} "
-                                 f"(e.g. {', '.join(model.dofs.labels()[:4])}, ...)") from None
+                                 f"(e.g. {', '.join(labels[:4])}, ...)")
+        index = labels.index(coordinate)
+        base = parametric_problem(model, contacts=contacts, **grids)
+        orders = lattice(base, orders)
         f_mesh = float(model.excitation.frequency.min())
         for field, value in zip(fields, values):
             h = STEP * value
             plus, minus = (_problem(text, source, field, value + s, rpm, contacts, grids) for s in (h, -h))
-            derivative = _derivative(base, plus, minus, h)
-            if method == METHODS[0]:
-                full, truncated = harmonic_balance_sensitivity(base, derivative, orders), None
-            else:
-                full = fourier_series_sensitivity(base, derivative, orders)
-                truncated = fourier_series_sensitivity(base, derivative, orders, truncated=True).d_modulus
+            full, truncated = _closed_form(base, _derivative(base, plus, minus, h), orders, method)
             for j, hk in enumerate(full.response.harmonics):
                 rows.append({"speed_rpm": float(rpm), "mesh_frequency_hz": f_mesh, "parameter": field.path,
                              "harmonic": str(tuple(int(x) for x in hk)),

@@ -407,8 +407,8 @@ def _place(model: LumpedModel, element: CycloidRows, t: float, touching=None) ->
 
 
 def _static_contact_set(model: LumpedModel, A: np.ndarray, element) -> np.ndarray:
-    """Which pins (rows ``A``) touch in the static equilibrium under the mean load at t = 0 (active set, from
-    all of them touching)."""
+    """Which pins (rows ``A``, of the time the rows are placed at) touch in the static equilibrium under the mean
+    load (active set, from all of them touching)."""
     K0 = model.K_b + model.K_mesh(model.excitation.mean_stiffness) + model.K_frame
     F = mean_load(model)
     active = np.ones(len(A), dtype=bool)

@@ -479,7 +479,7 @@ def cmd_sensitivity(args) -> int:
     method = sensitivity.METHODS[0] if args.method == "hb" else sensitivity.METHODS[1]
     if args.speeds and min(args.speeds) <= 0:
         raise GearcheckError(f"--speeds: every speed must be positive, got {min(args.speeds):g} rpm")
-    _coordinate(spec, coordinate)
+    index = _coordinate(spec, coordinate)
     with OutputDirectory(args.out) as place:
         if args.speeds:
             bar = ProgressBar(f"sensitivity map {spec.name}")
@@ -496,7 +496,6 @@ def cmd_sensitivity(args) -> int:
             rows = []
             for parameter in args.parameter:
                 result = sensitivity.field_sensitivity(text, source, parameter, args.orders, method)
-                index = _coordinate(spec, coordinate)
                 for j, h in enumerate(result.response.harmonics):
                     rows.append({"parameter": parameter, "value": result.value,
                                  "harmonic": str(tuple(int(x) for x in h)),

@@ -17,6 +17,11 @@ By default (``drive="steps"``) RK4's first stage sees x(t + eps) and the other t
 inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as
 the MuJoCo runner does), so the stiffness is constant over every sub-step and RK4 keeps its order.
 ``drive="stages"`` is the textbook RK4 with the drive at each stage's own time.
+
+The RK4 steps run compiled (:mod:`gearcheck.lumped.compiled_steps`), a chunk of steps at a time: Python samples
+the chunk's drive (and the rows of the turning elements at the stage times), vectorised, then checks the
+chunk's samples for divergence and reports progress; ``method="rk4-stages"`` runs the same chunks stage by stage
+through :meth:`_System.acceleration`, the reference the compiled steps are tested against.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from gearcheck.lumped.compiled_steps import Sparse, Turning, rk4_steps
 from gearcheck.lumped.cycloid_rows import CycloidRows
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
@@ -36,7 +42,8 @@ from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
-CHUNK = 20000
+CHUNK = 20000  # steps between divergence checks and progress reports
+CHUNK_BYTES = 16 * 2**20  # at most this much drive per chunk (the tooth pairs take a lot per step)
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
 
@@ -76,7 +83,10 @@ class _System:
         self.b = 0.5 * self.exc.backlash
         self.has_backlash = bool(np.any(self.b > 0))
         self.relieved = self.exc.relieved
-        self.has_relief = bool(self.relieved.size)
+        self.relieved_index = np.full(self.c.size, -1, dtype=np.int64)  # mesh -> its place among the relieved
+        self.relieved_index[self.relieved] = np.arange(self.relieved.size)
+        self.turning_arrays = Turning.of(self.turning, model.n)  # for the compiled steps
+        self.sparse = Sparse.of(self.Kc), Sparse.of(self.D), Sparse.of(self.A)
         self.F0 = model.F_static
         self.b_in, self.b_out = model.b_input, model.b_output
 
@@ -117,51 +127,16 @@ class _System:
             force = force + coupling.forces(t, q, v)
         return force * self.Minv
 
-    def load(self, k, e, de, t_in, t_out):
-        """The state-independent part of the generalized force while every mesh is on its drive flank
-        (delta - e > b, where the dead zone is delta - e - b): F0 + b T + A^T (k (e + b) + c de)."""
-        force = self.F0 + np.multiply.outer(t_in, self.b_in) + np.multiply.outer(t_out, self.b_out)
-        return force + (k * (e + self.b) + self.c * de) @ self.A
-
-    def on_drive_flanks(self, q, e) -> bool:
-        return bool(np.all(self.A @ q - e > self.b))
-
-
-class _LinearStep:
-    """One RK4 step of the linear model y' = J y + g(t), y = (q, v), written as a matrix map.
-
-    With the mesh stiffness k the same at the three stage times, RK4 gives exactly
-    y_{n+1} = P y_n + Q_1 g(t) + Q_2 g(t + h/2) + Q_3 g(t + h) with (hJ = Z)
-    P = I + Z + Z^2/2 + Z^3/6 + Z^4/24,  Q_1 = h/6 (I + Z + Z^2/2 + Z^3/4),
-    Q_2 = h/6 (4 I + 2 Z + Z^2/2),  Q_3 = h/6 I,
-    so a step costs four matrix-vector products instead of four right-hand sides.  The maps
-    are cached per stiffness vector (a rectangular stiffness takes a few values per cycle).
-    With backlash the map holds while every mesh stays on its drive flank; a step that starts or
-    ends off it, or crosses a stiffness switch, takes the stage-by-stage path.
-    """
-
-    def __init__(self, sys: _System, h: float):
-        self.sys, self.h = sys, h
-        self.cache: dict[bytes, tuple] = {}
-
-    def maps(self, k: np.ndarray):
-        key = k.tobytes()
-        if key not in self.cache:
-            s, n, h = self.sys, self.sys.Minv.size, self.h
-            K = s.Kc + s.A.T @ (k[:, None] * s.A)
-            D = s.D + s.A.T @ (s.c[:, None] * s.A)
-            J = np.block([[np.zeros((n, n)), np.eye(n)], [-s.Minv[:, None] * K, -s.Minv[:, None] * D]])
-            Z = h * J
-            I = np.eye(2 * n)
-            Z2 = Z @ Z
-            Z3 = Z2 @ Z
-            P = I + Z + Z2 / 2 + Z3 / 6 + Z3 @ Z / 24
-            to_v = np.vstack([np.zeros((n, n)), np.diag(s.Minv)])  # g = (0, M^-1 F)
-            Q1 = h / 6 * (I + Z + Z2 / 2 + Z3 / 4) @ to_v
-            Q2 = h / 6 * (4 * I + 2 * Z + Z2 / 2) @ to_v
-            Q3 = h / 6 * to_v
-            self.cache[key] = (P, Q1, Q2, Q3, Q2 + Q3)
-        return self.cache[key]
+    def compiled_steps(self, q, v, lengths, ends, times, inputs, first_step, every, q_out, v_out) -> int:
+        """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` on this system (see :func:`_chunk`)."""
+        k, e, de, tin, tout, pairs = inputs
+        pairs = np.zeros((0, 3, 0, 0, 2)) if pairs is None else np.ascontiguousarray(pairs)
+        K, D, A = self.sparse
+        turning = self.turning_arrays
+        return rk4_steps(q, v, lengths, ends, first_step, every, q_out, v_out,
+                         self.Minv, self.F0 - turning.static_load, self.b_in, self.b_out, K.indptr, K.indices, K.data,
+                         D.indptr, D.indices, D.data, A.indptr, A.indices, A.data, self.c, self.b, self.has_backlash,
+                         self.relieved_index, *turning.arrays(), times, tin, tout, k, e, de, pairs)
 
 
 def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
@@ -182,8 +157,8 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
              progress=None, drive: str = "steps") -> TimeResult:
     """Integrate ``model`` as ``settings`` ask.
 
-    method: "rk4" (matrix form of each step where the model is linear over it), "rk4-stages" (the
-    same RK4, stage by stage everywhere: the reference the matrix form is tested against) or
+    method: "rk4" (compiled steps, :mod:`gearcheck.lumped.compiled_steps`), "rk4-stages" (the same RK4 stage by
+    stage in Python: the reference the compiled steps are tested against) or
     one of scipy's adaptive methods, whose largest step is then ``settings.dt``.
     drive: "steps" (default, like-for-like with the MuJoCo runner) or "stages" (see the module doc).
     The step defaults to :func:`default_step` and is checked against the stability limit.
@@ -221,84 +196,113 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
+def _chunk(sys, h, start, stop, drive):
+    """The (sub-)steps of steps start..stop-1 and their drive: a step inside which a mesh stiffness jumps is
+    split there (:func:`~gearcheck.shared.stepping.split_steps`).  Returns (lengths, ends, times, inputs):
+    sub-step r spans [times[r, 0], times[r, 0] + lengths[r]], ``ends[r]`` when it ends a whole step, ``times``
+    (sub-steps, 3) its stage times t, t + h/2, t + h (at which the turning elements' rows are placed), and
+    ``inputs`` the drive (k, e, de, T_in, T_out, pairs) at the stage times of :data:`STAGE_OFFSETS`, with
+    time along axes (0, 1), held per step when ``drive == "steps"``."""
+    steps = np.arange(start, stop)
+    lengths = np.full(steps.size, h)
+    sample = (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
+    begins = steps * h
+    ends = np.ones(steps.size, dtype=bool)
+    split = stepping.split_steps(h, start, stop, sys.exc.switch_times(start * h, stop * h))
+    if split:
+        counts = np.ones(steps.size, dtype=int)
+        for i, inner in split.items():
+            counts[i - start] = inner.size + 1
+        row = np.repeat(np.arange(steps.size), counts)
+        lengths, sample, begins = lengths[row], sample[row], begins[row]
+        first = np.cumsum(counts) - counts
+        ends = np.zeros(row.size, dtype=bool)
+        ends[first + counts - 1] = True
+        for i, inner in split.items():
+            a, length = stepping.sub_steps(i * h, h, inner)
+            r = first[i - start] + np.arange(a.size)
+            begins[r], lengths[r] = a, length
+            sample[r] = a[:, None] + length[:, None] * np.array(STAGE_OFFSETS)[None, :]
+    times = begins[:, None] + np.array([0.0, 0.5, 1.0])[None, :] * lengths[:, None]
+    k, e, de, tin, tout, pairs = sys.drive(sample)
+    if drive == "steps":  # stages 2-4 all see the step's weighted drive (as MuJoCo's model fields)
+        k, tin, tout = (per_step_drive(x) for x in (k, tin, tout))
+        if sys.exc.has_transmission_error:  # else zeros
+            e, de = per_step_drive(e), per_step_drive(de)
+        pairs = None if pairs is None else per_step_pairs(pairs)
+    return lengths, ends, times, (k, e, de, tin, tout, pairs)
+
+
+def _chunk_steps(sys) -> int:
+    """Steps per chunk: ``CHUNK``, fewer where the tooth pairs make the per-step drive large, so that a chunk's
+    drive stays within ``CHUNK_BYTES`` (with a quarter of its steps split at stiffness jumps)."""
+    pairs = 0 if not sys.relieved.size else sys.exc.tooth_pairs(0.0)[0].size
+    per_step = 10 * 3 * (3 * sys.c.size + 5 + 2 * pairs)  # 8 bytes a number, 1.25 sub-steps a step
+    return int(max(64, min(CHUNK, CHUNK_BYTES // per_step)))
+
+
 def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, drive="steps"):
     """Fixed-step RK4 over n_steps, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
-    samples and its last state for divergence."""
+    samples and its last state for divergence.  The compiled steps (:func:`~gearcheck.lumped.compiled_steps.
+    rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python."""
     n = q.size
     n_out = n_steps // every + 1
     t_out = np.empty(n_out)
     q_out = np.empty((n_out, n))
     v_out = np.empty((n_out, n))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
-    acc = sys.acceleration
-    # turning couplings (periodic) and tooth pairs (a force that depends on the contacts) are not linear
-    linear = None if stage_by_stage or sys.turning or sys.has_relief else _LinearStep(sys, h)
-    stages = np.array(STAGE_OFFSETS)
-    y = np.concatenate([q, v])
-    j = j0 = 1
-    chunk = CHUNK // 10 if sys.has_relief else CHUNK  # the pairs' drive is (steps, 3, meshes, pairs, 2)
+    q, v = q.copy(), v.copy()
+    j = 1
+    chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
-        times = (np.arange(start, stop)[:, None] + stages[None, :]) * h
-        k, e, de, tin, tout, pairs = sys.drive(times)
-        if drive == "steps":  # stages 2-4 all see the step's weighted drive (as MuJoCo's model fields)
-            k, e, de, tin, tout = (per_step_drive(x) for x in (k, e, de, tin, tout))
-            pairs = None if pairs is None else per_step_pairs(pairs)
-        if linear is not None:
-            load = sys.load(k, e, de, tin, tout)
-            smooth = np.all(k[:, 0, :] == k[:, 1, :], axis=1) & np.all(k[:, 1, :] == k[:, 2, :], axis=1)
-        split = stepping.split_steps(h, start, stop, sys.exc.switch_times(start * h, stop * h))
-        for i in range(stop - start):
-            mapped = None
-            if start + i in split:
-                y = _split_step(sys, y, (start + i) * h, h, split[start + i], drive)
-            elif linear is not None and smooth[i]:
-                P, Q1, Q2, Q3, Q23 = linear.maps(k[i, 0])
-                if drive == "steps":
-                    mapped = P @ y + Q1 @ load[i, 0] + Q23 @ load[i, 1]
-                else:
-                    mapped = P @ y + Q1 @ load[i, 0] + Q2 @ load[i, 1] + Q3 @ load[i, 2]
-                if sys.has_backlash and not (sys.on_drive_flanks(y[:n], e[i, 0])
-                                             and sys.on_drive_flanks(mapped[:n], e[i, 2])):
-                    mapped = None
-            if mapped is not None:
-                y = mapped
-            elif start + i not in split:  # stage by stage: a contact change
-                t0 = (start + i) * h
-
-                def stage(s, q, v, i=i, t0=t0):
-                    return acc(q, v, k[i, s], e[i, s], de[i, s], tin[i, s], tout[i, s], t0 + 0.5 * s * h,
-                               None if pairs is None else pairs[i, s])
-
-                y = np.concatenate(rk4_step(stage, y[:n], y[n:], h))
-            step = start + i + 1
-            if step % every == 0:
-                t_out[j], q_out[j], v_out[j] = step * h, y[:n], y[n:]
-                j += 1
-        runaway(np.append(t_out[j0:j], stop * h), np.vstack([q_out[j0:j], y[None, :n]]))
-        j0 = j
+        lengths, ends, times, inputs = _chunk(sys, h, start, stop, drive)
+        if stage_by_stage:
+            written = _python_steps(sys, q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
+        else:
+            written = sys.compiled_steps(q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
+        t_out[j:j + written] = h * (every * (start // every + 1 + np.arange(written)))
+        runaway(np.append(t_out[j:j + written], stop * h), np.vstack([q_out[j:j + written], q[None]]))
+        j += written
         if progress is not None:
             progress(stop / n_steps)
     return t_out[:j], q_out[:j], v_out[:j]
 
 
-def _split_step(sys, y, t0, h, inner, drive):
-    """One step ended at the stiffness jumps ``inner`` inside it: RK4 sub-steps, each with its own drive."""
-    n = y.size // 2
-    q, v = y[:n], y[n:]
-    for a, length in zip(*stepping.sub_steps(t0, h, inner)):
-        k, e, de, tin, tout, pairs = sys.drive(a + length * np.array(STAGE_OFFSETS)[None, :])
-        if drive == "steps":
-            k, e, de, tin, tout = (per_step_drive(x) for x in (k, e, de, tin, tout))
-            pairs = None if pairs is None else per_step_pairs(pairs)
+def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
+    """A function (q, v) -> (q, v) at t = n_steps dt, from (q, v) at t = 0, by the compiled RK4 steps of
+    :func:`simulate` (same drive sampling and splits); the drive is sampled once, for every call (a shooting
+    method's many runs over one period)."""
+    sys = _System(model)
+    chunk = _chunk_steps(sys)
+    chunks = [(start, _chunk(sys, dt, start, min(start + chunk, n_steps), drive)) for start in range(0, n_steps, chunk)]
+    none = np.empty((0, model.n))
 
-        def stage(s, q, v, a=a, length=length, k=k[0], e=e[0], de=de[0], tin=tin[0], tout=tout[0],
-                  pairs=None if pairs is None else pairs[0]):
-            return sys.acceleration(q, v, k[s], e[s], de[s], tin[s], tout[s], a + 0.5 * s * length,
-                                    None if pairs is None else pairs[s])
+    def run(q, v):
+        q, v = np.array(q, dtype=float), np.array(v, dtype=float)
+        for start, (lengths, ends, times, inputs) in chunks:
+            sys.compiled_steps(q, v, lengths, ends, times, inputs, start, n_steps + 1, none, none)
+        return q, v
 
-        q, v = rk4_step(stage, q, v, length)
-    return np.concatenate([q, v])
+    return run
+
+
+def _python_steps(sys, q, v, lengths, ends, times, inputs, first_step, every, q_out, v_out) -> int:
+    """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` stage by stage in Python (the reference)."""
+    k, e, de, tin, tout, pairs = inputs
+    step, written = first_step, 0
+    for r, h in enumerate(lengths):
+        def stage(s, q, v):
+            return sys.acceleration(q, v, k[r, s], e[r, s], de[r, s], tin[r, s], tout[r, s], times[r, s],
+                                    None if pairs is None else pairs[r, s])
+
+        q[:], v[:] = rk4_step(stage, q, v, h)
+        if ends[r]:
+            step += 1
+            if step % every == 0:
+                q_out[written], v_out[written] = q, v
+                written += 1
+    return written
 
 
 def rk4_step(acceleration, q, v, h):

@@ -9,7 +9,6 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.loader import load_text, load_train, preset_text
 from gearcheck.lumped.static import static_solution
 from gearcheck.lumped.time_solver import default_step, mechanical_energy, simulate, stable_step
-from gearcheck.lumped.variants import edited
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.settings import RunSettings
 
@@ -91,20 +90,3 @@ def test_steady_state_mesh_force_mean_equals_static_load():
     np.testing.assert_allclose([r[n][r.steady].mean() for n in forces], [r.static[n] for n in forces], rtol=0.03)
     # the rectangular stiffness makes it vibrate: Kv departs from 1
     assert np.ptp(r.select("dynamic_factor")[r.steady][:, 0]) > 0.05
-
-
-def test_matrix_step_equals_stage_by_stage_rk4():
-    """The cached matrix form of an RK4 step (linear over the step: stiffness constant, every mesh
-    on its drive flank) is the same arithmetic as stage-by-stage RK4, with and without backlash;
-    with backlash and light load the teeth separate and the two paths share those steps."""
-    for spec in (load_train("demo-3p"),
-                 edited("demo-3p", [(r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nbacklash_um = 40.0\n"
-                                     "ste = [{ harmonic = 1, amplitude_um = 5.0 }]"),
-                                    (r"^output_torque = .*", "output_torque = 30.0")])):
-        model = build_model(spec)
-        a = simulate(model, RunSettings(0.01))
-        b = simulate(model, RunSettings(0.01), method="rk4-stages")
-        fa, fb = a.select("mesh_force"), b.select("mesh_force")
-        np.testing.assert_allclose(fa, fb, rtol=1e-9, atol=1e-9 * np.abs(fb).max())
-    e, _ = model.excitation.transmission_error(b.t)
-    assert np.any(b.select("dte") - e < 20e-6)  # the light-load case did leave the drive flanks

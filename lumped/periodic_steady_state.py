@@ -1,0 +1,244 @@
+"""The periodic steady state of the reference model by shooting, where its excitation has one period.
+
+Every time-varying part of the drive (mesh stiffness variation and transmission error at the mesh frequencies
+and their harmonics, eccentricities at the members' rotation frequencies in the carrier frame, torque ripple,
+the turning elements' rows) has a frequency; when all of them are whole multiples of one 1/T (within
+``PERIOD_TOLERANCE`` cycles over T) and T is at most ``MAX_MESH_PERIODS`` periods of the slowest time-varying
+mesh, the steady response is T-periodic.  The state y = (q, v) after one period of the compiled RK4 steps
+(:func:`gearcheck.lumped.time_solver.stepper`, the same steps, drive sampling and splits as
+:func:`~gearcheck.lumped.time_solver.simulate`, with a step that divides T) is a map y(T) = P(y0), and the steady
+state its fixed point, found from the static state by
+
+* ``method="anderson"`` (default): Anderson acceleration of y <- P(y) (Walker & Ni 2011), one period run an
+  iteration; on an affine map it is a Krylov method (GMRES in exact arithmetic), so it needs about as many runs
+  as the map has modes that a period does not damp out (14-28 on the presets, 3 for a long period), and it
+  takes the dead zones and contacts of a nonlinear model as they come.  Where it has not converged within
+  ``MAX_ANDERSON_RUNS`` runs, Newton goes on from its last iterate;
+* ``method="newton"``: Newton shooting, y0 <- y0 - (Phi - I)^-1 (P(y0) - y0), Phi = dP/dy0 by forward differences
+  (2n runs), kept while each step shrinks the residual tenfold (a chord step costs one run).  For a linear model
+  (no backlash, tip relief or pin contacts) P is affine, y(T) = Phi y0 + g, and one solve of
+  (I - Phi) y0 = g is exact ("affine", 2n + 2 runs).
+
+Either way the answer is the discrete orbit that time marching converges to, without the transient: a run
+``simulate(model, RunSettings(duration, dt=result.dt), y0=result.y0)`` is steady from t = 0.  Where there is no
+common period within the bound (hub-drive's two stages meet after 1491 periods of the slower mesh, three chained
+demo-3p stages not within 64; the RV reducer's eccentrics turn once in 69 mesh periods: pass ``max_mesh_periods``
+to shoot for it), or the drive is not periodic (a user torque function, a load ramp),
+:func:`periodic_steady_state` raises
+:class:`~gearcheck.shared.errors.SolverError` saying so: time-march and let the settle time
+(:meth:`gearcheck.shared.settings.RunSettings.settle_time`) or the plan's steady-state detection find it.
+"""
+
+from __future__ import annotations
+
+import math
+import time as clock
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearcheck.lumped.assembly import TurningCoupling
+from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.mesh_stiffness import ConstantStiffness
+from gearcheck.lumped.time_solver import initial_state, step_limits, stepper
+from gearcheck.shared import stepping
+from gearcheck.shared.errors import SolverError
+
+PERIOD_TOLERANCE = 1e-9  # cycles over the common period by which a frequency may miss a whole number
+MAX_MESH_PERIODS = 64  # the longest common period sought, in periods of the slowest time-varying mesh
+MAX_ITERATIONS = 20  # Newton steps
+ANDERSON_DEPTH = 10  # differences kept
+MAX_ANDERSON_RUNS = 100
+
+
+@dataclass(frozen=True)
+class PeriodicSteadyState:
+    """The state at t = 0 of the T-periodic steady response and how it was found.
+
+    q, v: pass ``(q, v)`` as ``y0`` to :func:`~gearcheck.lumped.time_solver.simulate` with ``dt``;
+    period: T (s); steps: RK4 steps per period; method: "anderson", "anderson, then newton", "affine" (Newton on
+    a linear model: one solve) or "newton"; iterations: Anderson and Newton steps; residual: max |y(T) - y0|
+    over the largest |y| of the first guess (v weighted by 1/omega_max); runs: one-period runs taken;
+    wall_time_s."""
+
+    q: np.ndarray
+    v: np.ndarray
+    period: float
+    dt: float
+    steps: int
+    method: str
+    iterations: int
+    residual: float
+    runs: int
+    wall_time_s: float
+
+    @property
+    def y0(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.q, self.v
+
+
+def drive_frequencies(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(frequencies of the time-varying drive in Hz, those of the time-varying meshes, what has no period).
+    Reads the excitation's terms (:class:`gearcheck.lumped.excitation.Excitation`)."""
+    exc, op = model.excitation, model.spec.operating
+    varying = np.array([not isinstance(m, ConstantStiffness) for m in exc.models], dtype=bool)
+    meshes = np.abs(exc.frequency[varying])
+    freqs = [meshes]
+    freqs += [np.array([h * abs(exc.frequency[i])]) for i, h, _, _ in exc._ste]
+    freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, *_ in exc._eccentric]
+    freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, _ in exc.ripple]
+    aperiodic = []
+    if exc._function is not None:
+        aperiodic.append(f"the torque function {op.torque_function}")
+    if exc._profile is not None:
+        times = exc._profile[0]
+        freqs.append(np.array([1.0 / (times[-1] - times[0])]))
+    if op.ramp > 0:
+        aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
+    for e in model.turning:
+        if isinstance(e, TurningCoupling):
+            freqs.append(np.array([abs(e.omega_b - e.omega_a) / (2 * math.pi)]))
+        elif isinstance(e, CycloidRows):  # eccentric (needles, orbit) and pins passing (identical pins)
+            freqs.append(np.array([abs(e.omega_eccentric), e.geometry.pins * abs(e.omega_pins - e.omega_eccentric)])
+                         / (2 * math.pi))
+    f = np.concatenate(freqs) if freqs else np.empty(0)
+    return f[f > 0], meshes[meshes > 0], aperiodic
+
+
+def common_period(model, max_mesh_periods: int = MAX_MESH_PERIODS) -> float:
+    """The shortest T over which every frequency of :func:`drive_frequencies` completes whole cycles (within
+    ``PERIOD_TOLERANCE`` cycles), at most ``max_mesh_periods`` periods of the slowest time-varying mesh (or of the
+    slowest frequency when no mesh varies); :class:`SolverError` when there is none."""
+    f, meshes, aperiodic = drive_frequencies(model)
+    name = model.spec.name
+    if aperiodic:
+        raise SolverError(f"{name}: no periodic steady state to shoot for: {' and '.join(aperiodic)} "
+                          "not periodic; time-march with a settle time (RunSettings.settle) instead")
+    if f.size == 0:
+        raise SolverError(f"{name}: nothing in the drive varies with time: the steady state is the static "
+                          "solution (gearcheck.lumped.static.static_solution)")
+    base = float(meshes.min() if meshes.size else f.min())
+    for p in range(1, max_mesh_periods + 1):
+        cycles = f * (p / base)
+        if np.all(np.abs(cycles - np.round(cycles)) <= PERIOD_TOLERANCE * np.maximum(1.0, cycles)) \
+                and np.all(np.round(cycles) >= 1):
+            return p / base
+    listed = ", ".join(f"{x:.10g}" for x in np.unique(np.round(f, 9)))
+    raise SolverError(f"{name}: the drive's frequencies {listed} Hz have no common period within "
+                      f"{max_mesh_periods} periods of the slowest time-varying mesh ({base:.10g} Hz; tolerance "
+                      f"{PERIOD_TOLERANCE:g} cycles): no periodic steady state to shoot for (incommensurate "
+                      "excitation); time-march with a settle time (RunSettings.settle) instead")
+
+
+def _is_linear(model) -> bool:
+    exc = model.excitation
+    return not (np.any(exc.backlash > 0) or exc.relieved.size or any(isinstance(e, CycloidRows) for e in model.turning))
+
+
+class _PeriodMap:
+    """P(z) in scaled coordinates z = w y / scale (q in its units, v over omega_max, both over the largest of the
+    first guess), counting its runs."""
+
+    def __init__(self, run, w: np.ndarray, scale: float):
+        self.run, self.w, self.scale, self.runs = run, w, scale, 0
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        self.runs += 1
+        y = z * self.scale / self.w
+        n = y.size // 2
+        return np.concatenate(self.run(y[:n], y[n:])) * self.w / self.scale
+
+
+def _anderson(P: _PeriodMap, z: np.ndarray, tolerance: float, max_runs: int):
+    """Anderson acceleration (Walker & Ni 2011, type II, depth ``ANDERSON_DEPTH``) of z <- P(z): (z, residual,
+    iterations); the residual max |P(z) - z| of the z returned."""
+    xs, fs = [], []
+    residual = math.inf
+    for iteration in range(max_runs):
+        f = P(z) - z
+        residual = float(np.max(np.abs(f)))
+        if residual <= tolerance:
+            return z, residual, iteration
+        xs, fs = (xs + [z])[-ANDERSON_DEPTH - 1:], (fs + [f])[-ANDERSON_DEPTH - 1:]
+        if len(xs) > 1:
+            dx, df = np.diff(np.array(xs), axis=0).T, np.diff(np.array(fs), axis=0).T
+            gamma = np.linalg.lstsq(df, f, rcond=None)[0]
+            z = z + f - (dx + df) @ gamma
+        else:
+            z = z + f
+    return z, residual, max_runs
+
+
+def _newton(P: _PeriodMap, z: np.ndarray, tolerance: float, linear: bool, name: str):
+    """Newton shooting with Phi = dP/dz by forward differences, 2n runs a column set, kept while each step shrinks
+    the residual tenfold (a chord step): (z, residual, iterations).  A linear model's map is affine: one solve,
+    exact whatever the differences' step, then one run to measure the residual."""
+    size = z.size
+    residual = last = math.inf
+    jacobian = None
+    for iteration in range(MAX_ITERATIONS + 1):
+        zT = P(z)
+        r = zT - z
+        residual = float(np.max(np.abs(r)))
+        if residual <= tolerance or (linear and iteration == 1) or iteration == MAX_ITERATIONS:
+            return z, residual, iteration
+        if jacobian is None or residual > 0.1 * last:
+            eps = 1.0 if linear else 1e-6
+            phi = np.empty((size, size))
+            for i in range(size):
+                zi = z.copy()
+                zi[i] += eps
+                phi[:, i] = (P(zi) - zT) / eps
+            jacobian = np.eye(size) - phi
+            if np.linalg.cond(jacobian) > 1e12:
+                raise SolverError(f"{name}: I - Phi over one period is singular (a mode that neither decays nor "
+                                  "grows, e.g. a rigid-body rotation): no unique periodic steady state; time-march "
+                                  "instead")
+        last = residual
+        z = z + np.linalg.solve(jacobian, r)
+    return z, residual, MAX_ITERATIONS  # pragma: no cover (the loop returns)
+
+
+def periodic_steady_state(model, dt: float | None = None, drive: str = "steps", tolerance: float = 1e-10,
+                          y0=None, method: str = "anderson", max_mesh_periods: int = MAX_MESH_PERIODS
+                          ) -> PeriodicSteadyState:
+    """The T-periodic steady state of ``model`` (see the module docstring), T from :func:`common_period`.
+
+    dt: the RK4 step, made a whole fraction of T (default: :func:`~gearcheck.lumped.time_solver.default_step`,
+    rounded down to one); drive: as :func:`~gearcheck.lumped.time_solver.simulate`'s; tolerance: on the residual
+    max |y(T) - y0| (v over omega_max) over the largest |y0|; y0: the first guess (default: the static state);
+    method: "anderson" (falls back to Newton where it has not converged in ``MAX_ANDERSON_RUNS`` runs) or "newton";
+    max_mesh_periods: the longest common period sought (:func:`common_period`).
+    Raises SolverError when the excitation has no common period, I - Phi is singular (a rigid-body mode: no
+    unique periodic orbit) or shooting does not converge."""
+    if method not in ("anderson", "newton"):
+        raise SolverError(f"method must be 'anderson' or 'newton', not {method!r}")
+    started = clock.perf_counter()
+    period = common_period(model, max_mesh_periods)
+    name = model.spec.name
+    limits = step_limits(model)
+    h = stepping.default_step(limits, model.excitation.frequency) if dt is None else dt
+    stepping.check_step(h, limits, model.excitation.frequency, f"lumped model of {name}")
+    steps = max(1, math.ceil(period / h - 1e-9))
+    h = period / steps
+    n = model.n
+    w = np.concatenate([np.ones(n), np.full(n, 1.0 / limits.omega_max)])  # v in a displacement's units
+    q0, v0 = initial_state(model) if y0 is None else y0
+    y = np.concatenate([q0, v0])
+    scale = float(np.max(np.abs(w * y))) or 1e-6
+    P = _PeriodMap(stepper(model, h, steps, drive), w, scale)
+    z, residual, iterations = w * y / scale, math.inf, 0
+    if method == "anderson":
+        z, residual, iterations = _anderson(P, z, tolerance, MAX_ANDERSON_RUNS)
+    used = method
+    if residual > tolerance:
+        linear = _is_linear(model)
+        used = "anderson, then newton" if method == "anderson" else "affine" if linear else "newton"
+        z, residual, newton = _newton(P, z, tolerance, linear, name)
+        iterations += newton
+    if residual > tolerance:
+        raise SolverError(f"{name}: shooting did not converge (residual {residual:.3g} > {tolerance:g} after "
+                          f"{P.runs} period runs); time-march with a settle time (RunSettings.settle) instead")
+    y = z * scale / w
+    return PeriodicSteadyState(y[:n].copy(), y[n:].copy(), period, h, steps, used, iterations, residual, P.runs,
+                               clock.perf_counter() - started)

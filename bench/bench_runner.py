@@ -1,29 +1,33 @@
 """Benchmark of the MuJoCo runner (not a test).
 
 1. Per-step cost of ``simulate_mujoco`` against a bare ``mj_step`` loop on the same model
-   (same RK4 integrator, same sensors, same step): the runner's extra Python work per step.
-   Target: ratio <= 1.3.
-2. Steps per second of the runner for 1, 2 and 3 planetary stages (demo-3p's stage chained,
-   carrier k -> sun k+1 by a spline coupling).
+   (same RK4 integrator, same sensors, same step), side by side in one run: the per-step loop in
+   Python (``engine="python"``, before issue 15) and in C (``engine="compiled"``, the default), for
+   1, 2 and 3 planetary stages (demo-3p's stage chained, carrier k -> sun k+1 by a spline coupling).
+   The bare loop is timed both from Python (``mujoco.mj_step`` per step) and in C
+   (``mujoco.rollout``, no Python per step).  Target: runner / bare Python mj_step <= 1.3.
+2. Several twins at once (``simulate_mujoco_many``, threads): wall time per step per twin.
 3. With ``--convergence``: normalised RMS differences between MuJoCo and the lumped RK4 run of
    demo-3p as the step shrinks.
 
-Run:  python bench/bench_runner.py [--steps N] [--convergence]
+Run:  python bench/bench_runner.py [--steps N] [--twins K] [--convergence]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import mujoco
 import numpy as np
+from mujoco import rollout
 
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.loader import load_train
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.lumped.variants import chained
-from gearcheck.mbd_models.runner import simulate_mujoco
+from gearcheck.mbd_models.runner import simulate_mujoco, simulate_mujoco_many
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.settings import RunSettings
 
@@ -42,26 +46,63 @@ def bare_step_cost(mb, n_steps: int, dt: float) -> float:
     return (time.perf_counter() - started) / n_steps
 
 
-def runner_step_cost(mb, n_steps: int, dt: float) -> float:
-    res = simulate_mujoco(mb, RunSettings(n_steps * dt, dt))
+def rollout_step_cost(mb, n_steps: int, dt: float) -> float:
+    """A bare mj_step loop in C: ``mujoco.rollout`` with the controls held, sensors recorded."""
+    m = mb.model
+    m.opt.timestep = dt
+    m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    d = mujoco.MjData(m)
+    for mid, speed in mb.kin.speeds.items():
+        d.qvel[mb.dadr[mid][2]] = speed
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, state, spec)
+    control = np.zeros((1, n_steps, m.nu))
+    started = time.perf_counter()
+    rollout.rollout(m, d, state[None], control)
+    return (time.perf_counter() - started) / n_steps
+
+
+def runner_step_cost(mb, n_steps: int, dt: float, engine: str) -> float:
+    res = simulate_mujoco(mb, RunSettings(n_steps * dt, dt), engine=engine)
+    assert res.info["engine"] == engine
     return res.info["wall_time_s"] / res.info["steps"]
 
 
-def cost_table(n_steps: int, repeats: int = 3):
-    print(f"runner vs bare mj_step (RK4, same model, same step), best of {repeats}, {n_steps} steps")
-    print(f"{'train':<10} {'bodies':>6} {'tendons':>7} {'dt [s]':>10} {'bare [us]':>10} {'runner [us]':>11} "
-          f"{'ratio':>6} {'steps/s':>9} {'sim s per wall s':>16}")
+def many_step_cost(mb, n_steps: int, dt: float, twins: int, threads: int) -> float:
+    """Wall time of ``twins`` copies of the twin run at once in ``threads`` threads (static states included),
+    per step per twin."""
+    started = time.perf_counter()
+    simulate_mujoco_many([mb] * twins, RunSettings(n_steps * dt, dt), threads=threads)
+    return (time.perf_counter() - started) / (twins * n_steps)
+
+
+def cost_table(n_steps: int, twins: int, repeats: int = 5):
+    threads = os.cpu_count() or 1
+    print(f"runner vs bare mj_step (RK4, same model, same step), best of {repeats}, {n_steps} steps; us per step")
+    print(f"{'':<10} {'':>6} {'':>7} {'':>10} {'bare mj_step':>19} {'runner':>23} {'runner/bare py':>17}"
+          f" {f'{twins} twins, {threads} thr':>17}")
+    print(f"{'train':<10} {'bodies':>6} {'tendons':>7} {'dt [s]':>10} {'python':>9} {'C':>9} {'python':>11} "
+          f"{'compiled':>11} {'before':>8} {'after':>8} {'us/step':>8} {'/bare':>8}")
     rows = []
     for n_stages in (1, 2, 3):
         spec = load_train("demo-3p") if n_stages == 1 else chained(n_stages)
         mb = compile_train(spec)
         dt = mb.model.opt.timestep  # the default step written into the MJCF
-        bare = min(bare_step_cost(mb, n_steps, dt) for _ in range(repeats))
-        run = min(runner_step_cost(mb, n_steps, dt) for _ in range(repeats))
-        rows.append((n_stages, bare, run))
+        runner_step_cost(mb, 100, dt, "compiled")  # load the compiled loop
+        costs = []
+        for _ in range(repeats):  # interleaved, so that a change in the machine's load touches every column
+            costs.append((bare_step_cost(mb, n_steps, dt), rollout_step_cost(mb, n_steps, dt),
+                          runner_step_cost(mb, n_steps, dt, "python"), runner_step_cost(mb, n_steps, dt, "compiled"),
+                          many_step_cost(mb, n_steps, dt, twins, threads)))
+        bare, bare_c, before, after, many = np.min(costs, axis=0)
+        rows.append((n_stages, bare, bare_c, before, after, many))
         label = f"{n_stages} stage" + ("s" if n_stages > 1 else "")
-        print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>10.2f} "
-              f"{run * 1e6:>11.2f} {run / bare:>6.3f} {1 / run:>9.0f} {dt / run:>16.4f}")
+        print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>9.2f} "
+              f"{bare_c * 1e6:>9.2f} {before * 1e6:>11.2f} {after * 1e6:>11.2f} {before / bare:>8.3f} "
+              f"{after / bare:>8.3f} {many * 1e6:>8.2f} {many / bare:>8.3f}")
+    print("runner/bare C (compiled): " + ", ".join(f"{r[0]} stage{'s' if r[0] > 1 else ''} {r[4] / r[2]:.3f}"
+                                                   for r in rows))
     return rows
 
 
@@ -96,10 +137,11 @@ def convergence_table(duration: float = 0.05, settle: float = 0.025):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=20000)
+    parser.add_argument("--twins", type=int, default=4)
     parser.add_argument("--convergence", action="store_true")
     args = parser.parse_args()
     print(f"mujoco {mujoco.__version__}")
-    cost_table(args.steps)
+    cost_table(args.steps, args.twins)
     if args.convergence:
         convergence_table()
 

@@ -46,16 +46,27 @@ Outputs: accelerations from MuJoCo's ``framelinacc``/``frameangacc`` sensors, me
 its tendon lengths, mesh and bearing forces from its generalized forces
 (:class:`~gearcheck.mbd_models.forces.ForceReader`); an RV reducer's pin forces from its pin tendons and its
 needle bearings' forces from their actuators.
+
+Engines: the loop above runs in C by default (:mod:`gearcheck.mbd_models.compiled`: the same model writes and
+MuJoCo calls from a numba kernel, the drive computed in arrays a chunk of steps at a time; equal to the Python
+loop to round-off, and about 1.1-1.2 times a bare ``mj_step``); ``engine="python"`` keeps it in Python (the lean
+single-carrier stepper or the general one), and the "bodies" stiffness clock always does.
+:func:`simulate_mujoco_many` runs several twins at once in threads.
 """
 
 from __future__ import annotations
 
+import concurrent.futures
+import copy
+import dataclasses
 import math
+import os
 import time as clock
 
 import mujoco
 import numpy as np
 
+from gearcheck.mbd_models import compiled
 from gearcheck.mbd_models.forces import ForceReader
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
 from gearcheck.mbd_models.twin import MbdModel
@@ -100,10 +111,10 @@ class _Drive:
         pairs = None if kp is None else np.stack([kp, ep], axis=-1)
         return self.exc.stiffness(t), self.controls(t), e, de, pairs
 
-    def steps(self, t0: np.ndarray, h: float):
+    def steps(self, t0: np.ndarray, h):
         """For steps starting at t0: each of (k, u, e, de, pairs) as (stage-1 rows, stages-2..4 rows), sampled
-        at t0 + h STAGE_OFFSETS and weighted as the lumped RK4 drives its steps."""
-        *values, pairs = self.at(t0[:, None] + h * np.array(STAGE_OFFSETS)[None, :])
+        at t0 + h STAGE_OFFSETS and weighted as the lumped RK4 drives its steps (h one step, or one per row)."""
+        *values, pairs = self.at(t0[:, None] + np.reshape(h, (-1, 1)) * np.array(STAGE_OFFSETS)[None, :])
         out = [(None, None) if x is None else tuple(per_step_drive(x)[:, :2].swapaxes(0, 1)) for x in values]
         return out + [(None, None) if pairs is None else tuple(per_step_pairs(pairs)[:, :2].swapaxes(0, 1))]
 
@@ -294,11 +305,85 @@ class _LeanStepper(_Stepper):
             rk(m, d, 4)
 
 
+class _CompiledStepper(_Stepper):
+    """The general stepper's contract with its step loop compiled (:func:`gearcheck.mbd_models.compiled.run_steps`):
+    the drive of a chunk of steps (and of its split steps' sub-steps) computed here in arrays, then every step
+    in C, an RV reducer's pin tendons set to the discs' poses there too.  Not for the "bodies" stiffness clock
+    (its stiffness models are Python functions of the bodies' angles)."""
+
+    def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool):
+        super().__init__(mb, d, h, n_samples, bodies, energy)
+        m, n, tc, reader = self.m, self.n_mesh, mb.turning, self.reader
+        self.c = compiled.library()
+        self.pointers = (m._address, d._address, reader.probe._address, reader.joints_only._address)
+        self.model_views = (m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm, compiled.timestep_view(m),
+                            reader.probe.tendon_stiffness[:n], reader.probe.tendon_lengthspring[:n], m.tendon_damping)
+        self.data_views = (d.qpos, d.qvel, d.ctrl, d.qfrc_applied, d.sensordata, d.qfrc_spring, d.qfrc_damper,
+                           d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length, d.ten_velocity)
+        self.cycloid_arrays = compiled.cycloid_arrays(mb.cycloid, m.nv)
+        self.turning_arrays = tuple(np.ascontiguousarray(x) for x in (
+            tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
+            mb.half_backlash))
+        c = self.contacts
+        none = np.zeros(0, dtype=np.int64)
+        self.contact_arrays = ((none, none, none, np.zeros(1, dtype=np.int64)) if c is None else
+                               tuple(np.ascontiguousarray(x, dtype=np.int64) for x in
+                                     (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps)))))
+        self.work = (mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n))
+        self.reader_arrays = (np.ascontiguousarray(reader.dofs, dtype=np.int64),
+                              np.ascontiguousarray(reader.slides, dtype=np.int64))
+        self.outputs = (self.sensors, self.forces,
+                        np.zeros((0, n)) if self.stiffness is None else self.stiffness,
+                        np.zeros((0, 2)) if self.energy is None else self.energy,
+                        np.zeros((0, 0)) if self.pins is None else self.pins)
+        self.flags = (self.drive.has_te, self.contacts is not None, self.stiffness is not None,
+                      self.energy is not None, self.pins is not None)
+
+    def _arrays(self, values, rows: int):
+        """(k1, k2, u1, u2, e1, e2, de1, de2, p1, p2) of :meth:`_Drive.steps` as contiguous arrays, the absent
+        ones empty along their last axes."""
+        n = self.n_mesh
+        empty = (np.zeros((rows, n)), np.zeros((rows, self.m.nu)), np.zeros((rows, 0)), np.zeros((rows, 0)),
+                 np.zeros((rows, 0, 0, 2)))
+        return tuple(np.ascontiguousarray(y) if y is not None else blank
+                     for (first, later), blank in zip(values, empty) for y in (first, later))
+
+    def run(self, start, stop, every, values, split) -> None:
+        rows = stop - start
+        first, count = np.zeros(rows, dtype=np.int64), np.zeros(rows, dtype=np.int64)
+        starts, lengths = [], []
+        for step in sorted(split):
+            a, length = stepping.sub_steps(step * self.h, self.h, split[step])
+            first[step - start], count[step - start] = len(lengths), len(length)
+            starts += list(a)
+            lengths += list(length)
+        lengths = np.array(lengths, dtype=float)
+        sub = (self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size
+               else [(None, None)] * 5)
+        split_arrays = (first, count, lengths) + self._arrays(sub, lengths.size)
+        c = self.c
+        self.j = compiled.run_steps(c.forward, c.runge_kutta, c.passive, c.kinematics, c.com_pos, c.jac,
+                                    self.pointers, self.model_views, self.data_views, self.turning_arrays,
+                                    self.contact_arrays, self.work, self.reader_arrays, self.cycloid_arrays,
+                                    self._arrays(values, rows), split_arrays, self.flags, self.outputs, self.h, start,
+                                    stop, every, self.j)
+
+
+def compiled_unsupported(mb: MbdModel, stiffness_clock: str = "nominal") -> str | None:
+    """Why the compiled step loop cannot run ``mb`` (None: it can)."""
+    if stiffness_clock != "nominal":
+        return "the 'bodies' stiffness clock evaluates the stiffness models from the bodies' angles in Python"
+    return compiled.unavailable()
+
+
 # --------------------------------------------------------------------------- run
 
 
+ENGINES = ("auto", "compiled", "python")
+
+
 def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffness_clock: str = "nominal",
-                    initial_state=None, record_energy: bool = False) -> TimeResult:
+                    initial_state=None, record_energy: bool = False, engine: str = "auto") -> TimeResult:
     """Run the MuJoCo twin ``mb`` as ``settings`` ask; a :class:`TimeResult` with the lumped solver's signals.
 
     The step defaults to the model's own (``mb.default_step``) and is refused above the stability
@@ -306,10 +391,19 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     like the lumped solver) or "bodies" (mesh position from the MuJoCo bodies' own rotation angles;
     transmission error stays on the nominal clock).  initial_state: optional (qpos, qvel) instead of
     the static start.  record_energy: enable ``mjENBL_ENERGY`` and return MuJoCo's kinetic and
-    potential energy in ``raw``.
+    potential energy in ``raw``.  engine: "compiled" (the step loop in C,
+    :mod:`gearcheck.mbd_models.compiled`; the same steps, equal to round-off), "python" (the loop in Python),
+    or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); ``info["engine"]`` says which
+    ran.
     """
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
+    if engine not in ENGINES:
+        raise SolverError(f"engine must be one of {', '.join(map(repr, ENGINES))}, not {engine!r}")
+    unsupported = None if engine == "python" else compiled_unsupported(mb, stiffness_clock)
+    if engine == "compiled" and unsupported:
+        raise SolverError(f"the compiled MuJoCo runner cannot run {mb.spec.name}: {unsupported}")
+    use_compiled = engine != "python" and not unsupported
     spec, m = mb.spec, mb.model
     dt = mb.default_step if settings.dt is None else settings.dt
     what = f"MuJoCo model of {spec.name}"
@@ -332,8 +426,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     d.qpos[:], d.qvel[:] = qpos0, qvel0
     lean = (mb.turning.single is not None and not mb.excitation.has_transmission_error
             and not mb.excitation.relieved.size and stiffness_clock == "nominal" and not record_energy)
-    stepper = (_LeanStepper if lean else _Stepper)(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies",
-                                                   record_energy)
+    kind = _CompiledStepper if use_compiled else _LeanStepper if lean else _Stepper
+    stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
     try:
         started = clock.perf_counter()
@@ -357,8 +451,37 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
             "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
             "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
             "static_newton_iterations": static.iterations, "static_residual": static.residual,
-            "forward_evaluations": 4 * n_steps}
+            "forward_evaluations": 4 * n_steps, "engine": "compiled" if use_compiled else "python"}
     return _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
+
+
+def simulate_mujoco_many(twins, settings, threads: int | None = None, **options) -> list[TimeResult]:
+    """Run several twins (variants: other speeds, parameters, trains) at once, each as :func:`simulate_mujoco`
+    runs it with ``options``; their results in order.
+
+    settings: one :class:`RunSettings` for all, or one per twin.  threads: how many run at a time (default: one
+    per core, at most one per twin).  The compiled step loop releases the GIL, so its runs proceed in parallel
+    (the Python engine's only interleave).  A run writes its model's fields (stiffness, coefficients, step), so a
+    twin given twice runs on a copy of its compiled model (an RV reducer's twin, whose pin contacts hold their
+    model, is refused twice).
+    """
+    twins = list(twins)
+    runs = list(settings) if isinstance(settings, (list, tuple)) else [settings] * len(twins)
+    if len(runs) != len(twins):
+        raise SolverError(f"simulate_mujoco_many: {len(runs)} settings for {len(twins)} twins")
+    seen, own = set(), []
+    for mb in twins:
+        if id(mb.model) in seen:
+            if mb.cycloid is not None:
+                raise SolverError(f"simulate_mujoco_many: the twin of {mb.spec.name} is given twice; compile it "
+                                  "once per run (an RV reducer's pin contacts hold their model)")
+            mb = dataclasses.replace(mb, model=copy.copy(mb.model))
+        seen.add(id(mb.model))
+        own.append(mb)
+    workers = max(1, min(len(own), threads or os.cpu_count() or 1))
+    with concurrent.futures.ThreadPoolExecutor(workers) as pool:
+        jobs = [pool.submit(simulate_mujoco, mb, run, **options) for mb, run in zip(own, runs)]
+        return [job.result() for job in jobs]
 
 
 def _check_divergence(stepper: _Stepper, j0: int, t_now: float, interval: float, scale: float, what: str) -> None:

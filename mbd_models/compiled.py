@@ -1,0 +1,343 @@
+"""The MuJoCo runner's step loop compiled: MuJoCo's own C functions called from a numba kernel, no Python per step.
+
+:func:`run_steps` does, step for step, what :class:`gearcheck.mbd_models.runner._Stepper` does in Python (the
+same operations in the same order): turn the mesh tendons' world-frame slide coefficients with their carriers
+(``wrap_prm``), drive stage 1 (mesh stiffness, controls, spring lengths of a transmission error and a backlash,
+the relieved meshes' tooth pairs in contact, the damping correction J^T g into ``qfrc_applied``),
+``mj_forward``, sample, drive stages 2-4, ``mj_RungeKutta``; a step inside which a mesh stiffness jumps as RK4
+sub-steps ended there (MuJoCo's ``opt.timestep`` set to each one's length).  The drive itself -- the excitation
+functions of the train, sampled at every stage -- is computed beforehand in arrays, a chunk of steps at a time,
+by the runner.  Every force law stays MuJoCo's: the kernel only writes the model fields and the data that the
+Python loop writes, and calls ``mj_forward``, ``mj_RungeKutta`` and ``mj_passive`` (the force reader's probes) on
+the compiled model through its C library (``ctypes``), with the GIL released, so several twins run at once in
+threads (:func:`gearcheck.mbd_models.runner.simulate_mujoco_many`).
+
+The kernel is compiled on first use and cached by numba next to this file.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import os
+from glob import glob
+
+import mujoco
+import numba
+import numpy as np
+
+from gearcheck.mbd_models.mjcf_builder import PIN_BAND
+
+_LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
+_OPTION_DOUBLES_BEFORE_GRAVITY = 7  # mjOption: timestep, impratio, 4 tolerances, sleep_tolerance, then gravity[3]
+
+
+class _MuJoCoC:
+    """MuJoCo's C functions the kernel calls, from the library the Python bindings load."""
+
+    def __init__(self):
+        folder = os.path.dirname(mujoco.__file__)
+        paths = [p for pattern in _LIBRARY_NAMES for p in sorted(glob(os.path.join(folder, pattern)))]
+        if not paths:
+            raise OSError(f"no MuJoCo C library next to the Python bindings in {folder}")
+        lib = ctypes.CDLL(paths[0])
+        pair = [ctypes.c_void_p, ctypes.c_void_p]
+        self.forward = lib.mj_forward
+        self.forward.argtypes, self.forward.restype = pair, None
+        self.runge_kutta = lib.mj_RungeKutta
+        self.runge_kutta.argtypes, self.runge_kutta.restype = pair + [ctypes.c_int], None
+        self.passive = lib.mj_passive
+        self.passive.argtypes, self.passive.restype = pair, None
+        self.kinematics = lib.mj_kinematics
+        self.kinematics.argtypes, self.kinematics.restype = pair, None
+        self.com_pos = lib.mj_comPos
+        self.com_pos.argtypes, self.com_pos.restype = pair, None
+        self.jac = lib.mj_jac  # (m, d, jacp, jacr, point, body)
+        self.jac.argtypes = pair + [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int]
+        self.jac.restype = None
+
+
+_C: _MuJoCoC | None = None
+_C_ERROR: str | None = None
+
+
+def library() -> _MuJoCoC | None:
+    """MuJoCo's C functions, or None where its library cannot be loaded (:func:`unavailable` says why)."""
+    global _C, _C_ERROR
+    if _C is None and _C_ERROR is None:
+        try:
+            _C = _MuJoCoC()
+        except (OSError, AttributeError) as exc:
+            _C_ERROR = str(exc)
+    return _C
+
+
+def unavailable() -> str | None:
+    """Why the compiled loop cannot run here, or None."""
+    library()
+    return _C_ERROR
+
+
+def timestep_view(m: mujoco.MjModel) -> np.ndarray:
+    """A one-element array that is ``m.opt.timestep`` itself (the kernel sets a split step's sub-steps there):
+    found from ``opt.gravity``'s address and the layout of ``mjOption``, and checked by writing through it."""
+    gravity = m.opt.gravity.__array_interface__["data"][0]
+    view = np.ctypeslib.as_array((ctypes.c_double * 1).from_address(gravity - 8 * _OPTION_DOUBLES_BEFORE_GRAVITY))
+    saved = m.opt.timestep
+    view[0] = 0.5 * saved + 1e-300
+    ok = m.opt.timestep == view[0]
+    m.opt.timestep = saved
+    if not ok or view[0] != saved:
+        raise OSError("this MuJoCo's mjOption layout is not the one gearcheck's compiled runner knows")
+    return view
+
+
+@numba.njit(cache=True)
+def _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef):
+    """The world-frame slide coefficients turned to the carriers' angles (``MbdModel.refresh``)."""
+    for w in range(wraps.size):
+        phi = qpos[carrier_qadr[w]]
+        coef[w] = base[w, 0] * math.cos(phi) + base[w, 1] * math.sin(phi)
+        wrap_prm[wraps[w]] = coef[w]
+
+
+def cycloid_arrays(cyc, nv: int):
+    """An RV reducer's pin contacts (:class:`~gearcheck.mbd_models.cycloid_twin.CycloidTwin`) as flat arrays for
+    :func:`_pins`: per pin tendon (its rows' order) its tendon, stiffness, damping, clearance, pin site and
+    ``wrap_prm`` entries; per disc its body, pin wheel (-1: none), phase, lobes, eccentricity, pitch radius, first
+    row and its tendons' dofs and qpos addresses; and work space.  None: empty arrays of the same types."""
+    rows, discs = [], []
+    width = 6
+    if cyc is not None:
+        width = max([g.dofs.shape[1] for g in cyc.stages], default=6)
+        for g in cyc.stages:
+            for i, body in enumerate(g.bodies):
+                first = g.rows.start + i * len(g.sites)
+                dofs, qadr = np.full(width, -1), np.full(width, -1)
+                dofs[:g.dofs.shape[1]], qadr[:g.dofs.shape[1]] = g.dofs[i], g.qadr[i]
+                discs.append((body, g.wheel, g.phases[i], g.lobes, g.eccentricity, g.pitch_radius, first,
+                              len(g.sites), g.dofs.shape[1], dofs, qadr))
+                for p, site in enumerate(g.sites):
+                    wraps = np.full(width, -1)
+                    wraps[:g.dofs.shape[1]] = g.wraps[i, p]
+                    rows.append((site, wraps))
+    i64, f64 = np.int64, np.float64
+    n_pins = len(rows)
+    pins = (np.asarray(cyc.tendons if cyc is not None else [], dtype=i64),
+            np.asarray(cyc.stiffness if cyc is not None else [], dtype=f64),
+            np.asarray(cyc.damping if cyc is not None else [], dtype=f64),
+            np.asarray(cyc.clearance if cyc is not None else [], dtype=f64),
+            np.array([r[0] for r in rows], dtype=i64), np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
+    columns = list(zip(*discs)) if discs else [[]] * 11
+    types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
+    disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))
+    disc = disc[:9] + tuple(x.reshape(len(discs), width) for x in disc[9:])
+    work = (np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins))
+    return pins, disc, work
+
+
+@numba.njit(cache=True)
+def _pins(kinematics, com_pos, jac, m, d, model, data, cyc, work):
+    """``CycloidTwin.refresh(d)`` (a run's compression-only contacts): every pin tendon's coefficients, spring
+    lengths, stiffness and damping at the discs' present poses, from MuJoCo's kinematics and Jacobians."""
+    stiffness, lengthspring, wrap_prm, damping_model = model[0], model[1], model[2], model[6]
+    qpos, xpos, xmat, site_xpos = data[0], data[8], data[9], data[10]
+    tendons, k_pin, c_pin, clearance, site, wraps = cyc[0]
+    body, wheel, phase, lobes, ecc, pitch_radius, first, count, ndof, dofs, qadr = cyc[1]
+    jacobian, point, G, delta, length = work
+    kinematics(m, d)
+    com_pos(m, d)
+    for i in range(body.size):
+        b, wh = body[i], wheel[i]
+        cx, cy = xpos[b, 0], xpos[b, 1]
+        if wh >= 0:
+            ox, oy = xpos[wh, 0], xpos[wh, 1]
+            w = math.atan2(xmat[wh, 3], xmat[wh, 0])
+        else:
+            ox, oy, w = 0.0, 0.0, 0.0
+        phi = phase[i] + (1 + lobes[i]) * w - lobes[i] * math.atan2(xmat[b, 3], xmat[b, 0])
+        ux, uy = math.cos(phi), math.sin(phi)
+        point[0] = ox + pitch_radius[i] * ux
+        point[1] = oy + pitch_radius[i] * uy
+        point[2] = xpos[b, 2]
+        jac(m, d, jacobian.ctypes.data, 0, point.ctypes.data, b)
+        for r in range(2):
+            for k in range(ndof[i]):
+                G[r, k] = jacobian[r, dofs[i, k]]
+        if wh >= 0:
+            jac(m, d, jacobian.ctypes.data, 0, point.ctypes.data, wh)
+            for r in range(2):
+                for k in range(ndof[i]):
+                    G[r, k] -= jacobian[r, dofs[i, k]]
+        vx, vy = cx - ox - ecc[i] * ux, cy - oy - ecc[i] * uy
+        for p in range(first[i], first[i] + count[i]):
+            nx, ny = site_xpos[site[p], 0] - point[0], site_xpos[site[p], 1] - point[1]
+            size = math.sqrt(nx * nx + ny * ny)
+            nx /= size
+            ny /= size
+            delta[p] = nx * vx + ny * vy
+            total = 0.0
+            for k in range(ndof[i]):
+                coef = nx * G[0, k] + ny * G[1, k]
+                wrap_prm[wraps[p, k]] = coef
+                total += coef * qpos[qadr[i, k]]
+            length[p] = total
+    for p in range(tendons.size):
+        t = tendons[p]
+        compression = delta[p] - clearance[p]
+        top = length[p] - compression
+        lengthspring[t, 0] = top - PIN_BAND
+        lengthspring[t, 1] = top
+        stiffness[t] = k_pin[p]
+        damping_model[t] = c_pin[p] * (compression > 0.0)
+
+
+@numba.njit(cache=True)
+def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, contacts, work):
+    """``_Stepper.set_stage``: stiffness, controls, spring lengths, tooth contacts, damping correction."""
+    stiffness, lengthspring, wrap_prm = model[0], model[1], model[2]
+    qpos, qvel, ctrl, applied = data[0], data[1], data[2], data[3]
+    wraps, base, carrier_qadr, tendon, slide_qadr, slide_dof, damping, half_backlash = turning
+    rel_tendons, rel_wraps, rel_qadr, rel_starts = contacts
+    J, coef, g = work
+    n = k.size
+    for i in range(n):
+        stiffness[i] = k[i]
+    for i in range(u.size):
+        ctrl[i] = u[i]
+    if has_te:
+        for i in range(n):
+            lengthspring[i, 0] = e[i] - half_backlash[i]
+            lengthspring[i, 1] = e[i] + half_backlash[i]
+    if has_pairs:  # _ToothContacts.apply
+        for r in range(rel_tendons.size):
+            t = rel_tendons[r]
+            offset = e[t] if has_te else 0.0
+            length = 0.0
+            for w in range(rel_starts[r], rel_starts[r + 1]):
+                length += wrap_prm[rel_wraps[w]] * qpos[rel_qadr[w]]
+            length -= offset
+            total = 0.0
+            moment = 0.0
+            for p in range(pairs.shape[1]):
+                if length > pairs[r, p, 1]:
+                    total += pairs[r, p, 0]
+                    moment += pairs[r, p, 0] * pairs[r, p, 1]
+            stiffness[t] = total
+            spring = offset + (moment / total if total > 0 else 0.0)
+            lengthspring[t, 0] = spring
+            lengthspring[t, 1] = spring
+    # DampingCorrection.apply: g = c (de/dt - m), qfrc_applied = J^T g
+    half = wraps.size // 2
+    for w in range(wraps.size):
+        coef[w] = wrap_prm[wraps[w]]
+        J[tendon[w], slide_dof[w]] = coef[w]
+    for i in range(n):
+        g[i] = 0.0
+    for w in range(wraps.size):
+        turned = -coef[w + half] if w < half else coef[w - half]  # dc/dphi: the pair (x, y) turns as (-y, x)
+        g[tendon[w]] -= damping[tendon[w]] * (turned * qvel[carrier_qadr[w]] * qpos[slide_qadr[w]])
+    if has_te:
+        for i in range(n):
+            g[i] += damping[i] * de[i]
+    for v in range(applied.size):
+        s = 0.0
+        for i in range(n):
+            s += g[i] * J[i, v]
+        applied[v] = s
+
+
+@numba.njit(cache=True)
+def _sample(j, passive, pointers, model, data, reader, outputs, record, pins):
+    """``_Stepper.sample``: sensordata, the force reader's generalized forces (``ForceReader.sample``), and
+    optionally the stiffness used and MuJoCo's energy, into row ``j``."""
+    stiffness, lengthspring = model[0], model[1]
+    probe_stiffness, probe_lengthspring = model[4], model[5]
+    sensordata, spring, damper, energy, applied = data[4], data[5], data[6], data[7], data[3]
+    dofs, slides = reader
+    sensors, forces, used, energies, pin_forces = outputs
+    record_stiffness, record_energy, has_pins = record
+    sensors[j, :] = sensordata
+    n = probe_stiffness.size
+    for i in range(n):
+        probe_stiffness[i] = stiffness[i]
+        probe_lengthspring[i, 0] = lengthspring[i, 0]
+        probe_lengthspring[i, 1] = lengthspring[i, 1]
+    passive(pointers[2], pointers[1])
+    nd = dofs.size
+    for i in range(nd):
+        forces[j, i] = spring[dofs[i]] + damper[dofs[i]]
+        forces[j, nd + i] = applied[dofs[i]]
+    passive(pointers[3], pointers[1])
+    for i in range(slides.size):
+        forces[j, 2 * nd + i] = spring[slides[i]] + damper[slides[i]]
+    if record_stiffness:
+        for i in range(n):
+            used[j, i] = stiffness[i]
+    if record_energy:
+        energies[j, 0] = energy[0]
+        energies[j, 1] = energy[1]
+    if has_pins:  # CycloidTwin.pin_forces
+        tendons, ten_length, ten_velocity, damping = pins[0][0], data[11], data[12], model[6]
+        for p in range(tendons.size):
+            t = tendons[p]
+            compression = ten_length[t] - lengthspring[t, 1]
+            pin_forces[j, p] = stiffness[t] * max(compression, 0.0) + damping[t] * ten_velocity[t]
+
+
+@numba.njit(nogil=True, cache=True)
+def run_steps(forward, runge_kutta, passive, kinematics, com_pos, jac, pointers, model, data, turning, contacts,
+              work, reader, cycloid, drive, split, flags, outputs, h, start, stop, every, j):
+    """Steps start..stop-1 of one twin, sampling those that begin on a multiple of ``every`` into rows j.. of
+    ``outputs``; returns the next row.
+
+    pointers: (mjModel, mjData, the force reader's mesh probe, its joints-only probe) addresses.  model: views of
+    (tendon_stiffness, tendon_lengthspring, wrap_prm, opt.timestep, the probe's tendon_stiffness and
+    tendon_lengthspring, tendon_damping).  data: views of (qpos, qvel, ctrl, qfrc_applied, sensordata, qfrc_spring,
+    qfrc_damper, energy, xpos, xmat, site_xpos, ten_length, ten_velocity).  cycloid: (pins, discs, work) of
+    :func:`cycloid_arrays`.  drive: (k1, k2, u1, u2, e1, e2, de1, de2, p1, p2), one row per step, stage 1 and
+    stages 2-4 as :meth:`gearcheck.mbd_models.runner._Drive.steps` gives them.  split: (first, count, lengths,
+    then the same ten arrays over sub-steps): step i is split when count[i - start] > 0, into sub-steps first.. of
+    those rows.
+    flags: (transmission error, tooth pairs, record stiffness, record energy, pin contacts).  outputs: (sensordata,
+    force reader, stiffness, energy, pin forces) rows."""
+    wrap_prm, timestep = model[2], model[3]
+    qpos = data[0]
+    wraps, base, carrier_qadr = turning[0], turning[1], turning[2]
+    coef = work[1]
+    k1, k2, u1, u2, e1, e2, de1, de2, p1, p2 = drive
+    first, count, lengths, sk1, sk2, su1, su2, se1, se2, sde1, sde2, sp1, sp2 = split
+    has_te, has_pairs, has_pins = flags[0], flags[1], flags[4]
+    record = (flags[2], flags[3], has_pins)
+    m, d = pointers[0], pointers[1]
+    for step in range(start, stop):
+        i = step - start
+        sample = step % every == 0
+        if count[i] > 0:
+            for s in range(first[i], first[i] + count[i]):
+                timestep[0] = lengths[s]
+                if has_pins:
+                    _pins(kinematics, com_pos, jac, m, d, model, data, cycloid[0:2], cycloid[2])
+                _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef)
+                _set_stage(sk1[s], su1[s], se1[s], sde1[s], sp1[s], has_te, has_pairs, model, data, turning,
+                           contacts, work)
+                forward(m, d)
+                if sample and s == first[i]:
+                    _sample(j, passive, pointers, model, data, reader, outputs, record, cycloid)
+                    j += 1
+                _set_stage(sk2[s], su2[s], se2[s], sde2[s], sp2[s], has_te, has_pairs, model, data, turning,
+                           contacts, work)
+                runge_kutta(m, d, 4)
+            timestep[0] = h
+            continue
+        if has_pins:
+            _pins(kinematics, com_pos, jac, m, d, model, data, cycloid[0:2], cycloid[2])
+        _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef)
+        _set_stage(k1[i], u1[i], e1[i], de1[i], p1[i], has_te, has_pairs, model, data, turning, contacts, work)
+        forward(m, d)
+        if sample:
+            _sample(j, passive, pointers, model, data, reader, outputs, record, cycloid)
+            j += 1
+        _set_stage(k2[i], u2[i], e2[i], de2[i], p2[i], has_te, has_pairs, model, data, turning, contacts, work)
+        runge_kutta(m, d, 4)
+    return j

@@ -14,6 +14,7 @@ The front door:
 * :func:`crosscheck` -- both solvers compared, with measurements, tolerances and baselines;
 * :func:`harmonic_response`, :func:`sensitivity` -- the steady forced response by harmonic methods and its
   derivatives to the numbers of a train file;
+* :func:`sweep` -- speed sweeps, parameter studies and Monte Carlo, cached, on local processes or Dask;
 * :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check.
 
 Packages: :mod:`gearcheck.lumped` (train description and reference solver),
@@ -42,6 +43,7 @@ from gearcheck.api import (  # noqa: E402
                            presets,
                            sensitivity,
                            simulate,
+                           sweep,
                            write_report,
 )
 from gearcheck.compare.engine import CrosscheckResult
@@ -57,4 +59,4 @@ __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "
            "Periodic", "SolverError", "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell",
            "crosscheck",
            "export_model", "harmonic_response", "load", "mjcf", "mode_pairing", "modes", "presets", "sensitivity",
-           "simulate", "write_report"]
+           "simulate", "sweep", "write_report"]

@@ -32,7 +32,7 @@ from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rpm_to_rad_s
 
 __all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "harmonic_response", "load", "mjcf", "mode_pairing",
-           "modes", "presets", "sensitivity", "simulate", "write_report"]
+           "modes", "presets", "sensitivity", "simulate", "sweep", "write_report"]
 
 SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
 
@@ -184,6 +184,63 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
         ``write(directory)``.
     """
     return _side(solver, load(train, speed), method).run(RunSettings(duration, dt, output_dt, settle), progress)
+
+
+def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
+          solver: str = "both", duration: float = 0.5, harmonics: int = 3, workers: int | None = None,
+          scheduler=None, executor=None, cache=None, progress=None):
+    """A speed sweep, a parameter study or a Monte Carlo: many runs of one train, reduced to one table.
+
+    Each point (a train file with swept fields edited, at one speed) runs each solver once and reduces
+    the steady state to the mean, RMS and peak-to-peak of every gated quantity and its amplitude and phase
+    at the mesh harmonics, beside the lumped model's natural frequencies at that speed
+    (:mod:`gearcheck.compare.sweep`).  Points are cached by a hash of their inputs, so an interrupted sweep
+    resumes, and the same inputs give the same table, byte for byte.  Worker processes start fresh (forkserver)
+    and never run the calling script again, so a script needs no ``if __name__ == "__main__":`` guard.
+
+    Parameters
+    ----------
+    train : str or path
+        A preset name or the path of a train file (its numbers are edited: not a loaded TrainSpec).
+    speeds : sequence of float, optional
+        Input speeds in rpm, each > 0 (default: the train's own).
+    fields : dict, optional
+        A parameter study: ``{"stages[0].sun.mass": [1.0, 1.2], ...}``, values in the file's own units
+        (the addressing of ``gearcheck calibrate``); the grid over all of them.
+    distributions : dict, optional
+        A Monte Carlo: ``{"stages[0].mesh.ste[0].amplitude_um": "lognormal(10, 1.5)", ...}`` with
+        ``normal(mean, sd)``, ``uniform(low, high)`` or ``lognormal(median, factor)``.
+    samples : int, optional
+        Monte Carlo draws (default 32), each from its own PCG64 stream of ``seed``.
+    seed : int
+        Monte Carlo seed.
+    solver : {"both", "lumped", "mujoco"}
+    duration : float
+        Simulated time of each run in s.
+    harmonics : int
+        Mesh harmonics per mesh frequency.
+    workers : int, optional
+        Local processes (default: the cores available; 1 runs in this process).
+    scheduler : str or distributed.Client, optional
+        A Dask scheduler's address (``tcp://host:8786``) or a client: the points run on that cluster.
+    executor : concurrent.futures.Executor, optional
+        Any executor of your own instead.
+    cache : path, optional
+        Folder of finished points (``KEY.parquet``); None: no cache.
+    progress : callable, optional
+        Called with the fraction of points done.
+
+    Returns
+    -------
+    SweepResult
+        ``table`` (pyarrow), ``to_pandas()``, ``summary()``, ``write(directory)`` (``sweep.parquet``,
+        ``sweep.json``, order plots or a study plot), ``computed``/``cached`` point counts, ``wall_s``.
+    """
+    from gearcheck.compare.sweep import sweep as run_sweep
+
+    return run_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples, seed=seed,
+                     solvers=solver, duration=duration, harmonics=harmonics, workers=workers, scheduler=scheduler,
+                     executor=executor, cache=cache, progress=progress)
 
 
 def export_model(train, path) -> None:

@@ -234,6 +234,40 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
     s.set_defaults(func=cmd_calibrate)
 
+    s = sub.add_parser("sweep", help="speed sweeps, parameter studies and Monte Carlo: many runs reduced to one "
+                                     "Parquet table of mesh-harmonic amplitudes with order plots; cached points, "
+                                     "local processes or a Dask cluster")
+    _train_arg(s)
+    s.add_argument("--speeds", metavar="A:B:N|V,V,...",
+                   help="input speeds in rpm: N from A to B, or a list (default: the train file's)")
+    s.add_argument("--set", action="append", default=[], metavar="FIELD=V,V,...",
+                   help="a parameter study: values of a train-file field in its own units, or FIELD=A:B:N "
+                        "(repeatable: the grid over all), e.g. stages[0].mesh.ste[0].amplitude_um=5,10,20")
+    s.add_argument("--vary", action="append", default=[], metavar="FIELD=DIST",
+                   help="Monte Carlo: a field's distribution, normal(mean,sd), uniform(low,high) or "
+                        "lognormal(median,factor) (repeatable)")
+    s.add_argument("--distributions", type=Path, metavar="FILE",
+                   help="Monte Carlo: a TOML file with a [distributions] table, \"FIELD\" = \"normal(mean, sd)\"")
+    s.add_argument("--samples", type=int, metavar="N", help="Monte Carlo draws (default 32)")
+    s.add_argument("--seed", type=int, default=0, metavar="S", help="Monte Carlo seed (default 0)")
+    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both")
+    s.add_argument("--duration", type=SECONDS, default=0.5, metavar="S", help="simulated time per run (default 0.5 s)")
+    s.add_argument("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics per mesh frequency "
+                                                                         "(default 3)")
+    s.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the cores available; "
+                                                           "1 runs in this process)")
+    s.add_argument("--scheduler", metavar="ADDRESS", help="run the points on a Dask distributed cluster, e.g. "
+                                                         "tcp://scheduler.example.org:8786")
+    s.add_argument("--cache", type=Path, metavar="DIR", help="finished points, one Parquet file per input hash: a "
+                                                            "rerun skips them (default OUT.cache)")
+    s.add_argument("--no-cache", action="store_true", help="keep no cache")
+    s.add_argument("--quantity", action="append", metavar="NAME",
+                   help="a quantity to plot (repeatable; default: carrier and ring accelerations and the first sun "
+                        "and ring mesh forces of each stage)")
+    s.add_argument("--out", type=Path, default=Path("out/sweep"), metavar="DIR",
+                   help="writes sweep.parquet, sweep.json and the figures (default out/sweep)")
+    s.set_defaults(func=cmd_sweep)
+
     s = sub.add_parser("sensitivity", help="derivatives of the steady harmonic response to train-file numbers "
                                            "(closed form, checked by finite differences; maps over speed)")
     _train_arg(s)
@@ -667,6 +701,66 @@ def cmd_calibrate(args) -> int:
         lines = write_calibration(result, spec.name, place.path, args.out)
     for line in lines:
         print(line)
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from gearcheck.compare.distributions import read_distributions
+    from gearcheck.compare.sweep import check_quantities, parse_speeds, parse_values
+
+    speeds = None if args.speeds is None else parse_speeds(args.speeds)
+    fields: dict[str, list[float]] = {}
+    for text in args.set:
+        path, values = parse_values(text)
+        if path in fields:
+            raise GearcheckError(f"--set {path}: given twice")
+        fields[path] = values
+    distributions = read_distributions(args.distributions) if args.distributions is not None else {}
+    for text in args.vary:
+        path, eq, law = text.partition("=")
+        if not eq or not path.strip():
+            raise GearcheckError(f"--vary {text!r}: give FIELD=DISTRIBUTION, e.g. stages[0].sun.mass=normal(1.0,0.05)")
+        if path.strip() in distributions:
+            raise GearcheckError(f"--vary {path.strip()}: given twice")
+        distributions[path.strip()] = law
+    if args.no_cache and args.cache is not None:
+        raise GearcheckError("--cache and --no-cache: give one")
+    cache = None if args.no_cache else (args.cache or args.out.with_name(args.out.name + ".cache"))
+    inside = cache is not None and Path(os.path.abspath(args.out)) in (Path(os.path.abspath(cache)),
+                                                                       *Path(os.path.abspath(cache)).parents)
+    if inside:
+        raise GearcheckError(f"--cache {cache}: inside --out {args.out}, which each run replaces whole: give a folder "
+                             "beside it")
+    if args.quantity:
+        check_quantities(args.train, args.quantity)
+    with OutputDirectory(args.out) as place:
+        bar = ProgressBar(f"sweep {args.train}")
+        result = gearcheck.sweep(args.train, speeds=speeds, fields=fields, distributions=distributions,
+                                 samples=args.samples, seed=args.seed, solver=args.solver, duration=args.duration,
+                                 harmonics=args.harmonics, workers=args.workers, scheduler=args.scheduler,
+                                 cache=cache, progress=bar)
+        bar.close()
+        written = result.write_files(place.path, args.quantity)
+        summary = result.summary()
+    n = len(result.plan.points)
+    per_point = f", {sum(result.point_wall_s) / result.computed:.3g} s per point run" if result.computed else ""
+    print(f"{result.train}: {n} points ({result.computed} run, {result.cached} from the cache"
+          f"{'' if cache is None else f' {cache}'}) in {result.wall_s:.3g} s on {result.backend}{per_point}")
+    by_quantity: dict[str, list[str]] = {}
+    for peak in summary["peaks"]:
+        by_quantity.setdefault(peak["quantity"], []).append(
+            f"{peak['mesh']} x{peak['order']} = {peak['amplitude']:.4g} {peak['unit']} at {peak['speed_rpm']:.6g} rpm "
+            f"({peak['frequency_hz']:.5g} Hz, {peak['solver']})")
+    for quantity, peaks in by_quantity.items():
+        print(f"  {quantity}: largest harmonic " + "; ".join(peaks))
+    if summary["no_steady_state"]:
+        print(f"  {summary['no_steady_state']} of {n * len(result.settings['solvers'])} runs reached no steady state "
+              "(steady = none: their second half is reduced, left out of the peaks and plots); a longer --duration "
+              "helps")
+    for failure in summary["failed"]:
+        print(f"  point {failure['point']} ({failure['solver']}) failed: {failure['error']}")
+    print(f"  wrote {args.out / 'sweep.parquet'} ({result.table.num_rows} rows), "
+          + ", ".join(str(args.out / name) for name in written[1:]))
     return 0
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property, reduce
+from functools import cached_property
 
 import numpy as np
 from scipy import sparse
@@ -187,39 +187,47 @@ class HarmonicResponse:
 
 
 def harmonic_lattice(orders) -> np.ndarray:
-    """The lattice |h_k| <= H_k as (P, d) rows in C order: row P-1-j is minus row j, the centre row h = 0."""
-    return np.stack(np.meshgrid(*[np.arange(-H, H + 1) for H in orders], indexing="ij"), -1).reshape(-1, len(orders))
+    """The harmonics kept, as (P, d) rows in C (lexicographic) order, so that row P-1-j is minus row j and the
+    centre row is h = 0: the box |h_k| <= H_k for ``orders`` (H_1, ..., H_d), or the union of boxes for several
+    (``((45, 4), (4, 45))``, a cross that holds each clock's high harmonics without all their products: the
+    truncated index sets of quasi-periodic harmonic balance, Guskov & Thouverez 2012)."""
+    boxes = np.atleast_2d(orders)
+    return np.unique(np.concatenate([np.stack(np.meshgrid(*[np.arange(-H, H + 1) for H in box], indexing="ij"), -1)
+                                     .reshape(-1, boxes.shape[1]) for box in boxes]), axis=0)
 
 
 def positive_harmonics(problem: ParametricProblem, orders) -> np.ndarray:
-    """One of each pair {h, -h} != 0 of the lattice |h_k| <= H_k, the one with h . omega > 0."""
+    """One of each pair {h, -h} != 0 of the lattice of ``orders``, the one with h . omega > 0."""
     lattice = harmonic_lattice(_orders(problem, orders))
     half = lattice[len(lattice) // 2 + 1:]
     return half * np.where(half @ problem.omegas < 0, -1, 1)[:, None]
 
 
 def hill_operator(problem: ParametricProblem, orders) -> sparse.csc_matrix:
-    """Harmonic balance of M q'' + C(t) q' + K(t) q on the lattice |h_k| <= H_k, unknowns ordered (lattice point in
+    """Harmonic balance of M q'' + C(t) q' + K(t) q on the lattice of ``orders``, unknowns ordered (lattice point in
     C order, coordinate): block (h, g) is -omega_h^2 M [h = g] + i omega_g C_{h-g} + K_{h-g}."""
-    orders = _orders(problem, orders)
-    w = harmonic_lattice(orders) @ problem.omegas
+    lattice = harmonic_lattice(_orders(problem, orders))
+    w = lattice @ problem.omegas
     A = sparse.kron(sparse.diags(-w**2), problem.M)
     for harmonics, rate in ((problem.stiffness_harmonics, None), (problem.damping_harmonics, sparse.diags(1j * w))):
         for m, X_m in harmonics.items():
-            if all(abs(mk) <= 2 * H for mk, H in zip(m, orders)):
-                shift = reduce(sparse.kron, [sparse.eye(2 * H + 1, k=-mk) for mk, H in zip(m, orders)])
+            rows = _rows(lattice, lattice + m)  # block (g + m, g)
+            kept = rows >= 0
+            if kept.any():
+                shift = sparse.csr_matrix((np.ones(kept.sum()), (rows[kept], np.flatnonzero(kept))),
+                                          shape=(len(lattice),) * 2)
                 A = A + sparse.kron(shift if rate is None else shift @ rate, X_m)
     return sparse.csc_matrix(A)
 
 
 def hill_force(problem: ParametricProblem, orders) -> np.ndarray:
     """The right-hand side of :func:`hill_operator`: each force harmonic F_h on its lattice point."""
-    orders = _orders(problem, orders)
-    P = len(harmonic_lattice(orders))
-    out = np.zeros((P, problem.n), dtype=complex)
+    lattice = harmonic_lattice(_orders(problem, orders))
+    out = np.zeros((len(lattice), problem.n), dtype=complex)
     for h, F_h in problem.force_harmonics.items():
-        if all(abs(hk) <= H for hk, H in zip(h, orders)):
-            out[np.ravel_multi_index(tuple(np.asarray(h) + orders), tuple(2 * np.asarray(orders) + 1))] += F_h
+        row = _rows(lattice, np.array([h]))[0]
+        if row >= 0:
+            out[row] += F_h
     return out.ravel()
 
 
@@ -237,7 +245,7 @@ def fourier_series_response(problem: ParametricProblem, harmonics) -> HarmonicRe
 
 def harmonic_balance_response(problem: ParametricProblem, orders) -> HarmonicResponse:
     """Harmonic balance (Hill's method; Bolotin 1964, Nayfeh & Mook 1979) on the lattice |h_k| <= H_k,
-    ``orders`` = H or (H1, H2)."""
+    ``orders`` = H, (H1, H2) or a union of such boxes (:func:`harmonic_lattice`)."""
     A, b = hill_operator(problem, orders), hill_force(problem, orders)
     return lattice_response(problem, orders, refined_solve(splu(A), A, b))
 
@@ -269,17 +277,31 @@ def lattice_response(problem: ParametricProblem, orders, X: np.ndarray) -> Harmo
     orders = _orders(problem, orders)
     X = X.reshape(-1, problem.n)
     h = positive_harmonics(problem, orders)
-    rows = np.ravel_multi_index(tuple((h + orders).T), tuple(2 * np.asarray(orders) + 1))
     truncation = (f"harmonic balance on the lattice {_lattice_text(orders)} of omega = {_omega_text(problem)}; "
                   f"stiffness entries below {problem.tol:g} of the largest dropped")
-    return HarmonicResponse("harmonic balance", truncation, h, h @ problem.omegas, X[len(X) // 2].real, 2 * X[rows])
+    return HarmonicResponse("harmonic balance", truncation, h, h @ problem.omegas, X[len(X) // 2].real,
+                            2 * X[_rows(harmonic_lattice(orders), h)])
 
 
-def _orders(problem: ParametricProblem, orders) -> tuple[int, ...]:
-    orders = tuple(int(H) for H in np.atleast_1d(orders))
-    if len(orders) != problem.dim or min(orders) < 0:
-        raise SolverError(f"orders: {problem.dim} non-negative truncation orders, one per frequency, not {orders}")
-    return orders
+def _rows(lattice: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The row of each of ``points`` in ``lattice`` (C order), -1 where it is not there."""
+    span = np.abs(lattice).max(axis=0)
+    inside = np.all(np.abs(points) <= span, axis=1)
+    dims = tuple(2 * span + 1)
+    keys = np.ravel_multi_index(tuple((lattice + span).T), dims)  # ascending: C order
+    wanted = np.ravel_multi_index(tuple((np.where(inside[:, None], points, 0) + span).T), dims)
+    rows = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+    return np.where(inside & (keys[rows] == wanted), rows, -1)
+
+
+def _orders(problem: ParametricProblem, orders) -> tuple:
+    """``orders`` checked: H (one clock), (H_1, H_2), or a union of such boxes ((H_1, H_2), (H_1', H_2'))."""
+    boxes = np.atleast_2d(np.asarray(orders, dtype=int))
+    if boxes.ndim != 2 or boxes.shape[1] != problem.dim or boxes.min() < 0:
+        raise SolverError(f"orders: {problem.dim} non-negative truncation orders, one per frequency (or several "
+                          f"such boxes), not {orders}")
+    return tuple(int(H) for H in boxes[0]) if len(boxes) == 1 else tuple(tuple(int(H) for H in b) for b in boxes)
+
 
 
 def _harmonics(problem: ParametricProblem, harmonics) -> np.ndarray:
@@ -300,7 +322,7 @@ def _fs_truncation(problem: ParametricProblem, h: np.ndarray) -> str:
 
 
 def _lattice_text(orders) -> str:
-    return ", ".join(f"|h{k + 1}| <= {H}" for k, H in enumerate(orders))
+    return " and ".join(", ".join(f"|h{k + 1}| <= {H}" for k, H in enumerate(box)) for box in np.atleast_2d(orders))
 
 
 def _omega_text(problem: ParametricProblem) -> str:

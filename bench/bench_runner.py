@@ -32,13 +32,19 @@ from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.settings import RunSettings
 
 
-def bare_step_cost(mb, n_steps: int, dt: float) -> float:
+def turning_data(mb, dt: float):
+    """The twin's model on RK4 at step ``dt`` and a data with every body turning at its nominal speed."""
     m = mb.model
     m.opt.timestep = dt
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     d = mujoco.MjData(m)
     for mid, speed in mb.kin.speeds.items():
         d.qvel[mb.dadr[mid][2]] = speed
+    return m, d
+
+
+def bare_step_cost(mb, n_steps: int, dt: float) -> float:
+    m, d = turning_data(mb, dt)
     mujoco.mj_forward(m, d)
     started = time.perf_counter()
     for _ in range(n_steps):
@@ -48,12 +54,7 @@ def bare_step_cost(mb, n_steps: int, dt: float) -> float:
 
 def rollout_step_cost(mb, n_steps: int, dt: float) -> float:
     """A bare mj_step loop in C: ``mujoco.rollout`` with the controls held, sensors recorded."""
-    m = mb.model
-    m.opt.timestep = dt
-    m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
-    d = mujoco.MjData(m)
-    for mid, speed in mb.kin.speeds.items():
-        d.qvel[mb.dadr[mid][2]] = speed
+    m, d = turning_data(mb, dt)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(m, spec))
     mujoco.mj_getState(m, d, state, spec)

@@ -52,6 +52,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import tomli_w
+from threadpoolctl import threadpool_limits
 
 from gearcheck.compare.align import STEADY_THRESHOLD, steady_state
 from gearcheck.compare.calibrate import FitParameter
@@ -385,7 +386,13 @@ class _Rows:
 def run_point(point: Point) -> tuple[bytes, float, float]:
     """Run ``point``: (its table as Parquet bytes, wall time in s, CPU time of this process in s).  A solver that
     fails on the point (it diverges, or refuses a step) gives one row ``metric = "failed"`` with the reason; the
-    others still run."""
+    others still run.  The point runs on one BLAS thread: the cores go to the workers, and a point's numbers are
+    then the same to the last bit whichever backend runs it (a multi-threaded BLAS sums in another order)."""
+    with threadpool_limits(limits=1):
+        return _run_point(point)
+
+
+def _run_point(point: Point) -> tuple[bytes, float, float]:
     started, cpu = time.perf_counter(), time.process_time()
     spec = load_train(load_text(point.text, point.source), point.speed_rpm)
     lumped = LumpedSide(spec)

@@ -6,7 +6,6 @@ interrupted sweep; bad input refused with one line and nothing written."""
 from __future__ import annotations
 
 import math
-import multiprocessing
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -85,12 +84,8 @@ def test_an_interrupted_sweep_keeps_its_finished_points(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         sw.sweep("demo-3p", speeds=SPEEDS, workers=1, cache=tmp_path, progress=stop_at(0.3), **FAST)
     assert len(list(tmp_path.glob("*.parquet"))) == 1 and not list(tmp_path.glob(".*"))
-    with pytest.raises(KeyboardInterrupt):  # processes: the pool's workers are ended, not left running
-        sw.sweep("demo-3p", speeds=SPEEDS + [2500.0], workers=2, cache=tmp_path, progress=stop_at(0.5), **FAST)
-    assert not [p for p in multiprocessing.active_children() if "SpawnProcess" in type(p).__name__
-                or "ForkServerProcess" in type(p).__name__]
     done = sw.sweep("demo-3p", speeds=SPEEDS + [2500.0], workers=1, cache=tmp_path, **FAST)
-    assert done.cached >= 2 and done.computed + done.cached == 4
+    assert done.cached == 1 and done.computed == 3
 
 
 def test_processes_and_a_dask_local_cluster_give_the_same_table(tmp_path):

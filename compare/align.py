@@ -54,7 +54,10 @@ def resample_at(t: np.ndarray, x: np.ndarray, times: np.ndarray) -> np.ndarray:
     """Linear interpolation of ``x`` (time along axis 0) at ``times``, no filtering."""
     if x.ndim == 1:
         return np.interp(times, t, x)
-    return np.stack([np.interp(times, t, x[:, j]) for j in range(x.shape[1])], axis=1)
+    out = np.empty((np.size(times), x.shape[1]))
+    for j in range(x.shape[1]):
+        out[:, j] = np.interp(times, t, x[:, j])
+    return out
 
 
 def steady_start(t: np.ndarray, x: np.ndarray, cycle: float, threshold: float = STEADY_THRESHOLD,
@@ -66,20 +69,30 @@ def steady_start(t: np.ndarray, x: np.ndarray, cycle: float, threshold: float = 
     edges = np.arange(t[0], t[-1] + 1e-12, cycle)
     if edges.size < cycles + 2:
         return None
-    phase = np.arange(CYCLE_POINTS) / CYCLE_POINTS
-    stats = []
-    for a in edges[:-1]:
-        w = resample_at(t, x, a + phase * cycle)  # the same phases in every cycle
-        stats.append((np.std(w, axis=0), np.mean(w, axis=0)))
+    std, mean = _cycle_statistics(t, x, edges[:-1], cycle)
+    change = np.maximum(np.abs(np.diff(std, axis=0)), np.abs(np.diff(mean, axis=0))) / np.maximum(std[1:], 1e-300)
     run = 0
-    for k in range(1, len(stats)):
-        std, mean = stats[k]
-        scale = np.maximum(std, 1e-300)
-        change = np.maximum(np.abs(std - stats[k - 1][0]), np.abs(mean - stats[k - 1][1])) / scale
-        run = run + 1 if np.all(change < threshold) else 0
+    for k, steady in enumerate(np.all(change < threshold, axis=1), start=1):
+        run = run + 1 if steady else 0
         if run >= cycles:
             return float(edges[k - cycles])
     return None
+
+
+CYCLES_PER_BLOCK = 256  # cycles resampled at once by _cycle_statistics
+
+
+def _cycle_statistics(t: np.ndarray, x: np.ndarray, starts: np.ndarray, cycle: float) -> tuple[np.ndarray, np.ndarray]:
+    """(standard deviation, mean) of ``x`` (time x channels) over the cycles from ``starts``, each (cycles x
+    channels), from ``CYCLE_POINTS`` samples at the same phases in every cycle."""
+    x = np.asfortranarray(x)  # each channel contiguous: np.interp reads it without a copy
+    offsets = np.arange(CYCLE_POINTS) / CYCLE_POINTS * cycle
+    std, mean = np.empty((2, starts.size, x.shape[1]))
+    for first in range(0, starts.size, CYCLES_PER_BLOCK):
+        block = starts[first:first + CYCLES_PER_BLOCK]
+        w = resample_at(t, x, (block[:, None] + offsets).ravel()).reshape(block.size, CYCLE_POINTS, -1)
+        std[first:first + block.size], mean[first:first + block.size] = np.std(w, axis=1), np.mean(w, axis=1)
+    return std, mean
 
 
 STEADY_WINDOW_CYCLES = 4  # slowest mesh cycles a steady window must hold after a start found by decay

@@ -63,10 +63,10 @@ class Excitation:
 
     def stiffness(self, t) -> np.ndarray:
         """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...)."""
-        xi = self.mesh_position(t)
-        k = np.empty_like(xi)
-        for j, model in enumerate(self.models):
-            k[..., j] = model(xi[..., j])
+        t = np.asarray(t, dtype=float)
+        k = np.empty(t.shape + (len(self.models),))
+        for j, (f, phase, model) in enumerate(zip(self.frequency, self.phase, self.models)):
+            k[..., j] = model(f * t - phase)  # mesh_position, one mesh at a time
         return k
 
     def tooth_pairs(self, t):

@@ -12,12 +12,22 @@ Both solvers call the same objects, so a new model is one new class registered i
 
 from __future__ import annotations
 
+import functools
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from gearcheck.lumped import helical_mesh, tooth_stiffness
+from gearcheck.lumped.geometry import Gear, MeshGeometry
 from gearcheck.lumped.schema import REQUIRED, Context, Integer, Number, Positive, Table, bound
+
+
+def cycle_fraction(xi) -> np.ndarray:
+    """frac(xi), the position within the mesh cycle: xi - floor(xi), which is exact and so equals np.mod(xi, 1.0)
+    to the bit, in a fraction of its time."""
+    xi = np.asarray(xi, dtype=float)
+    return xi - np.floor(xi)
 
 
 class MeshStiffness:
@@ -52,8 +62,7 @@ class MeshStiffness:
 
     def pairs(self, xi):
         """Tooth pairs in contact at mesh position ``xi``, from the contact ratio."""
-        frac = np.mod(np.asarray(xi, dtype=float), 1.0)
-        return self.pairs_low + (frac < self.multi_fraction)
+        return self.pairs_low + (cycle_fraction(xi) < self.multi_fraction)
 
     @property
     def maximum(self) -> float:
@@ -116,29 +125,56 @@ class EnergyMethodStiffness(MeshStiffness):
 
     def __init__(self, params: dict, mesh):
         self.contact_ratio = mesh.geometry.contact_ratio
-        pitch = mesh.geometry.base_pitch
-        path = self.contact_ratio * pitch
-        parts = [(0.0, self.multi_fraction, self.pairs_low + 1), (self.multi_fraction, 1.0, self.pairs_low)]
-        self.grids = [np.linspace(lo, hi, self.grid_points) for lo, hi, _ in parts]
-        distances = [np.minimum((grid[:, None] + np.arange(n)[None, :]) * pitch, path)
-                     for grid, (_, _, n) in zip(self.grids, parts)]
-        width = min(mesh.central_gear.face_width, mesh.planet_gear.face_width)
-        flat = tooth_stiffness.pair_stiffness_along_path(
-            mesh, np.concatenate([d.ravel() for d in distances]), params["youngs_modulus"],
-            params["poisson_ratio"], params["slices"], params["tooth_load_per_width"] * width)
-        split = distances[0].size
-        self.values = [flat[:split].reshape(distances[0].shape).sum(axis=1),
-                       flat[split:].reshape(distances[1].shape).sum(axis=1)]
-        self.mean = float(sum(np.trapezoid(k, grid) for k, grid in zip(self.values, self.grids)))
+        pair = GearPair(mesh.central_gear, mesh.planet_gear, mesh.geometry)
+        self._xi, self._k, self.mean = _energy_table(pair, self.grid_points, params["youngs_modulus"],
+                                                     params["poisson_ratio"], params["slices"],
+                                                     params["tooth_load_per_width"])
 
     def __call__(self, xi):
-        frac = np.mod(np.asarray(xi, dtype=float), 1.0)
-        (multi, k_multi), (rest, k_rest) = zip(self.grids, self.values)
-        return np.where(frac < self.multi_fraction, np.interp(frac, multi, k_multi), np.interp(frac, rest, k_rest))
+        # both parts in one table: at eps - floor(eps), the end of one part and the start of the next, np.interp
+        # takes the later point, the rest's value, so k jumps there exactly
+        return np.interp(cycle_fraction(xi), self._xi, self._k)
 
     @property
     def maximum(self) -> float:
-        return float(max(np.max(k) for k in self.values))
+        return float(np.max(self._k))
+
+
+class GearPair(NamedTuple):
+    """What the energy method reads of a mesh (:func:`~gearcheck.lumped.tooth_stiffness.pair_stiffness_along_path`
+    takes it for one); hashable, so meshes of equal gears share one table."""
+
+    central_gear: Gear
+    planet_gear: Gear
+    geometry: MeshGeometry
+
+    @property
+    def internal(self) -> bool:
+        return self.central_gear.internal
+
+
+@functools.lru_cache(maxsize=64)
+def _energy_table(pair: GearPair, points: int, youngs_modulus: float, poisson_ratio: float, slices: int,
+                  tooth_load_per_width: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """(xi, k(xi), mean) of :class:`EnergyMethodStiffness` over one cycle (read-only arrays): k tabulated at
+    ``points`` on the multi-pair part [0, eps - floor(eps)] and as many on the rest."""
+    eps, pitch = pair.geometry.contact_ratio, pair.geometry.base_pitch
+    low = math.floor(eps)
+    parts = [(0.0, eps - low, low + 1), (eps - low, 1.0, low)]
+    grids = [np.linspace(lo, hi, points) for lo, hi, _ in parts]
+    distances = [np.minimum((grid[:, None] + np.arange(n)[None, :]) * pitch, eps * pitch)
+                 for grid, (_, _, n) in zip(grids, parts)]
+    width = min(pair.central_gear.face_width, pair.planet_gear.face_width)
+    flat = tooth_stiffness.pair_stiffness_along_path(
+        pair, np.concatenate([d.ravel() for d in distances]), youngs_modulus, poisson_ratio, slices,
+        tooth_load_per_width * width)
+    split = distances[0].size
+    values = [flat[:split].reshape(distances[0].shape).sum(axis=1),
+              flat[split:].reshape(distances[1].shape).sum(axis=1)]
+    mean = float(sum(np.trapezoid(k, grid) for k, grid in zip(values, grids)))
+    xi, k = np.concatenate(grids), np.concatenate(values)
+    xi.flags.writeable = k.flags.writeable = False
+    return xi, k, mean
 
 
 class ContactLineStiffness(MeshStiffness):

@@ -528,20 +528,17 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
         adr, dim = mb.sensor[name]
         return S[:, adr:adr + dim]
 
-    members = list(spec.members)
-    acc = np.empty((t.size, len(members), 3))
-    angle = np.empty((t.size, len(members)))
-    for jm, mid in enumerate(members):
-        member = spec.members[mid]
-        carrier = spec.members[spec.stage_of(mid).carrier]
-        phi = series(f"{carrier.label}_angle")[:, 0] + member.angle
-        lin = series(f"{member.label}_linacc")
-        c, s = np.cos(phi), np.sin(phi)
-        acc[:, jm, 0] = c * lin[:, 0] + s * lin[:, 1]
-        acc[:, jm, 1] = -s * lin[:, 0] + c * lin[:, 1]
-        acc[:, jm, 2] = series(f"{member.label}_angacc")[:, 2]
-        angle[:, jm] = phi
-    delta = np.column_stack([series(f"{m.label}_deflection")[:, 0] for m in spec.meshes])
+    def columns(sensor, axis, labels):  # one axis of a sensor of each label, (n_t, labels)
+        return S[:, [mb.sensor[f"{label}_{sensor}"][0] + axis for label in labels]]
+
+    members = spec.members.values()
+    carriers = [spec.members[spec.stage_of(mid).carrier].label for mid in spec.members]
+    labels = [member.label for member in members]
+    angle = columns("angle", 0, carriers) + [member.angle for member in members]
+    c, s = np.cos(angle), np.sin(angle)
+    lin_x, lin_y = columns("linacc", 0, labels), columns("linacc", 1, labels)
+    acc = np.stack([c * lin_x + s * lin_y, -s * lin_x + c * lin_y, columns("angacc", 2, labels)], axis=-1)
+    delta = columns("deflection", 0, [m.label for m in spec.meshes])
     mesh_force, bearing_force = stepper.reader.forces(stepper.forces[:stepper.j])
     k = (mb.excitation.stiffness(t + STAGE_OFFSETS[0] * info["dt_s"]) if stepper.stiffness is None
          else stepper.stiffness[:stepper.j])

@@ -206,18 +206,28 @@ def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflecti
     (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and bearings are the
     run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
     :func:`disc_names` order (an RV reducer's)."""
-    columns = []
-    for j in range(len(spec.members)):
+    signals = train_signals(spec)
+    values = np.empty((len(t), len(signals)))
+    for j in range(len(spec.members)):  # member by member: small temporaries
         a = acc_carrier[:, j, :]
         c, s = np.cos(carrier_angle[:, j]), np.sin(carrier_angle[:, j])
-        columns += [c * a[:, 0] - s * a[:, 1], s * a[:, 0] + c * a[:, 1], a[:, 0], a[:, 1], a[:, 2]]
-    for j in range(len(spec.meshes)):
-        columns += [mesh_force[:, j], mesh_deflection[:, j], mesh_force[:, j] / static_mesh_force[j],
-                    mesh_stiffness[:, j]]
-    columns += [bearing_force[:, j] for j in range(bearing_force.shape[1])]
-    for j in range(len(disc_names(spec))):
-        columns += [pin_force[:, j].max(axis=-1), (pin_force[:, j] > 0).sum(axis=-1).astype(float)]
+        values[:, 5 * j] = c * a[:, 0] - s * a[:, 1]
+        values[:, 5 * j + 1] = s * a[:, 0] + c * a[:, 1]
+        values[:, 5 * j + 2:5 * j + 5] = a
+    col = _fill(values, 5 * len(spec.members),
+                [mesh_force, mesh_deflection, mesh_force / np.asarray(static_mesh_force), mesh_stiffness])
+    col = _fill(values, col, [bearing_force])
+    if disc_names(spec):
+        _fill(values, col, [pin_force.max(axis=-1), (pin_force > 0).sum(axis=-1)])
     static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
     static.update({f"{name}.force": float(f) for name, f in zip(bearing_names(spec), static_bearing_force)})
-    return TimeResult(spec.name, solver, np.asarray(t), train_signals(spec), np.column_stack(columns), settle_time,
-                      info, raw, static)
+    return TimeResult(spec.name, solver, np.asarray(t), signals, values, settle_time, info, raw, static)
+
+
+def _fill(values: np.ndarray, start: int, arrays) -> int:
+    """Write ``arrays`` a, b, ... (time x n each) into the columns of ``values`` from ``start`` on, interleaved
+    a_0, b_0, ..., a_1, b_1, ... (a block of columns per mesh); returns the column after them."""
+    stop = start + sum(x.shape[1] for x in arrays)
+    for k, x in enumerate(arrays):
+        values[:, start + k:stop:len(arrays)] = x
+    return stop

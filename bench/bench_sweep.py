@@ -34,9 +34,23 @@ def warm() -> None:
     engine.run_point(engine.plan_sweep("demo-3p", speeds=[1000.0], duration=0.01).points[0])
 
 
+def mujoco_floor(train: str, speed: float, duration: float) -> float:
+    """CPU seconds of the MuJoCo twin's run of one point (compiled step loop, the model already built)."""
+    from gearcheck.lumped.loader import load_train
+    from gearcheck.mbd_models.side import MujocoSide
+    from gearcheck.shared.settings import RunSettings
+
+    side = MujocoSide(load_train(train, speed))
+    side.run(RunSettings(0.001))  # the model built and the kernel loaded outside the timing
+    started = time.process_time()
+    side.run(RunSettings(duration))
+    return time.process_time() - started
+
+
 def timed(label, count, speeds, args, **backend):
     started = time.perf_counter()
-    result = sweep(args.train, speeds=speeds, solvers=args.solver, duration=args.duration, cache=None, **backend)
+    result = sweep(args.train, speeds=speeds, solvers=args.solver, duration=args.duration, cache=None,
+                   integration_check=args.integration_check, **backend)
     wall = time.perf_counter() - started
     return {"label": label, "workers": count, "wall": wall, "per_point": wall / len(speeds),
             "busy": sum(result.point_wall_s) / (count * wall), "load": os.getloadavg()[0],
@@ -54,10 +68,13 @@ def main(argv=None):
     p.add_argument("--solver", default="both", choices=("both", "lumped", "mujoco"))
     p.add_argument("--workers", default="1,2", help="local process counts (default 1,2)")
     p.add_argument("--no-dask", action="store_true", help="leave the Dask LocalCluster out")
+    p.add_argument("--integration-check", action="store_true",
+                   help="run each solver's integration check too (the sweep's default; the target counts each "
+                        "solver once per point)")
     args = p.parse_args(argv)
     speeds = np.linspace(args.low, args.high, args.points).tolist() if args.points > 1 else [args.low]
     print(f"{args.train}: {args.points} points from {speeds[0]:g} to {speeds[-1]:g} rpm, {args.duration:g} s each, "
-          f"solver {args.solver}")
+          f"solver {args.solver}, integration check {'on' if args.integration_check else 'off'}")
     rows = [timed(f"processes ({n})" if n > 1 else "in-process (1)", n, speeds, args, workers=n)
             for n in (int(w) for w in args.workers.split(","))]
     if not args.no_dask:
@@ -85,6 +102,9 @@ def main(argv=None):
           "measures them too)")
     print(f"\nCPU time per point (one worker): {rows[0]['cpu']:.3f} s; on 2 idle cores the {TARGET_POINTS}-point sweep "
           f"would take {rows[0]['cpu'] * TARGET_POINTS / 2:.0f} s at that rate")
+    floor = mujoco_floor(args.train, 0.5 * (speeds[0] + speeds[-1]), args.duration)
+    print(f"MuJoCo's share (one run at {0.5 * (speeds[0] + speeds[-1]):g} rpm, in this process): {floor:.3f} s CPU; "
+          f"{TARGET_POINTS} runs on 2 cores take {floor * TARGET_POINTS / 2:.0f} s of MuJoCo alone")
     same = all(r["bytes"] == rows[0]["bytes"] for r in rows)
     print(f"tables identical across backends: {'yes' if same else 'NO'}")
     best = min(r["per_point"] * TARGET_POINTS for r in rows if r["workers"] <= 2)

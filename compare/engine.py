@@ -280,14 +280,19 @@ def _run_pairs(sides, settings, wall, progress):
         if not getattr(side, "rerunnable", True):
             pairs.append((run, None))
             continue
-        h = run.info["dt_s"]
-        check_dt = 2 * h if 2 * h <= side.stable_step() else 0.5 * h
+        check_dt = check_step(side, run.info["dt_s"])
         report = (lambda f, i=i: progress((1.5 * i + 1.0 + 0.5 * f) / 3.0)) if progress else None
         started = time.perf_counter()
         check = side.run(replace(run_settings, dt=check_dt, output_dt=None), report)
         wall[f"{label}_check_s"] = time.perf_counter() - started
         pairs.append((run, check))
     return pairs
+
+
+def check_step(side, h: float) -> float:
+    """The step of the integration check of ``side``'s run at step ``h``: 2 h, or h / 2 where 2 h is beyond
+    the side's stable step."""
+    return 2 * h if 2 * h <= side.stable_step() else 0.5 * h
 
 
 def _common_grid(a, b, names, plan, sensor_band):

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from gearcheck.compare.align import estimate_lag, shift_signal
+from gearcheck.compare.line_projection import harmonics
 
 
 def _stats(x: np.ndarray) -> dict[str, float]:
@@ -52,13 +53,8 @@ def waveform_metrics(a: np.ndarray, b: np.ndarray, fs: float, max_lag: float) ->
 
 
 def spectral_amplitude(x: np.ndarray, fs: float, frequencies) -> np.ndarray:
-    """Amplitude of the tone at each frequency (Hann-windowed projection)."""
-    n = x.size
-    t = np.arange(n) / fs
-    w = np.hanning(n)
-    xw = (x - np.mean(x)) * w
-    basis = np.exp(-2j * np.pi * np.outer(frequencies, t))
-    return 2.0 * np.abs(basis @ xw) / np.sum(w)
+    """Amplitude of the tone at each frequency (Hann-windowed projection) of samples at the rate ``fs``."""
+    return np.abs(harmonics(np.arange(x.size) / fs, x, frequencies, np.inf)[:, 0])
 
 
 def spectral_lines(f_mesh: float, f_carrier: float, duration: float, harmonics: int = 4) -> list[tuple[str, float]]:

@@ -2,8 +2,9 @@
 
 A *point* is one train file (the user's, with swept fields edited in its own units), one input speed, the
 solvers to run and the run settings.  :func:`run_point` runs each solver on it (the same sides the cross-check
-runs, :class:`~gearcheck.lumped.side.LumpedSide` and :class:`~gearcheck.mbd_models.side.MujocoSide`, once
-each, no step-doubling check), finds the steady window by the cross-check's rule
+runs, :class:`~gearcheck.lumped.side.LumpedSide` and :class:`~gearcheck.mbd_models.side.MujocoSide`), each
+twice as the cross-check does, at its step and at its check step (2 h, or h / 2), finds the steady window by
+the cross-check's rule
 (:func:`gearcheck.compare.align.steady_state` over the plan's mesh-force groups; without a steady state the
 second half, flagged ``steady = "none"``) and reduces it to a tidy table, one row per (solver, quantity,
 metric, mesh, order):
@@ -13,7 +14,15 @@ metric, mesh, order):
   every distinct mesh frequency of the train (``mesh`` names its stages, e.g. ``I``), by the Hann-windowed
   projection the cross-check's spectra use, A = 2 |sum w x e^{-i 2 pi f t}| / sum w, phase of cos(2 pi f t +
   phase) with t the run's own time; ``resolved`` is False where the window cannot separate the line from
-  its neighbours or from DC (T |f - f'| < 2, the Hann main lobe);
+  its neighbours or from DC (T |f - f'| < 2, the Hann main lobe).  The lines are projected with the jumps of
+  a switching mesh stiffness taken out (:func:`gearcheck.compare.line_projection.harmonics`): a plain sum
+  aliases them onto the lines, by the same amount in both solvers, which then agree on a wrong number -- the
+  cross-check of two solvers cannot see an error they share.  ``integration_error`` estimates the error of
+  a statistic or line by its change on doubling the step (|X_h - X_2h|, or 2 |X_h - X_h/2|; for a line the
+  change of its complex amplitude), which bounds it for an integrator of order p >= 1 in its asymptotic
+  range (against runs at h / 8 on demo-3p it stayed within a factor of 2 of the error on the lines that
+  count); a line whose estimate exceeds a tenth of it (:mod:`gearcheck.compare.sweep_lines`) is left out of the
+  peaks and drawn faint in the plots;
 * ``natural_frequency``: the reference lumped model's gyroscopic natural frequencies at the point's speed
   (Cooley & Parker 2012), one row per elastic mode, so order plots overlay them (``solver`` "lumped").
 
@@ -22,15 +31,14 @@ canonical TOML text and the digest of a torque CSV it reads, speed, solvers, set
 skips points whose ``KEY.parquet`` already lies in the cache folder (an interrupted sweep resumes; a changed
 input is a new key), runs the others through a :class:`concurrent.futures.Executor` (processes by default;
 in-process for one worker) or on a Dask distributed cluster (``scheduler``: an address or a
-``distributed.Client``), writes each finished point into the cache at once (whole or not at all), and
-concatenates the points in index order with their inputs as columns (``point``, ``sample``, ``seed``,
+``distributed.Client``; :mod:`gearcheck.compare.point_backends`), writes each finished point into the cache
+at once (whole or not at all), and concatenates the points in index order with their inputs as columns (``point``, ``sample``, ``seed``,
 ``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no time stamps, so the same
 inputs give a byte-identical Parquet file.
 """
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import hashlib
 import importlib.metadata
@@ -38,11 +46,7 @@ import io
 import itertools
 import json
 import math
-import multiprocessing
 import os
-import re
-import signal
-import sys
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -54,10 +58,14 @@ import pyarrow.parquet as pq
 import tomli_w
 from threadpoolctl import threadpool_limits
 
+from gearcheck.compare import point_backends as backends
 from gearcheck.compare.align import STEADY_THRESHOLD, steady_state
 from gearcheck.compare.calibrate import FitParameter
 from gearcheck.compare.distributions import Distribution, draw_samples
+from gearcheck.compare.engine import check_step
+from gearcheck.compare.line_projection import harmonics
 from gearcheck.compare.plan import TrainPlan
+from gearcheck.compare.sweep_lines import counted, measured
 from gearcheck.lumped.loader import load_text, load_train, read_train_text
 from gearcheck.lumped.modal import settling_time
 from gearcheck.lumped.side import LumpedSide
@@ -70,18 +78,18 @@ from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
 
-FORMAT = 1  # of the table; part of every point's key
+FORMAT = 2  # of the table; part of every point's key
 SOLVERS = ("lumped", "mujoco")
 DURATION = 0.5  # s simulated per point and solver
 HARMONICS = 3
 STATISTICS = ("mean", "rms", "peak_to_peak")
 MAX_POINTS = 1_000_000
-CONNECT_TIMEOUT = "10s"  # to a Dask scheduler
 
 POINT_SCHEMA = pa.schema([
     ("solver", pa.string()), ("quantity", pa.string()), ("kind", pa.string()), ("unit", pa.string()),
     ("metric", pa.string()), ("mesh", pa.string()), ("order", pa.int64()), ("frequency_hz", pa.float64()),
-    ("amplitude", pa.float64()), ("phase_rad", pa.float64()), ("resolved", pa.bool_()), ("steady", pa.string()),
+    ("amplitude", pa.float64()), ("phase_rad", pa.float64()), ("resolved", pa.bool_()),
+    ("integration_error", pa.float64()), ("steady", pa.string()),
     ("steady_start_s", pa.float64()), ("dt_s", pa.float64()), ("error", pa.string()),
 ])
 """The columns :func:`run_point` gives (what the cache holds per point)."""
@@ -102,6 +110,8 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
     "amplitude": ("unit", "the statistic, or the harmonic's amplitude"),
     "phase_rad": ("rad", "phase of the harmonic, cos(2 pi f t + phase), t from the run's start"),
     "resolved": ("", "the steady window separates the line from its neighbours and from DC"),
+    "integration_error": ("unit", "estimate of the integration error of amplitude: its change on doubling the "
+                                  "step (null without the check)"),
     "steady": ("", "detected, decayed or none (then the second half of the run)"),
     "steady_start_s": ("s", "start of the steady window"),
     "dt_s": ("s", "the solver's step"),
@@ -210,6 +220,7 @@ class Point:
     values: tuple = ()  # ((field path, value), ...) of the swept fields
     seed: int | None = None
     extra: str = ""  # digest of files the train reads (a torque CSV)
+    check: bool = True  # each run's integration check (a second run at 2 h or h / 2)
 
     @property
     def key(self) -> str:
@@ -217,7 +228,7 @@ class Point:
         where it lies nor the point's index (the same run in two sweeps shares it)."""
         data = {"format": FORMAT, "gearcheck": version(), "train": self.text,
                 "speed_rpm": self.speed_rpm, "solvers": list(self.solvers), "duration_s": self.duration,
-                "harmonics": self.harmonics, "files": self.extra}
+                "harmonics": self.harmonics, "files": self.extra, "integration_check": self.check}
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
 
 
@@ -230,11 +241,13 @@ class SweepPlan:
 
 
 def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
-               solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS) -> SweepPlan:
+               solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS,
+               integration_check: bool = True) -> SweepPlan:
     """The points of a sweep, validated before anything runs (every edited train file loads, every speed is
     one the train can turn at).  ``fields``: {path: [values]} (a grid over all of them); ``distributions``:
     {path: "normal(mean, sd)" or Distribution} with ``samples`` draws seeded ``seed``; ``speeds`` in rpm
-    (None: the file's).  Parameter sets are the outer loop, speeds the inner."""
+    (None: the file's); ``integration_check``: run each solver a second time for its integration error.
+    Parameter sets are the outer loop, speeds the inner."""
     if isinstance(train, TrainSpec):
         raise GearcheckError("a sweep needs the train file (a preset name or a path), not a loaded TrainSpec: "
                              "it edits the file's numbers and hashes its text")
@@ -243,6 +256,8 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
         raise GearcheckError(f"--duration {duration!r}: needs a positive number of seconds")
     if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
         raise GearcheckError(f"--harmonics {harmonics!r}: needs an integer from 1 to 20")
+    if not isinstance(integration_check, bool):
+        raise GearcheckError(f"integration_check {integration_check!r}: needs True or False")
     text, source = read_train_text(train)
     base = load_text(text, source)
     document = tomllib.loads(text)
@@ -304,9 +319,9 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
                                          ) from None
         for speed in speeds or [None]:
             points.append(Point(len(points), canonical, source, speed, solvers, float(duration), harmonics, i,
-                                tuple((f.path, float(v)) for f, v in values.items()), seed, extra))
+                                tuple((f.path, float(v)) for f, v in values.items()), seed, extra, integration_check))
     settings = {"train": base.name, "source": source, "solvers": list(solvers), "duration_s": float(duration),
-                "harmonics": harmonics, "speeds_rpm": speeds,
+                "harmonics": harmonics, "integration_check": integration_check, "speeds_rpm": speeds,
                 "grid": {f.path: [float(v) for v in vs] for f, vs in grid.items()},
                 "distributions": {f.path: str(d) for f, d in laws.items()},
                 "samples": len(sets) if laws else None, "seed": seed, "gearcheck": version()}
@@ -410,58 +425,70 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
         side = lumped if solver == "lumped" else MujocoSide(spec)
         try:
             result = side.run(RunSettings(point.duration))
+            check = (side.run(RunSettings(point.duration, dt=check_step(side, result.info["dt_s"])))
+                     if point.check else None)
         except SolverError as exc:
             rows.add(solver=solver, quantity="", metric="failed", error=str(exc))
             continue
-        reduce_run(result, plan, lines, rows, solver)
+        reduce_run(result, plan, lines, rows, solver, check, model.excitation.switch_times)
     sink = io.BytesIO()
     pq.write_table(rows.table(), sink, compression="zstd")
     return sink.getvalue(), time.perf_counter() - started, time.process_time() - cpu
 
 
-def harmonics(t: np.ndarray, x: np.ndarray, frequencies: np.ndarray, fs: float) -> np.ndarray:
-    """Complex amplitudes (lines x columns of ``x``, time along axis 0) of the tones at ``frequencies`` (Hz):
-    A e^{i phase} for x ~ A cos(2 pi f t + phase), by the Hann-windowed projection on the samples ``t``;
-    NaN at and above the Nyquist frequency ``fs / 2``."""
-    x = np.asarray(x, dtype=float).reshape(t.size, -1)
-    w = np.hanning(t.size)
-    xm = (x - x.mean(axis=0)) * w[:, None]
-    frequencies = np.asarray(frequencies, dtype=float)
-    usable = frequencies < 0.5 * fs
-    out = np.full((frequencies.size, x.shape[1]), np.nan + 0j)
-    out[usable] = 2.0 * (np.exp(-2j * np.pi * np.outer(frequencies[usable], t)) @ xm) / w.sum()
-    return out
-
-
-def reduce_run(result, plan, lines, rows: _Rows, solver: str) -> None:
-    """The steady window of ``result`` reduced to statistics and mesh harmonics (rows of ``rows``)."""
+def reduce_run(result, plan, lines, rows: _Rows, solver: str, check=None, switch_times=None) -> None:
+    """The steady window of ``result`` reduced to statistics and mesh harmonics (rows of ``rows``), each with its
+    integration error estimate from ``check``, the same run at 2 h or h / 2 (None: no estimate).  ``switch_times(t0,
+    t1)``: the instants where the mesh stiffness jumps, which the harmonics are corrected for
+    (:func:`gearcheck.compare.line_projection.harmonics`)."""
     t = result.t
     names = result.names(compared=True)
     groups = [(np.stack([result[n] for n in forces], axis=1), cycle) for forces, cycle in plan.steady_groups(names)]
     start, how = steady_state(t, groups, plan.settle) if groups else (None, None)
     if start is None:
         start, how = 0.5 * t[-1], "none"
-    window = t >= start
-    tw = t[window]
-    x = result.values[window][:, [result._index[n] for n in names]]
-    fs = (t.size - 1) / (t[-1] - t[0])
-    span = tw[-1] - tw[0] if tw.size > 1 else 0.0
     freqs = np.array([f for _, _, f in lines])
-    full = harmonics(tw, x, freqs, fs)
+    stats, full, fs, span = _window(result, names, start, freqs, switch_times)
     resolved = [bool(f < 0.45 * fs and f * span >= 2.0 and all(abs(f - g) * span >= 2.0 for g in freqs if g != f))
                 for f in freqs]
     dt = float(result.info.get("dt_s", np.nan))
+    if check is None:
+        stat_error = dict.fromkeys(STATISTICS, np.full(len(names), np.nan))
+        line_error = np.full(full.shape, np.nan)
+    else:  # the estimate of compare.engine.integration_error, per statistic and line
+        factor = 1.0 if check.info["dt_s"] > dt else 2.0
+        check_stats, check_full, _, _ = _window(check, names, start, freqs, switch_times)
+        stat_error = {m: factor * np.abs(stats[m] - check_stats[m]) for m in STATISTICS}
+        line_error = factor * np.abs(full - check_full)
     common = {"solver": solver, "steady": how, "steady_start_s": float(start), "dt_s": dt}
-    stats = {"mean": x.mean(axis=0), "rms": np.sqrt(np.mean(x**2, axis=0)), "peak_to_peak": np.ptp(x, axis=0)}
     for j, name in enumerate(names):
         s = result.signal(name)
         info = {"quantity": name, "kind": s.kind, "unit": s.unit, **common}
         for metric in STATISTICS:
-            rows.add(**info, metric=metric, order=0, amplitude=float(stats[metric][j]))
-        for (label, k, f), value, ok in zip(lines, full[:, j], resolved):
+            rows.add(**info, metric=metric, order=0, amplitude=float(stats[metric][j]),
+                     integration_error=_number(stat_error[metric][j]))
+        for (label, k, f), value, error, ok in zip(lines, full[:, j], line_error[:, j], resolved):
             rows.add(**info, metric="harmonic", mesh=label, order=k, frequency_hz=float(f),
                      amplitude=float(abs(value)), phase_rad=float(np.angle(value)) if np.isfinite(value) else np.nan,
-                     resolved=ok)
+                     resolved=ok, integration_error=_number(error))
+
+
+def _window(result, names, start: float, freqs: np.ndarray, switch_times=None):
+    """(statistics {metric: per quantity}, complex harmonics at ``freqs`` (lines x quantities), sampling rate,
+    window span) of ``result``'s quantities ``names`` over t >= ``start``, corrected for the jumps at
+    ``switch_times(t0, t1)``."""
+    t = result.t
+    window = t >= start
+    tw = t[window]
+    x = result.values[window][:, [result._index[n] for n in names]]
+    fs = (t.size - 1) / (t[-1] - t[0])
+    stats = {"mean": x.mean(axis=0), "rms": np.sqrt(np.mean(x**2, axis=0)), "peak_to_peak": np.ptp(x, axis=0)}
+    switches = switch_times(tw[0], tw[-1]) if switch_times is not None and tw.size > 1 else ()
+    return stats, harmonics(tw, x, freqs, fs, switches), fs, (tw[-1] - tw[0] if tw.size > 1 else 0.0)
+
+
+def _number(value) -> float | None:
+    return float(value) if np.isfinite(value) else None
 
 
 # ----------------------------------------------------------------------------- running many points
@@ -513,17 +540,17 @@ def execute(points, *, workers: int | None = None, scheduler=None, executor=None
     workers = _workers(workers)
     if scheduler is not None:
         backend = "dask"
-        _run_dask(pending, scheduler, finished)
+        backends.run_dask(run_point, pending, scheduler, finished)
     elif executor is not None:
         backend = type(executor).__name__
-        _run_futures(executor, pending, finished)
+        backends.run_futures(executor, run_point, pending, finished)
     elif workers == 1 or len(pending) <= 1:
         backend = "in-process"
         for p in pending:
             finished(p.key, *run_point(p))
     else:
         backend = f"processes ({min(workers, len(pending))})"
-        _run_pool(pending, min(workers, len(pending)), finished)
+        backends.run_pool(run_point, pending, min(workers, len(pending)), finished)
     return Execution(tables, len(pending), cached, walls, cpus, backend)
 
 
@@ -555,100 +582,6 @@ def _store(path: Path, data: bytes) -> None:
         if tmp.exists():
             tmp.unlink()
         raise
-
-
-def _worker_init() -> None:
-    """Workers leave Ctrl-C to the parent, which cancels the pending points and ends them."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-def _run_pool(pending, workers: int, finished) -> None:
-    from concurrent.futures import ProcessPoolExecutor
-
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload([__name__])
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init)
-    try:
-        _run_futures(pool, pending, finished, start=_script_hidden)
-    except BaseException:
-        processes = list((getattr(pool, "_processes", None) or {}).values())
-        pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:  # the pool's own workers, which this call started
-            if process.is_alive():
-                process.terminate()
-        for process in processes:
-            process.join(timeout=10)
-        raise
-    pool.shutdown()
-
-
-@contextlib.contextmanager
-def _script_hidden():
-    """Hide the script that runs the sweep from multiprocessing while the pool starts its workers (on the first
-    submissions): they need nothing from it (the points and :func:`run_point` are gearcheck's), so a script
-    without the ``if __name__ == "__main__":`` guard is not run again in every worker, as it would be by
-    multiprocessing's start methods other than fork."""
-    main = sys.modules.get("__main__")
-    saved = {name: getattr(main, name) for name in ("__file__", "__spec__") if hasattr(main, name)}
-    try:
-        if "__spec__" in saved:
-            main.__spec__ = None
-        if "__file__" in saved:
-            del main.__file__
-        yield
-    finally:
-        for name, value in saved.items():
-            setattr(main, name, value)
-
-
-def _run_futures(executor, pending, finished, start=contextlib.nullcontext) -> None:
-    from concurrent.futures import as_completed
-
-    with start():
-        futures = {executor.submit(run_point, p): p.key for p in pending}
-    try:
-        for future in as_completed(futures):
-            finished(futures[future], *future.result())
-    except BaseException:
-        for future in futures:
-            future.cancel()
-        raise
-
-
-def connect(scheduler):
-    """(a ``distributed.Client``, whether this call opened it) for an address or a client; refused with one
-    line when dask.distributed is missing or the scheduler cannot be reached."""
-    try:
-        import distributed
-    except ImportError:
-        raise GearcheckError(f"--scheduler {scheduler}: needs dask.distributed (pip install 'gearcheck[cluster]')"
-                             ) from None
-    if isinstance(scheduler, distributed.Client):
-        return scheduler, False
-    if not isinstance(scheduler, str) or not re.fullmatch(r"[a-z+]+://\S+|\S+:\d+", scheduler):
-        raise GearcheckError(f"--scheduler {scheduler!r}: give the scheduler's address, e.g. tcp://scheduler.example.org:8786")
-    try:
-        return distributed.Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False), True
-    except Exception as exc:  # OSError, TimeoutError, ValueError: whatever stops the connection
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise GearcheckError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({reason})") from None
-
-
-def _run_dask(pending, scheduler, finished) -> None:
-    import distributed
-
-    client, opened = connect(scheduler)
-    try:
-        futures = {client.submit(run_point, p, key=f"gearcheck-point-{p.key}", pure=False): p.key for p in pending}
-        try:
-            for future in distributed.as_completed(list(futures), loop=client.loop):
-                finished(futures[future], *future.result())
-        except BaseException:
-            client.cancel(list(futures))
-            raise
-    finally:
-        if opened:
-            client.close()
 
 
 # ----------------------------------------------------------------------------- the table
@@ -732,8 +665,8 @@ class SweepResult:
     def summary(self) -> dict:
         frame = self.to_pandas()
         peaks = []
-        harmonic = frame[(frame["metric"] == "harmonic") & frame["resolved"].fillna(False).astype(bool)
-                         & (frame["steady"] != "none")].dropna(subset=["amplitude"])
+        lines = frame[(frame["metric"] == "harmonic") & measured(frame)].dropna(subset=["amplitude"])
+        harmonic = lines[counted(lines)]
         for (solver, quantity), rows in harmonic.groupby(["solver", "quantity"], sort=False):
             if quantity not in self.headline():
                 continue
@@ -746,6 +679,7 @@ class SweepResult:
         return {"train": self.train, "points": len(self.plan.points), "rows": self.table.num_rows,
                 "settings": self.settings, "peaks": peaks,
                 "no_steady_state": int((steady["steady"] == "none").sum()),
+                "lines": int(len(lines)), "unconverged_lines": int(len(lines) - len(harmonic)),
                 "failed": [{"point": int(r.point), "solver": r.solver, "error": r.error} for r in failed.itertuples()]}
 
     def headline(self) -> list[str]:
@@ -799,12 +733,13 @@ def _plain(value):
 
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
-          solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS, workers: int | None = None,
-          scheduler=None, executor=None, cache=None, progress=None) -> SweepResult:
+          solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS, integration_check: bool = True,
+          workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None) -> SweepResult:
     """Plan, run (resuming from ``cache``) and assemble a sweep; see :func:`plan_sweep` and :func:`execute`."""
     started = time.perf_counter()
     plan = plan_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples,
-                      seed=seed, solvers=solvers, duration=duration, harmonics=harmonics)
+                      seed=seed, solvers=solvers, duration=duration, harmonics=harmonics,
+                      integration_check=integration_check)
     if cache is not None:
         check_place(Path(cache), "--cache")
     if scheduler is not None and executor is not None:

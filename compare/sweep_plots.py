@@ -4,7 +4,8 @@
   model's natural frequencies at each speed, the mesh-harmonic lines k f_mesh(speed), and each harmonic's
   amplitude as the colour of a dot on its line: a waterfall seen from above); below, the amplitude of each
   mesh harmonic against speed, one colour per harmonic, a line style per solver, with a circle where the
-  harmonic's frequency crosses a natural frequency (the speeds where it excites a mode);
+  harmonic's frequency crosses a natural frequency (the speeds where it excites a mode), and the lines whose
+  integration error estimate exceeds a tenth of them as faint circles off the lines;
 * a parameter study or a Monte Carlo: ``study.png``, per quantity its dominant harmonic (the line with the
   largest median amplitude): at one speed, amplitude against the first swept field (grid) or its histogram
   (Monte Carlo); over several speeds, one line per parameter set of a small grid, else the median over the
@@ -22,6 +23,7 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from gearcheck.compare.distributions import Distribution
+from gearcheck.compare.sweep_lines import CONVERGED, counted, measured
 
 MAX_LINES = 8  # a grid of up to this many parameter sets draws one line each; more: a band
 LINESTYLES = ("-", "--", ":", "-.")
@@ -80,7 +82,7 @@ def order_plot(frame, train: str, quantity: str) -> bytes:
     mode_speeds, mode_hz = _modes(frame)
     fig = Figure(figsize=(9.5, 8.5), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(1.0, 1.1))
-    reference = rows[(rows["solver"] == solvers[0]) & _shown(rows)]
+    reference = rows[(rows["solver"] == solvers[0]) & counted(rows)]
     unsteady = rows.loc[rows["steady"] == "none", "speed_rpm"].nunique()
     f_top = 1.15 * float(rows["frequency_hz"].max())
     for j in range(mode_hz.shape[1]):
@@ -110,9 +112,12 @@ def order_plot(frame, train: str, quantity: str) -> bytes:
         for s, solver in enumerate(solvers):
             line = rows[(rows["solver"] == solver) & (rows["mesh"] == mesh) & (rows["order"] == k)]
             line = line.sort_values("speed_rpm")
-            y = np.where(_shown(line), line["amplitude"], np.nan)
+            y = np.where(counted(line), line["amplitude"], np.nan)
             bottom.plot(line["speed_rpm"], y, color=colour, ls=LINESTYLES[s % len(LINESTYLES)], lw=1.3 - 0.3 * s,
                         marker="x" if s else None, ms=3, label=f"{mesh} ×{k} ({solver})")
+            shaky = line[measured(line) & ~counted(line)]
+            bottom.plot(shaky["speed_rpm"], shaky["amplitude"], ls="none", marker="o", ms=2.5, mfc="none", mec=colour,
+                        alpha=0.45, mew=0.6)
             if s == 0 and mode_hz.size:
                 f_line = np.interp(mode_speeds, line["speed_rpm"], line["frequency_hz"])
                 log_y = np.log(np.where(y > 0, y, np.nan))
@@ -124,16 +129,12 @@ def order_plot(frame, train: str, quantity: str) -> bytes:
     bottom.set_ylabel(f"amplitude ({unit})")
     bottom.set_title("amplitude of each mesh harmonic (" + ", ".join(
         f"{LINESTYLES[s]}{'x' if s else ''} {solver}" for s, solver in enumerate(solvers))
-        + "); ○ where k·f_mesh crosses a natural frequency\nomitted: lines the window does not resolve"
+        + "); ○ where k·f_mesh crosses a natural frequency\nfaint circles: integration error estimate above "
+        f"{CONVERGED:.0%} of the line; omitted: lines the window does not resolve"
         + (f", {unsteady} speeds without a steady state" if unsteady else ""), fontsize=9)
     bottom.grid(True, which="major", alpha=0.3)
     bottom.legend(fontsize=7, ncol=max(1, len(solvers)), loc="best")
     return _png(fig)
-
-
-def _shown(rows):
-    """Rows of harmonics worth drawing: resolved, from a run that reached its steady state."""
-    return rows["resolved"].fillna(False).astype(bool) & (rows["steady"] != "none")
 
 
 def dominant_line(rows) -> tuple[str, int]:

@@ -32,8 +32,8 @@ skips points whose ``KEY.parquet`` already lies in the cache folder (an interrup
 input is a new key), runs the others through a :class:`concurrent.futures.Executor` (processes by default;
 in-process for one worker) or on a Dask distributed cluster (``scheduler``: an address or a
 ``distributed.Client``; :mod:`gearcheck.compare.point_backends`), writes each finished point into the cache
-at once (whole or not at all), and concatenates the points in index order with their inputs as columns (``point``, ``sample``, ``seed``,
-``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no time stamps, so the same
+at once (whole or not at all), and concatenates the points in index order with their inputs as columns
+(``point``, ``sample``, ``seed``, ``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no time stamps, so the same
 inputs give a byte-identical Parquet file.
 """
 
@@ -84,6 +84,7 @@ DURATION = 0.5  # s simulated per point and solver
 HARMONICS = 3
 STATISTICS = ("mean", "rms", "peak_to_peak")
 MAX_POINTS = 1_000_000
+MAX_REFINE = 64
 
 POINT_SCHEMA = pa.schema([
     ("solver", pa.string()), ("quantity", pa.string()), ("kind", pa.string()), ("unit", pa.string()),
@@ -221,6 +222,7 @@ class Point:
     seed: int | None = None
     extra: str = ""  # digest of files the train reads (a torque CSV)
     check: bool = True  # each run's integration check (a second run at 2 h or h / 2)
+    refine: int = 1  # each solver's default step divided by this
 
     @property
     def key(self) -> str:
@@ -228,7 +230,8 @@ class Point:
         where it lies nor the point's index (the same run in two sweeps shares it)."""
         data = {"format": FORMAT, "gearcheck": version(), "train": self.text,
                 "speed_rpm": self.speed_rpm, "solvers": list(self.solvers), "duration_s": self.duration,
-                "harmonics": self.harmonics, "files": self.extra, "integration_check": self.check}
+                "harmonics": self.harmonics, "files": self.extra, "integration_check": self.check,
+                "refine": self.refine}
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
 
 
@@ -242,12 +245,12 @@ class SweepPlan:
 
 def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
                solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS,
-               integration_check: bool = True) -> SweepPlan:
+               integration_check: bool = True, refine: int = 1) -> SweepPlan:
     """The points of a sweep, validated before anything runs (every edited train file loads, every speed is
     one the train can turn at).  ``fields``: {path: [values]} (a grid over all of them); ``distributions``:
     {path: "normal(mean, sd)" or Distribution} with ``samples`` draws seeded ``seed``; ``speeds`` in rpm
-    (None: the file's); ``integration_check``: run each solver a second time for its integration error.
-    Parameter sets are the outer loop, speeds the inner."""
+    (None: the file's); ``integration_check``: run each solver a second time for its integration error;
+    ``refine``: each solver's default step divided by it.  Parameter sets are the outer loop, speeds the inner."""
     if isinstance(train, TrainSpec):
         raise GearcheckError("a sweep needs the train file (a preset name or a path), not a loaded TrainSpec: "
                              "it edits the file's numbers and hashes its text")
@@ -258,6 +261,8 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
         raise GearcheckError(f"--harmonics {harmonics!r}: needs an integer from 1 to 20")
     if not isinstance(integration_check, bool):
         raise GearcheckError(f"integration_check {integration_check!r}: needs True or False")
+    if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:
+        raise GearcheckError(f"--refine {refine!r}: needs an integer from 1 to {MAX_REFINE}")
     text, source = read_train_text(train)
     base = load_text(text, source)
     document = tomllib.loads(text)
@@ -319,9 +324,11 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
                                          ) from None
         for speed in speeds or [None]:
             points.append(Point(len(points), canonical, source, speed, solvers, float(duration), harmonics, i,
-                                tuple((f.path, float(v)) for f, v in values.items()), seed, extra, integration_check))
+                                tuple((f.path, float(v)) for f, v in values.items()), seed, extra, integration_check,
+                                refine))
     settings = {"train": base.name, "source": source, "solvers": list(solvers), "duration_s": float(duration),
-                "harmonics": harmonics, "integration_check": integration_check, "speeds_rpm": speeds,
+                "harmonics": harmonics, "integration_check": integration_check, "refine": refine,
+                "speeds_rpm": speeds,
                 "grid": {f.path: [float(v) for v in vs] for f, vs in grid.items()},
                 "distributions": {f.path: str(d) for f, d in laws.items()},
                 "samples": len(sets) if laws else None, "seed": seed, "gearcheck": version()}
@@ -424,7 +431,8 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
     for solver in point.solvers:
         side = lumped if solver == "lumped" else MujocoSide(spec)
         try:
-            result = side.run(RunSettings(point.duration))
+            result = side.run(RunSettings(point.duration, dt=None if point.refine == 1 else
+                                          side.default_step() / point.refine))
             check = (side.run(RunSettings(point.duration, dt=check_step(side, result.info["dt_s"])))
                      if point.check else None)
         except SolverError as exc:
@@ -734,12 +742,13 @@ def _plain(value):
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
           solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS, integration_check: bool = True,
-          workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None) -> SweepResult:
+          refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None,
+          progress=None) -> SweepResult:
     """Plan, run (resuming from ``cache``) and assemble a sweep; see :func:`plan_sweep` and :func:`execute`."""
     started = time.perf_counter()
     plan = plan_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples,
                       seed=seed, solvers=solvers, duration=duration, harmonics=harmonics,
-                      integration_check=integration_check)
+                      integration_check=integration_check, refine=refine)
     if cache is not None:
         check_place(Path(cache), "--cache")
     if scheduler is not None and executor is not None:

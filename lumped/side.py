@@ -19,7 +19,7 @@ from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, sim
 from gearcheck.lumped.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed
 from gearcheck.lumped.published import four_dof_model, linear_model
-from gearcheck.lumped.time_solver import simulate, stable_step
+from gearcheck.lumped.time_solver import default_step, simulate, stable_step
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
@@ -61,6 +61,9 @@ class LumpedSide:
 
     def stable_step(self) -> float:
         return stable_step(self.model)
+
+    def default_step(self) -> float:
+        return default_step(self.model)
 
 
 class LinearSide:

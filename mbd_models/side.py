@@ -56,6 +56,9 @@ class MujocoSide:
     def stable_step(self) -> float:
         return stepping.stable_step(self.model.limits)
 
+    def default_step(self) -> float:
+        return self.model.default_step
+
 
 class PublishedTwinSide:
     """The MuJoCo twin of the 4-DOF model ``name`` of Matejic et al. (2021); ``y1`` and ``carrier_mass``

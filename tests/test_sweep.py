@@ -93,6 +93,17 @@ def test_each_line_carries_its_integration_error_and_the_stiffness_switches_do_n
     assert counted(lines).mean() > 0.8
 
 
+def test_refine_divides_the_step_and_the_estimates_shrink_with_it():
+    coarse, fine = (sw.sweep("demo-3p", speeds=[1000.0], refine=n, workers=1, **FAST).to_pandas() for n in (1, 2))
+    rows = [f[(f["metric"] == "harmonic") & f["resolved"]].set_index(["quantity", "order"]) for f in (coarse, fine)]
+    assert rows[1]["dt_s"].iloc[0] == pytest.approx(rows[0]["dt_s"].iloc[0] / 2, rel=1e-12)
+    assert fine["key"].iloc[0] != coarse["key"].iloc[0]
+    largest = rows[0]["amplitude"].groupby(level="quantity").transform("max")
+    lines = rows[0].index[rows[0]["amplitude"] >= 0.1 * largest]  # lines well above round-off
+    ratio = (rows[1]["integration_error"] / rows[0]["integration_error"]).loc[lines]
+    assert ratio.median() < 0.25  # at least second order: halving the step quarters the change on doubling it
+
+
 def test_reproducible_and_resumable_from_the_cache(tmp_path):
     first = sw.sweep("demo-3p", speeds=SPEEDS, workers=1, cache=tmp_path / "a", **FAST)
     again = sw.sweep("demo-3p", speeds=SPEEDS, workers=1, cache=tmp_path / "b", **FAST)
@@ -241,6 +252,7 @@ def test_the_sweep_command_writes_table_plots_and_summary(tmp_path, capsys):
     (["--vary", "stages[0].sun.mass=normal(1,0.01)", "--samples", "0"], "--samples 0: needs an integer"),
     (["--workers", "0"], "--workers 0: needs an integer from 1"),
     (["--harmonics", "0"], "--harmonics 0: needs an integer from 1 to 20"),
+    (["--refine", "0"], "--refine 0: needs an integer from 1 to 64"),
     (["--quantity", "stage1.nothing"], "--quantity stage1.nothing: not a gated quantity of demo-3p"),
     (["--scheduler", "tcp://127.0.0.1:9"], "--scheduler tcp://127.0.0.1:9: cannot reach the Dask scheduler"),
     (["--scheduler", "nowhere"], "--scheduler 'nowhere': give the scheduler's address"),

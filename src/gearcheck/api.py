@@ -188,7 +188,7 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
           solver: str = "both", duration: float = 0.5, harmonics: int = 3, integration_check: bool = True,
-          workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None):
+          refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None):
     """A speed sweep, a parameter study or a Monte Carlo: many runs of one train, reduced to one table.
 
     Each point (a train file with swept fields edited, at one speed) runs each solver and reduces the
@@ -223,6 +223,9 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
     integration_check : bool
         Run each solver a second time, at twice its step, for the integration error estimates (default); False
         saves a third of the work per point and leaves the bounds empty.
+    refine : int
+        Each solver's default step divided by this (1 to 64): for lines whose integration error estimate is
+        too large to read them.
     workers : int, optional
         Local processes (default: the cores available; 1 runs in this process).
     scheduler : str or distributed.Client, optional
@@ -244,7 +247,8 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
 
     return run_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples, seed=seed,
                      solvers=solver, duration=duration, harmonics=harmonics, integration_check=integration_check,
-                     workers=workers, scheduler=scheduler, executor=executor, cache=cache, progress=progress)
+                     refine=refine, workers=workers, scheduler=scheduler, executor=executor, cache=cache,
+                     progress=progress)
 
 
 def export_model(train, path) -> None:

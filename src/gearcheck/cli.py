@@ -257,6 +257,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--no-integration-check", dest="integration_check", action="store_false",
                    help="run each solver once per point, without the second run at twice the step that estimates "
                         "each line's integration error (about 1.5 times faster; every line then counts)")
+    s.add_argument("--refine", type=int, default=1, metavar="N",
+                   help="divide each solver's default step by N (default 1), for lines whose integration error "
+                        "estimate is too large to read them; the work grows N times")
     s.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the cores available; "
                                                            "1 runs in this process)")
     s.add_argument("--scheduler", metavar="ADDRESS", help="run the points on a Dask distributed cluster, e.g. "
@@ -742,6 +745,7 @@ def cmd_sweep(args) -> int:
         result = gearcheck.sweep(args.train, speeds=speeds, fields=fields, distributions=distributions,
                                  samples=args.samples, seed=args.seed, solver=args.solver, duration=args.duration,
                                  harmonics=args.harmonics, integration_check=args.integration_check,
+                                 refine=args.refine,
                                  workers=args.workers, scheduler=args.scheduler,
                                  cache=cache, progress=bar)
         bar.close()

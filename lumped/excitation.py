@@ -15,7 +15,7 @@ import numpy as np
 
 from gearcheck.lumped.kinematics import Kinematics
 from gearcheck.lumped.line_of_action import line_of_action
-from gearcheck.lumped.mesh_stiffness import stiffness_model
+from gearcheck.lumped.mesh_stiffness import ConstantStiffness, stiffness_model
 from gearcheck.lumped.tooth_pairs import ToothPairs, relieved
 
 
@@ -94,6 +94,25 @@ class Excitation:
                     times.append((n + b + phase) / f)
         t = np.concatenate(times) if times else np.empty(0)
         return np.unique(t[(t > t0) & (t < t1)])
+
+    def periodic_terms(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """(the frequencies in Hz of the drive's periodic terms: time-varying mesh stiffness, transmission error
+        harmonics, eccentricities, torque ripple, a torque profile repeated; those of the time-varying meshes
+        alone; the terms without a period, named)."""
+        varying = np.array([not isinstance(m, ConstantStiffness) for m in self.models], dtype=bool)
+        meshes = np.abs(self.frequency[varying])
+        freqs = [meshes]
+        freqs += [np.array([h * abs(self.frequency[i])]) for i, h, _, _ in self._ste]
+        freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, *_ in self._eccentric]
+        freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, _ in self.ripple]
+        if self._profile is not None:
+            times = self._profile[0]
+            freqs.append(np.array([1.0 / (times[-1] - times[0])]))
+        op = self.spec.operating
+        aperiodic = [] if self._function is None else [f"the torque function {op.torque_function}"]
+        if op.ramp > 0:
+            aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
+        return np.concatenate(freqs), meshes, aperiodic
 
     @property
     def has_transmission_error(self) -> bool:

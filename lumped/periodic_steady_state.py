@@ -39,7 +39,6 @@ import numpy as np
 
 from gearcheck.lumped.assembly import TurningCoupling
 from gearcheck.lumped.cycloid_rows import CycloidRows
-from gearcheck.lumped.mesh_stiffness import ConstantStiffness
 from gearcheck.lumped.time_solver import initial_state, step_limits, stepper
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import SolverError
@@ -78,23 +77,11 @@ class PeriodicSteadyState:
 
 
 def drive_frequencies(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """(frequencies of the time-varying drive in Hz, those of the time-varying meshes, what has no period).
-    Reads the excitation's terms (:class:`gearcheck.lumped.excitation.Excitation`)."""
-    exc, op = model.excitation, model.spec.operating
-    varying = np.array([not isinstance(m, ConstantStiffness) for m in exc.models], dtype=bool)
-    meshes = np.abs(exc.frequency[varying])
-    freqs = [meshes]
-    freqs += [np.array([h * abs(exc.frequency[i])]) for i, h, _, _ in exc._ste]
-    freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, *_ in exc._eccentric]
-    freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, _ in exc.ripple]
-    aperiodic = []
-    if exc._function is not None:
-        aperiodic.append(f"the torque function {op.torque_function}")
-    if exc._profile is not None:
-        times = exc._profile[0]
-        freqs.append(np.array([1.0 / (times[-1] - times[0])]))
-    if op.ramp > 0:
-        aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
+    """(frequencies of the time-varying drive in Hz, those of the time-varying meshes, what has no period): the
+    excitation's periodic terms (:meth:`gearcheck.lumped.excitation.Excitation.periodic_terms`) and the
+    model's turning couplings and cycloid contacts."""
+    drive, meshes, aperiodic = model.excitation.periodic_terms()
+    freqs = [drive]
     for e in model.turning:
         if isinstance(e, TurningCoupling):
             freqs.append(np.array([abs(e.omega_b - e.omega_a) / (2 * math.pi)]))

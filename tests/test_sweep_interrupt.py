@@ -29,10 +29,16 @@ SWEEP = ["sweep", "demo-3p", "--speeds", f"1000:2000:{POINTS}", "--solver", "lum
 PREVIOUS = {MARKER: b"gearcheck output\n", "previous.txt": b"the previous sweep\n"}
 
 
+# ``python -m gearcheck`` with Ctrl-C handled as in a terminal's foreground job: a test run started in the
+# background (``cmd &`` in a script) inherits SIGINT ignored, and Python keeps an ignored SIGINT ignored
+FOREGROUND = ("import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+              "sys.argv[0] = 'gearcheck'; runpy.run_module('gearcheck', run_name='__main__', alter_sys=True)")
+
+
 def _start(cwd: Path, *args: str) -> subprocess.Popen:
     """``python -m gearcheck sweep ...`` in a new session: its process group is its own, and so is its session
     id, which every process it starts inherits."""
-    return subprocess.Popen([sys.executable, "-m", "gearcheck", *SWEEP, *args], cwd=cwd, text=True,
+    return subprocess.Popen([sys.executable, "-c", FOREGROUND, *SWEEP, *args], cwd=cwd, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
 

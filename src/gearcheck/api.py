@@ -222,7 +222,7 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
         Mesh harmonics per mesh frequency.
     integration_check : bool
         Run each solver a second time, at twice its step, for the integration error estimates (default); False
-        saves a third of the work per point and leaves the bounds empty.
+        saves a third of the work per point and leaves the estimates empty.
     refine : int
         Each solver's default step divided by this (1 to 64): for lines whose integration error estimate is
         too large to read them.

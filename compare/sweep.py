@@ -431,8 +431,7 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
     for solver in point.solvers:
         side = lumped if solver == "lumped" else MujocoSide(spec)
         try:
-            result = side.run(RunSettings(point.duration, dt=None if point.refine == 1 else
-                                          side.default_step() / point.refine))
+            result = side.run(RunSettings(point.duration, dt=side.default_step() / point.refine))
             check = (side.run(RunSettings(point.duration, dt=check_step(side, result.info["dt_s"])))
                      if point.check else None)
         except SolverError as exc:

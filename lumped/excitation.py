@@ -57,16 +57,20 @@ class Excitation:
             self._function = getattr(importlib.import_module(module), name)
 
     # ------------------------------------------------------------------ meshes
-    def mesh_position(self, t) -> np.ndarray:
-        """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...)."""
-        return np.multiply.outer(np.asarray(t, dtype=float), self.frequency) - self.phase
+    def mesh_position(self, t, mesh: int | None = None) -> np.ndarray:
+        """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...), or (...) for the one
+        mesh of index ``mesh``."""
+        t = np.asarray(t, dtype=float)
+        if mesh is not None:
+            return self.frequency[mesh] * t - self.phase[mesh]
+        return np.multiply.outer(t, self.frequency) - self.phase
 
     def stiffness(self, t) -> np.ndarray:
         """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...)."""
         t = np.asarray(t, dtype=float)
         k = np.empty(t.shape + (len(self.models),))
-        for j, (f, phase, model) in enumerate(zip(self.frequency, self.phase, self.models)):
-            k[..., j] = model(f * t - phase)  # mesh_position, one mesh at a time
+        for j, model in enumerate(self.models):  # one mesh at a time: no (..., n_mesh) temporary
+            k[..., j] = model(self.mesh_position(t, j))
         return k
 
     def tooth_pairs(self, t):

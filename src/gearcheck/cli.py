@@ -745,8 +745,7 @@ def cmd_sweep(args) -> int:
         result = gearcheck.sweep(args.train, speeds=speeds, fields=fields, distributions=distributions,
                                  samples=args.samples, seed=args.seed, solver=args.solver, duration=args.duration,
                                  harmonics=args.harmonics, integration_check=args.integration_check,
-                                 refine=args.refine,
-                                 workers=args.workers, scheduler=args.scheduler,
+                                 refine=args.refine, workers=args.workers, scheduler=args.scheduler,
                                  cache=cache, progress=bar)
         bar.close()
         written = result.write_files(place.path, args.quantity)

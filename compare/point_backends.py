@@ -1,8 +1,8 @@
-"""Where the points of a sweep run: a local process pool, any ``concurrent.futures`` executor, or a Dask cluster.
+"""Where the points of a sweep (or the samples of a study) run: a local process pool, any ``concurrent.futures``
+executor, or a Dask cluster.
 
-Each backend takes ``run`` (a module-level function of one point returning ``(bytes, wall s, CPU s)``), the
-points (anything with a ``key``) and ``finished(key, *result)``, called in this process as each point ends.  The
-local pool starts fresh processes from a fork server that preloads ``run``'s module, never runs the calling
+Each backend takes ``run`` (a module-level function of one point), the points (picklable; on Dask with a
+``key``) and ``finished(point, result)``, called in this process as each point ends.  The local pool starts fresh processes from a fork server that preloads ``run``'s module, never runs the calling
 script again, and ends cleanly on Ctrl-C (its workers leave the signal to the parent); a Dask worker runs each
 point with glibc's malloc thresholds as a plain process has them.
 """
@@ -29,7 +29,7 @@ def _worker_init() -> None:
 
 def run_pool(run, pending, workers: int, finished) -> None:
     """``run`` (a module-level function) on each point of ``pending`` in ``workers`` fresh processes (forkserver,
-    which preloads ``run``'s module), ``finished(key, *result)`` as each ends; on Ctrl-C or an error the pending
+    which preloads ``run``'s module), ``finished(point, result)`` as each ends; on Ctrl-C or an error the pending
     points are cancelled and the pool's workers ended."""
     from concurrent.futures import ProcessPoolExecutor
 
@@ -101,14 +101,14 @@ def _script_hidden():
 
 def run_futures(executor, run, pending, finished, start=contextlib.nullcontext) -> None:
     """``run`` on each point of ``pending`` through ``executor`` (its submissions inside ``start()``),
-    ``finished(key, *result)`` as each ends; the rest cancelled on an error or Ctrl-C."""
+    ``finished(point, result)`` as each ends; the rest cancelled on an error or Ctrl-C."""
     from concurrent.futures import as_completed
 
     with start():
-        futures = {executor.submit(run, p): p.key for p in pending}
+        futures = {executor.submit(run, p): p for p in pending}
     try:
         for future in as_completed(futures):
-            finished(futures[future], *future.result())
+            finished(futures[future], future.result())
     except BaseException:
         for future in futures:
             future.cancel()
@@ -137,17 +137,17 @@ def connect(scheduler):
 
 def run_dask(run, pending, scheduler, finished) -> None:
     """``run`` on each point of ``pending`` on a Dask cluster (``scheduler``: an address or a client),
-    ``finished(key, *result)`` as each ends; the rest cancelled on an error or Ctrl-C."""
+    ``finished(point, result)`` as each ends; the rest cancelled on an error or Ctrl-C."""
     import distributed
 
     client, opened = connect(scheduler)
     try:
         # through _dask_point: Dask's workers pin glibc's malloc thresholds, up to 1.5 x the CPU per point
-        futures = {client.submit(_dask_point, run, p, key=f"gearcheck-point-{p.key}", pure=False): p.key
+        futures = {client.submit(_dask_point, run, p, key=f"gearcheck-point-{p.key}", pure=False): p
                    for p in pending}
         try:
             for future in distributed.as_completed(list(futures), loop=client.loop):
-                finished(futures[future], *future.result())
+                finished(futures[future], future.result())
         except BaseException:
             client.cancel(list(futures))
             raise

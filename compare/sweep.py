@@ -532,7 +532,8 @@ def execute(points, *, workers: int | None = None, scheduler=None, executor=None
     walls: list[float] = []
     cpus: list[float] = []
 
-    def finished(key: str, data: bytes, wall: float, cpu: float) -> None:
+    def finished(point: Point, result: tuple[bytes, float, float]) -> None:
+        key, (data, wall, cpu) = point.key, result
         if cache is not None:
             _store(cache / f"{key}.parquet", data)
         tables[key] = data
@@ -554,7 +555,7 @@ def execute(points, *, workers: int | None = None, scheduler=None, executor=None
     elif workers == 1 or len(pending) <= 1:
         backend = "in-process"
         for p in pending:
-            finished(p.key, *run_point(p))
+            finished(p, run_point(p))
     else:
         backend = f"processes ({min(workers, len(pending))})"
         backends.run_pool(run_point, pending, min(workers, len(pending)), finished)

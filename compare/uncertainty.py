@@ -30,17 +30,15 @@ prediction (which uncertain numbers drive the spread).
 from __future__ import annotations
 
 import math
-import multiprocessing
-import signal
 import time
 import tomllib
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 import tomli_w
 
+from gearcheck.compare import point_backends as backends
 from gearcheck.compare.calibrate import SPEED_MATCH, FitParameter, calibrate
 from gearcheck.compare.distributions import Distribution, draw_samples
 from gearcheck.compare.sweep import Field
@@ -140,10 +138,6 @@ def run_sample(task: _Task) -> dict:
     return row
 
 
-def _ignore_sigint() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _parse_distributions(distributions: dict, document: dict, fit_paths: set) -> dict[str, Distribution]:
     if not isinstance(distributions, dict) or not distributions:
         raise GearcheckError("distributions: need at least one FIELD -> distribution, e.g. "
@@ -236,17 +230,7 @@ def uncertainty_study(text: str, source: str, entries: list[dict], distributions
         for task in tasks:
             finished(task, run_sample(task))
     else:
-        context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload([__name__])
-        with ProcessPoolExecutor(min(workers, len(tasks)), mp_context=context, initializer=_ignore_sigint) as pool:
-            futures = {pool.submit(run_sample, task): task for task in tasks}
-            try:
-                for future in as_completed(futures):
-                    finished(futures[future], future.result())
-            except BaseException:
-                for future in futures:
-                    future.cancel()
-                raise
+        backends.run_pool(run_sample, tasks, min(workers, len(tasks)), finished)
     frame = pd.DataFrame([rows[t.sample] for t in tasks])
     if nominal:  # the file's own values (NaN where it leaves a field to its default)
         for path in laws:

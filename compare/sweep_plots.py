@@ -14,7 +14,6 @@
 
 from __future__ import annotations
 
-import io
 import re
 import textwrap
 
@@ -23,20 +22,13 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from gearcheck.compare.distributions import Distribution
+from gearcheck.compare.plots import _png
 from gearcheck.compare.sweep_lines import CONVERGED, counted, measured
 
 MAX_LINES = 8  # a grid of up to this many parameter sets draws one line each; more: a band
 LINESTYLES = ("-", "--", ":", "-.")
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive",
            "tab:cyan", "tab:gray")
-
-
-def _png(fig) -> bytes:
-    out = io.BytesIO()
-    if fig.get_layout_engine() is None:
-        fig.tight_layout()
-    fig.savefig(out, dpi=110, metadata={"Software": None}, format="png")
-    return out.getvalue()
 
 
 def file_name(quantity: str) -> str:

@@ -36,10 +36,10 @@ import numpy as np
 from numba import njit
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.periodic_steady_state import periodic_steady_state
 from gearcheck.lumped.time_solver import default_step, simulate
-from gearcheck.lumped.variants import chained, edited, wide_stage
+from gearcheck.train.variants import chained, edited, wide_stage
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
@@ -224,7 +224,7 @@ def steady_state_table():
 COMPILE_PROBE = """
 import time
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.settings import RunSettings

@@ -24,9 +24,9 @@ import numpy as np
 from mujoco import rollout
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.time_solver import simulate
-from gearcheck.lumped.variants import chained
+from gearcheck.train.variants import chained
 from gearcheck.mbd_models.runner import simulate_mujoco, simulate_mujoco_many
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.settings import RunSettings

@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from gearcheck.compare.sweep import sweep
+from gearcheck.compare.studies.sweep import sweep
 
 TARGET_POINTS, TARGET_S = 181, 180.0
 
@@ -29,14 +29,14 @@ TARGET_POINTS, TARGET_S = 181, 180.0
 def warm() -> None:
     """One tiny point in a Dask worker: its imports and the solvers' compiled kernels loaded, as in a cluster that
     has run before (the local pool's workers inherit the imports from its fork server)."""
-    from gearcheck.compare import sweep as engine
+    from gearcheck.compare.studies import sweep as engine
 
     engine.run_point(engine.plan_sweep("demo-3p", speeds=[1000.0], duration=0.01).points[0])
 
 
 def mujoco_floor(train: str, speed: float, duration: float) -> float:
     """CPU seconds of the MuJoCo twin's run of one point (compiled step loop, the model already built)."""
-    from gearcheck.lumped.loader import load_train
+    from gearcheck.train.loader import load_train
     from gearcheck.mbd_models.side import MujocoSide
     from gearcheck.shared.settings import RunSettings
 

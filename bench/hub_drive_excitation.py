@@ -16,9 +16,9 @@ from __future__ import annotations
 import argparse
 import re
 
-from gearcheck.compare.measure import measure
+from gearcheck.compare.engine.measure import measure
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_text, load_train, preset_text
+from gearcheck.train.loader import load_text, load_train, preset_text
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.settings import RunSettings
 

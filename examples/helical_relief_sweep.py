@@ -18,7 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import gearcheck
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 
 AMOUNTS_UM = (0.0, 2.5, 5.0, 7.5, 10.0, 15.0, 20.0, 30.0)
 DURATION = 0.07

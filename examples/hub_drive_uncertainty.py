@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gearcheck.compare.plots import _png
-from gearcheck.compare.uncertainty import NOMINAL, band, drivers, uncertainty_study
-from gearcheck.lumped.loader import load_text, read_train_text
+from gearcheck.compare.presentation.plots import _png
+from gearcheck.compare.studies.uncertainty import NOMINAL, band, drivers, uncertainty_study
+from gearcheck.train.loader import load_text, read_train_text
 
 G = 9.8  # m/s^2 per g, as the paper
 FITS = ["stages[0].mesh.ste[0].amplitude_um=0.2:20", "operating.output_torque=20:20000"]

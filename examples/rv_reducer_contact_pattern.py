@@ -17,7 +17,7 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.cycloid_rows import CycloidRows
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import harmonic_balance_response
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.shared.settings import RunSettings
 
 DURATION, WINDOW, GRID = 0.16, 0.04, 2048

@@ -14,7 +14,7 @@ from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.shared.settings import RunSettings
 
 DURATION, WINDOW = 0.16, 0.04

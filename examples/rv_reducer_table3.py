@@ -16,7 +16,7 @@ from dataclasses import replace
 from scipy.optimize import brentq, fsolve
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_text, preset_text
+from gearcheck.train.loader import load_text, preset_text
 from gearcheck.lumped.modal import modes
 from gearcheck.shared.errors import TrainFileError
 

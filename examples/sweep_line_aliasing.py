@@ -3,7 +3,7 @@
 demo-3p's rectangular mesh stiffness switches twice a mesh cycle, so the mesh forces and the bodies' accelerations
 jump there.  The lumped solver runs the train at 1500 rpm for 0.5 s at 2, 1, 1/2, 1/4 and 1/8 times its default
 step h; the steady half of each run is projected on the first three mesh harmonics, once by the plain Hann-windowed
-sum and once with the jumps at the stiffness switches corrected (:func:`gearcheck.compare.line_projection.harmonics`).
+sum and once with the jumps at the stiffness switches corrected (:func:`gearcheck.compare.engine.line_projection.harmonics`).
 The plain lines converge at first order in the step (the jumps alias onto them: the step divides the mesh period),
 the corrected ones sit on their limit from the default step on.  Writes line_aliasing.png and line_aliasing.json.
 
@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from gearcheck.compare.line_projection import harmonics
-from gearcheck.compare.plots import _png
-from gearcheck.lumped.loader import load_train
+from gearcheck.compare.engine.line_projection import harmonics
+from gearcheck.compare.presentation.plots import _png
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.shared.settings import RunSettings
 

@@ -18,8 +18,8 @@ derived here.  Run it:
 import numpy as np
 
 from gearcheck import LinearModel, Mesh, Periodic
-from gearcheck.lumped.excitation import Excitation
-from gearcheck.lumped.kinematics import kinematics
+from gearcheck.train.excitation import Excitation
+from gearcheck.train.kinematics import kinematics
 
 SAMPLES = 4096  # of each mesh's stiffness over its cycle
 

@@ -1,9 +1,9 @@
-"""The train description and the reference lumped-parameter solver.
+"""The reference lumped-parameter solver, built from the train description (:mod:`gearcheck.train`).
 
-Description (what both models are built from; the MuJoCo twin may import these): ``schema``,
-``loader``, ``spec``, ``geometry``, ``line_of_action``, ``kinematics``, ``mesh_stiffness`` (with
-``tooth_stiffness`` and ``iso6336``), ``excitation``, ``published_parameters``, ``variants``.
-
-Equations (the reference model; the twin never imports these): ``assembly``, ``modal``, ``static``,
-``time_solver``, ``harmonic``, ``published``, and ``side``, their face towards the cross-check.
+``assembly`` (M, G, K(t), C, F of the rotating-frame formulation), ``cycloid_rows`` (an RV reducer's
+turning rows), ``static``, ``modal``, ``time_solver`` with ``compiled_steps``, ``periodic_steady_state``,
+``harmonic``, ``forced_response`` and ``fourier_response`` (with ``response_sensitivity``),
+``transmission_error``, ``pin_loads``, the user's own models (``linear_model``, ``matrix_file``,
+``linear_run``, ``export``), the 4-DOF models of a paper (``published``) and ``side``, their face towards
+the cross-check.  Nothing here imports :mod:`gearcheck.mbd_models`, at any depth.
 """

@@ -44,10 +44,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from gearcheck.lumped.cycloid_rows import CycloidRows
-from gearcheck.lumped.excitation import Excitation
-from gearcheck.lumped.kinematics import Kinematics, kinematics
-from gearcheck.lumped.line_of_action import lever, line_of_action
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.excitation import Excitation
+from gearcheck.train.kinematics import Kinematics, kinematics
+from gearcheck.train.line_of_action import lever, line_of_action
+from gearcheck.train.spec import TrainSpec
 from gearcheck.lumped.static import mean_load
 from gearcheck.shared.errors import SolverError
 

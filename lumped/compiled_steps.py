@@ -14,7 +14,7 @@ chunk, and runs RK4 through them in compiled code.  Its right-hand side is that 
   frames (:meth:`gearcheck.lumped.assembly.TurningCoupling.forces`) and the cycloid stages' needle bearings,
   compression-only pin contacts and orbit loads (:meth:`gearcheck.lumped.cycloid_rows.CycloidRows.forces`; the
   pins' normals and arms from one sine and cosine per disc by the angle-addition formulas, as
-  :func:`gearcheck.lumped.cycloid.pin_contacts` states them).
+  :func:`gearcheck.train.cycloid.pin_contacts` states them).
 
 numba (``@njit(cache=True)``, compiled on the first call and cached on disk) is the one compiled dependency:
 a step is a loop over a few hundred numbers with branches (dead zones, contacts) that numpy cannot vectorise

@@ -12,7 +12,7 @@ axis at t = 0); pin i sits at beta_i(t) = 2 pi i / Z_p + (w_w - Omega) t on the 
   block on a non-rotation matrix and with the eccentric frozen; see the audit in the documentation).
 * Pin contact i of disc j, compression only: the common normal passes through the pitch point (Willis),
       delta = n . (u_j - u_w) + l theta_j - (C_i x n) theta_w - clearance,
-  n and l from :func:`gearcheck.lumped.cycloid.pin_contacts`; force k max(delta, 0) + c delta' while it
+  n and l from :func:`gearcheck.train.cycloid.pin_contacts`; force k max(delta, 0) + c delta' while it
   touches.
 * The disc's nominal orbit e(phi_j) at the crank's absolute speed w_H: its centrifugal load
   m e w_H^2 e(phi_j(t)) on the disc, written in the carrier frame (the frame's own terms act on the
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.lumped.cycloid import pin_contacts
+from gearcheck.train.cycloid import pin_contacts
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.cycloid import min_curvature_radius
+from gearcheck.train.cycloid import min_curvature_radius
 from gearcheck.shared.units import rad_s_to_rpm
 
 

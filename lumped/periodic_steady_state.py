@@ -78,7 +78,7 @@ class PeriodicSteadyState:
 
 def drive_frequencies(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """(frequencies of the time-varying drive in Hz, those of the time-varying meshes, what has no period): the
-    excitation's periodic terms (:meth:`gearcheck.lumped.excitation.Excitation.periodic_terms`) and the
+    excitation's periodic terms (:meth:`gearcheck.train.excitation.Excitation.periodic_terms`) and the
     model's turning couplings and cycloid contacts."""
     drive, meshes, aperiodic = model.excitation.periodic_terms()
     freqs = [drive]

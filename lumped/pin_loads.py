@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gearcheck.lumped.assembly import frozen_at
-from gearcheck.lumped.cycloid import (
+from gearcheck.train.cycloid import (
     classical_peak_force,
     pin_contacts,
     rigid_disc_load_share,

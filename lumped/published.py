@@ -9,7 +9,7 @@ the carrier (its absolute angle is theta_h + theta_f, Eq. 3), theta_b the ring b
 The paper writes c for stiffness and k for damping; so does this module.
 
 Models (``MODELS``), every one built from the same
-:class:`~gearcheck.lumped.published_parameters.PaperParameters`:
+:class:`~gearcheck.train.published_parameters.PaperParameters`:
 
 * ``as-published`` -- M, B, C, D exactly as printed in Eqs. 10, 11, 12, 13.  Row and column 1
   of B and C carry only their diagonal (k1 + k2, c1 + c2): the y1-rotation coupling that
@@ -46,7 +46,7 @@ import numpy as np
 
 from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import linear_modes
-from gearcheck.lumped.published_parameters import DESCRIPTIONS, LABELS, PaperParameters, check_model
+from gearcheck.train.published_parameters import DESCRIPTIONS, LABELS, PaperParameters, check_model
 from gearcheck.shared.modal import ModalResult
 
 FINDING = (

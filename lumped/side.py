@@ -16,7 +16,7 @@ import numpy as np
 from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, simulate_linear, step_limits, unmapped
-from gearcheck.lumped.mesh_stiffness import MODELS
+from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed
 from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import default_step, simulate, stable_step
@@ -112,7 +112,7 @@ class LinearSide:
 
 class PublishedSide(LinearSide):
     """A 4-DOF model of Matejic et al. (2021) (``name`` one of
-    :data:`gearcheck.lumped.published_parameters.MODELS`), from rest under the paper's excitation
+    :data:`gearcheck.train.published_parameters.MODELS`), from rest under the paper's excitation
     (``load``: with the output load on ring b), through the same door as any user's model."""
 
     def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1):

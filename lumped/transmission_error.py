@@ -1,6 +1,6 @@
 """Static transmission error of every mesh, unloaded and loaded, from its tooth pairs and their tip relief.
 
-Over one mesh cycle, with the pairs of :class:`gearcheck.lumped.tooth_pairs.ToothPairs` on thin slices
+Over one mesh cycle, with the pairs of :class:`gearcheck.train.tooth_pairs.ToothPairs` on thin slices
 across the face (one for spur gears):
 
 * the unloaded static transmission error is the smallest gap (the pair that touches first);
@@ -15,10 +15,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gearcheck.lumped import helical_mesh
+from gearcheck.train import helical_mesh
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.static import static_solution
-from gearcheck.lumped.tooth_pairs import ToothPairs
+from gearcheck.train.tooth_pairs import ToothPairs
 from gearcheck.shared.errors import GearcheckError
 
 HELICAL_SLICES = 400  # slices across a helical face: the slice model's TE error is O(1/n), 1 % of its ripple here

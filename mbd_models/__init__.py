@@ -1,10 +1,10 @@
 """gearcheck's MuJoCo half: the same train as real rigid bodies on real joints.
 
 An independent second derivation of the train: the MJCF is generated from the train description
-only (the spec, description-level geometry and kinematics, and the excitation functions of
-:mod:`gearcheck.lumped`); the dynamics, the mesh deflection coefficients, the linearisation, the
-static state and the forces all come from MuJoCo itself, never from the lumped model's matrices or
-equations (a test keeps it so).
+only (:mod:`gearcheck.train`: the spec, geometry, kinematics and excitation functions); the dynamics,
+the mesh deflection coefficients, the linearisation, the static state and the forces all come from
+MuJoCo itself, never from the lumped model's matrices or equations: nothing here imports :mod:`gearcheck.lumped`, at any depth (the import contracts in
+``pyproject.toml``).
 
 * ``mjcf_builder`` -- the MJCF text;
 * ``twin`` -- :func:`~gearcheck.mbd_models.twin.compile_train`, the compiled twin with named indices;
@@ -14,5 +14,6 @@ equations (a test keeps it so).
 * ``cycloid_twin`` -- an RV reducer's pin contacts, which follow the discs every step;
 * ``forces`` -- mesh and bearing forces read from MuJoCo's generalized forces;
 * ``published_twin`` -- the twin of the 4-DOF model of Matejic et al. (2021);
+* ``gear_visuals`` -- tooth outlines for the viewer;
 * ``side`` -- both as the cross-check sees them.
 """

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models.mjcf_builder import (
     PIN_BAND,
     needle_actuator,

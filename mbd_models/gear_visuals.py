@@ -1,5 +1,5 @@
 """Visual meshes of the involute gears of a train (and of an RV reducer's cycloid discs: their exact profile,
-:func:`gearcheck.lumped.cycloid.disc_profile`), for MuJoCo's viewer and offscreen renders.
+:func:`gearcheck.train.cycloid.disc_profile`), for MuJoCo's viewer and offscreen renders.
 
 Visual only: the geoms that carry these meshes are contact-free (contype = conaffinity = 0) and the
 bodies' mass and inertia come from their explicit ``<inertial>`` (the compiler has
@@ -29,9 +29,9 @@ import math
 
 import numpy as np
 
-from gearcheck.lumped.cycloid import CycloidGeometry, disc_profile
-from gearcheck.lumped.geometry import Gear, base_tooth_thickness
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.cycloid import CycloidGeometry, disc_profile
+from gearcheck.train.geometry import Gear, base_tooth_thickness
+from gearcheck.train.spec import TrainSpec
 
 FLANK_POINTS = 4  # per flank, evenly spaced in roll length
 HELIX_SLICES = 4  # extrusion slices of a helical gear

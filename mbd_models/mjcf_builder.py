@@ -52,7 +52,7 @@ from __future__ import annotations
 
 import math
 
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import gear_visuals
 
 STAGE_SPACING = 0.12  # m along z between stages (visual only: stages do not touch)

@@ -1,7 +1,7 @@
 """A MuJoCo twin of the 4-DOF idealisation of Matejic, Blagojevic & Matejic (2021).
 
 Built from bodies and joints, not from the paper's matrices (it uses the paper's parameter table,
-:class:`gearcheck.lumped.published_parameters.PaperParameters`, never the 4-DOF models' M, B, C):
+:class:`gearcheck.train.published_parameters.PaperParameters`, never the 4-DOF models' M, B, C):
 
 * ``carrier`` -- child of the world on the axis, hinge ``theta_h`` about z, then a slide
   ``y1`` (in the carrier's frame, so it turns with the carrier).  Mass m_h, polar inertia
@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from gearcheck.lumped.published_parameters import LABELS, PaperParameters, four_dof_result
+from gearcheck.train.published_parameters import LABELS, PaperParameters, four_dof_result
 from gearcheck.shared.errors import DivergenceError
 from gearcheck.shared.modal import ModalResult, modal_result
 from gearcheck.shared.settings import RunSettings
@@ -169,7 +169,7 @@ def twin_modes(twin: PublishedTwin) -> ModalResult:
 def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: bool = True):
     """From rest, MuJoCo's RK4 at the step ``settings.dt`` (default: the twin's own
     :func:`~gearcheck.shared.stepping.transient_step`); the paper's torques (M_h, T_b)
-    (:meth:`~gearcheck.lumped.published_parameters.PaperParameters.torques`) applied as qfrc_applied on
+    (:meth:`~gearcheck.train.published_parameters.PaperParameters.torques`) applied as qfrc_applied on
     theta_h and theta_b, held over each step.  Records qacc of every state (after mj_forward);
     ``model`` names the 4-DOF model whose kinematics the twin has (for the signals' descriptions)."""
     m = twin.model

@@ -2,7 +2,7 @@
 
 Per step (fixed step h, MuJoCo's RK4 integrator):
 
-* mesh stiffness k(t) from :meth:`gearcheck.lumped.excitation.Excitation.stiffness` (the nominal
+* mesh stiffness k(t) from :meth:`gearcheck.train.excitation.Excitation.stiffness` (the nominal
   clock, as the lumped solver) into ``m.tendon_stiffness``; a static transmission error
   e(t) shifts the tendons' spring length (``m.tendon_lengthspring`` = e -/+ b); a mesh with tip relief
   gets the stiffness and spring length of its tooth pairs in contact at the tendon's length

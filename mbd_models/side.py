@@ -11,7 +11,7 @@ from functools import cached_property
 
 import numpy as np
 
-from gearcheck.lumped.published_parameters import KINEMATICS, PaperParameters, check_model
+from gearcheck.train.published_parameters import KINEMATICS, PaperParameters, check_model
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.published_twin import PublishedTwin, build_twin, simulate_twin, twin_modes
 from gearcheck.mbd_models.runner import simulate_mujoco
@@ -62,7 +62,7 @@ class MujocoSide:
 
 class PublishedTwinSide:
     """The MuJoCo twin of the 4-DOF model ``name`` of Matejic et al. (2021); ``y1`` and ``carrier_mass``
-    override the kinematics that model claims (:data:`~gearcheck.lumped.published_parameters.KINEMATICS`).
+    override the kinematics that model claims (:data:`~gearcheck.train.published_parameters.KINEMATICS`).
     A run needs its step: the 4-DOF models and their twin are compared on one time grid."""
 
     solver = "mujoco"

@@ -4,7 +4,7 @@
 tendon over its nine joints and compiles it once.  The tendon coefficients are then taken from
 MuJoCo itself, d . (Jp_central(p) - Jp_planet(p)): the translation Jacobians (``mujoco.mj_jac``)
 of the two bodies at the pitch point p, projected on the line of action d of the train
-description (:func:`gearcheck.lumped.line_of_action.line_of_action`, given in the carrier frame and
+description (:func:`gearcheck.train.line_of_action.line_of_action`, given in the carrier frame and
 placed in the world with the carrier body's pose), and written into the compiled model's
 ``wrap_prm`` and into the text.  The mesh damping c = 2 zeta sqrt(k_mean m_eq),
 m_eq = 1/(r_A^2/I_A + r_B^2/I_B), takes r_A, r_B from those coefficients on the two gears' hinges
@@ -30,10 +30,10 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from gearcheck.lumped.excitation import Excitation
-from gearcheck.lumped.kinematics import Kinematics, kinematics
-from gearcheck.lumped.line_of_action import line_of_action
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.excitation import Excitation
+from gearcheck.train.kinematics import Kinematics, kinematics
+from gearcheck.train.line_of_action import line_of_action
+from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.cycloid_twin import CycloidTwin
 from gearcheck.mbd_models.mjcf_builder import (

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from gearcheck.lumped.loader import preset_names
+from gearcheck.train.loader import preset_names
 
 
 @pytest.fixture(params=preset_names())

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from gearcheck.compare.align import estimate_lag, resample, steady_start, uniform_grid
-from gearcheck.compare.metrics import spectral_amplitude, waveform_metrics
+from gearcheck.compare.engine.align import estimate_lag, resample, steady_start, uniform_grid
+from gearcheck.compare.engine.metrics import spectral_amplitude, waveform_metrics
 
 FS = 50_000.0
 

@@ -1,4 +1,4 @@
-"""Teaching animations (gearcheck.mbd_models.animate) and the live viewer's no-display error, headless.
+"""Teaching animations (gearcheck.compare.presentation.animate) and the live viewer's no-display error, headless.
 
 Rendering runs in one subprocess with MUJOCO_GL=egl (unless set): MuJoCo picks its OpenGL backend when it
 is first imported, which this test process did long before."""
@@ -14,15 +14,15 @@ import pytest
 from PIL import Image
 
 import gearcheck
-from gearcheck.mbd_models import animate as anim
-from gearcheck.mbd_models.live_view import live_view
+from gearcheck.compare.presentation import animate as anim
+from gearcheck.compare.presentation.live_view import live_view
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.errors import GearcheckError
 
 SCRIPT = """
 import sys
 import gearcheck
-from gearcheck.mbd_models.animate import animate, animate_mode
+from gearcheck.compare.presentation.animate import animate, animate_mode
 spec, out = gearcheck.load("demo-3p"), sys.argv[1]
 for name in ("a", "b"):
     animate(spec, f"{out}/{name}.gif", duration=8 / 15, fps=15, width=160, height=120)

@@ -1,12 +1,14 @@
-"""The package's walls, read from the installed code: one import package, the MuJoCo side never
-imports the lumped equations, imports run one way with no cycles, a twin compiles once, the data
-files ship, and importing gearcheck leaves matplotlib's backend alone."""
+"""The package's walls, read from the installed code: one import package, the lumped and MuJoCo sides never
+import each other at any depth and imports run one way (import-linter's contracts, each shown able to fail),
+a twin compiles once, the data files ship, and importing gearcheck leaves matplotlib's backend alone."""
 
 from __future__ import annotations
 
-import ast
+import importlib
 import importlib.metadata
 import importlib.resources
+import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -16,96 +18,54 @@ import pytest
 
 import gearcheck
 
-ROOT = Path(gearcheck.__file__).parent
-LAYERS = ["shared", "lumped", "mbd_models", "compare"]  # each may import those before it, never after
-DESCRIPTION = {  # the modules of gearcheck.lumped that describe the train: what the MuJoCo side may use
-    "schema", "loader", "spec", "geometry", "line_of_action", "kinematics", "mesh_stiffness", "tooth_stiffness",
-    "iso6336", "excitation", "published_parameters", "cycloid",
-}
+PYPROJECT = Path(__file__).parents[1] / "pyproject.toml"  # the contracts: [tool.importlinter]
+PACKAGES = ["gearcheck", "gearcheck.lumped", "gearcheck.mbd_models", "gearcheck.compare"]  # the mapped folders
 
 
-def package_modules() -> dict[str, Path]:
-    """Every module of the installed package by dotted name (package-dir mapped folders included)."""
-    out = {}
-    for sub in ["", *LAYERS]:
-        pkg = importlib.import_module(f"gearcheck.{sub}" if sub else "gearcheck")
-        for path in Path(pkg.__file__).parent.glob("*.py"):
-            name = pkg.__name__ if path.stem == "__init__" else f"{pkg.__name__}.{path.stem}"
-            out[name] = path
-    return out
+def installed_tree(dest: Path) -> Path:
+    """The installed package's source, laid out as one folder tree under ``dest`` (an editable install maps
+    lumped/, mbd_models/ and compare/ from elsewhere; grimp reads a package from one folder)."""
+    for name in PACKAGES:
+        folder = Path(importlib.import_module(name).__file__).parent
+        shutil.copytree(folder, dest.joinpath(*name.split(".")), dirs_exist_ok=True,
+                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    return dest
 
 
-def imports_of(source: str, module: str, is_package: bool = False) -> set[str]:
-    """Every gearcheck module imported anywhere in ``source`` (module level or inside functions)."""
-    package = module if is_package else module.rsplit(".", 1)[0]
-    found = set()
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Import):
-            found |= {alias.name for alias in node.names}
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = package.split(".")
-                base = ".".join(parts[:len(parts) - node.level + 1] + ([base] if base else []))
-            found.add(base)
-            found |= {f"{base}.{alias.name}" for alias in node.names}  # `from pkg import module`
-    return {name for name in found if name == "gearcheck" or name.startswith("gearcheck.")}
+def lint_imports(tree: Path) -> subprocess.CompletedProcess:
+    lint = Path(sys.executable).with_name("lint-imports")
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    return subprocess.run([str(lint), "--no-cache", "--no-logo", str(PYPROJECT)], cwd=tree, env=env,
+                          capture_output=True, text=True, timeout=300)
 
 
 @pytest.fixture(scope="module")
-def graph():
-    modules = package_modules()
-    return {name: {m for m in imports_of(path.read_text(encoding="utf-8"), name, path.stem == "__init__")
-                   if m in modules and m != name}
-            for name, path in modules.items()}
+def tree(tmp_path_factory):
+    return installed_tree(tmp_path_factory.mktemp("installed"))
 
 
-def wall_breaches(imports: set[str]) -> set[str]:
-    """The modules of gearcheck.lumped outside its description that ``imports`` reach."""
-    return {".".join(m.split(".")[:3]) for m in imports
-            if m.startswith("gearcheck.lumped.") and m.split(".")[2] not in DESCRIPTION}
+def test_every_import_contract_holds(tree):
+    done = lint_imports(tree)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "Contracts: 3 kept, 0 broken." in done.stdout
 
 
-def test_the_mujoco_side_never_imports_the_lumped_equations(graph):
-    mbd = {name: deps for name, deps in graph.items() if name.startswith("gearcheck.mbd_models")}
-    assert len(mbd) >= 8
-    for name, deps in mbd.items():
-        assert not wall_breaches(deps), f"{name} imports the lumped equations: {sorted(wall_breaches(deps))}"
-
-
-def test_the_wall_check_can_fail():
-    breach = "from gearcheck.lumped.assembly import build_model\nfrom gearcheck.lumped import static\n"
-    assert wall_breaches(imports_of(breach, "gearcheck.mbd_models.x")) == {"gearcheck.lumped.assembly",
-                                                                          "gearcheck.lumped.static"}
-    assert not wall_breaches(imports_of("from gearcheck.lumped.spec import TrainSpec\n", "gearcheck.mbd_models.x"))
-
-
-def test_imports_run_one_way(graph):
-    for name, deps in graph.items():
-        layer = name.split(".")[1] if name.count(".") else "front door"
-        if layer not in LAYERS:
-            continue  # the front door and the command line sit on top
-        allowed = {f"gearcheck.{lower}" for lower in LAYERS[:LAYERS.index(layer) + 1]}
-        wrong = {d for d in deps if not any(d == a or d.startswith(a + ".") for a in allowed)}
-        assert not wrong, f"{name} ({layer}) imports {sorted(wrong)}"
-
-
-def test_no_import_cycles(graph):
-    state: dict[str, int] = {}
-
-    def visit(node, path):
-        state[node] = 1
-        for dep in sorted(graph[node]):
-            if state.get(dep) == 1:
-                pytest.fail("import cycle: " + " -> ".join(path[path.index(dep):] + [dep]) if dep in path
-                            else f"import cycle through {dep}")
-            if dep not in state:
-                visit(dep, path + [dep])
-        state[node] = 2
-
-    for node in sorted(graph):
-        if node not in state:
-            visit(node, [node])
+@pytest.mark.parametrize("planted_in, planted, contract", [
+    # three imports deep: train.excitation -> lumped.assembly; the twin reaches it through mbd_models.twin
+    ("gearcheck/train/excitation.py", "import gearcheck.lumped.assembly", "The second derivation stays independent"),
+    ("gearcheck/lumped/static.py", "from gearcheck.mbd_models import forces", "The second derivation stays independent"),
+    ("gearcheck/shared/units.py", "import gearcheck.compare.engine.metrics", "Imports run one way"),
+    ("gearcheck/compare/engine/align.py", "from gearcheck.compare.studies import sweep", "compare's rooms"),
+])
+def test_a_planted_import_breaks_its_contract(tmp_path, planted_in, planted, contract):
+    """The negative control: one import added anywhere (inside a function too) fails the check."""
+    tree = installed_tree(tmp_path)
+    target = tree / planted_in
+    target.write_text(target.read_text(encoding="utf-8") + f"\n\ndef _planted():\n    {planted}\n", encoding="utf-8")
+    done = lint_imports(tree)
+    assert done.returncode == 1, done.stdout + done.stderr
+    broken = done.stdout.partition("Broken contracts")[2]
+    assert contract in broken, done.stdout
 
 
 def test_a_twin_compiles_once(monkeypatch):
@@ -126,8 +86,8 @@ def test_only_gearcheck_goes_into_site_packages():
 
 
 def test_presets_and_baselines_ship_with_the_package():
-    presets = importlib.resources.files("gearcheck.lumped.presets")
-    baselines = importlib.resources.files("gearcheck.compare").joinpath("baselines")
+    presets = importlib.resources.files("gearcheck.train.presets")
+    baselines = importlib.resources.files("gearcheck.compare.engine").joinpath("baselines")
     for name in gearcheck.presets():
         assert presets.joinpath(f"{name}.toml").is_file()
         assert baselines.joinpath(f"{name}.json").is_file()

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from gearcheck.cli import main
-from gearcheck.lumped.loader import preset_text
+from gearcheck.train.loader import preset_text
 
 DEMO = preset_text("demo-3p")
 
@@ -168,7 +168,7 @@ STRUCTURE = [
 
 
 def coupling_between_speeds() -> str:
-    from gearcheck.lumped.variants import chained_text
+    from gearcheck.train.variants import chained_text
 
     return chained_text(2) + ('\n[[couplings]]\nname = "locks"\nfrom = "stage1.sun"\nto = "stage2.sun"\n'
                               "torsional_stiffness = 1e6\n")

@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.lumped.variants import chained, edited
+from gearcheck.train.variants import chained, edited
 from gearcheck.mbd_models import compiled, runner
 from gearcheck.mbd_models.runner import simulate_mujoco, simulate_mujoco_many
 from gearcheck.mbd_models.twin import compile_train

@@ -6,8 +6,8 @@ import pytest
 from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.compiled_steps import Turning
-from gearcheck.lumped.loader import load_train
-from gearcheck.lumped.variants import chained, edited
+from gearcheck.train.loader import load_train
+from gearcheck.train.variants import chained, edited
 from gearcheck.shared.settings import RunSettings
 
 LIGHT_BACKLASH = [(r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nbacklash_um = 40.0\n"

@@ -9,11 +9,11 @@ import pytest
 
 from gearcheck import crosscheck
 from gearcheck.cli import main
-from gearcheck.compare.baseline import BASELINE_DIR
-from gearcheck.compare.engine import compare
-from gearcheck.compare.plan import TrainPlan
-from gearcheck.compare.tolerances import Tolerances
-from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.compare.engine.baseline import BASELINE_DIR
+from gearcheck.compare.engine.comparison import compare
+from gearcheck.compare.engine.plan import TrainPlan
+from gearcheck.compare.engine.tolerances import Tolerances
+from gearcheck.train.loader import load_train, preset_names
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide
@@ -119,7 +119,7 @@ def test_measured_values_appear_as_a_third_column(tmp_path, capsys):
 def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
     """A mesh-force tolerance tighter than the integration error cannot be decided: those quantities are
     unresolved, by name, and the verdict INCONCLUSIVE (exit 3), not PASS; the steps were refined first."""
-    from gearcheck.lumped.variants import edited
+    from gearcheck.train.variants import edited
 
     strict = edited("demo-3p", [(r"^\[\[stages\]\]", "[tolerances]\nmesh_force.nrmse = 1e-9\n\n[[stages]]")])
     assert strict.tolerances == {"mesh_force.nrmse": 1e-9}
@@ -130,7 +130,7 @@ def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
     assert any("halved (2x)" in note for note in result.notes)
     loose = tmp_path / "tol.toml"
     loose.write_text("[tolerances]\n\"stage1.planet1.sun.force.nrmse\" = 0.5\n")
-    from gearcheck.compare.tolerances import Tolerances
+    from gearcheck.compare.engine.tolerances import Tolerances
 
     tol = Tolerances.for_train(strict, loose)
     assert tol.lookup("stage1.planet1.sun.force", "mesh_force", "nrmse") == 0.5

@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import minimize_scalar
 
-from gearcheck.lumped.cycloid import (
+from gearcheck.train.cycloid import (
     CycloidGeometry,
     classical_peak_force,
     conjugate_disc_angle,

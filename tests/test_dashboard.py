@@ -19,9 +19,9 @@ import pytest
 from matplotlib.image import imread
 
 import gearcheck
-from gearcheck.compare import dashboard, history
-from gearcheck.compare.report import to_dict
-from gearcheck.lumped.loader import preset_text
+from gearcheck.compare.presentation import dashboard, history
+from gearcheck.compare.presentation.report import to_dict
+from gearcheck.train.loader import preset_text
 from gearcheck.shared.errors import GearcheckError
 
 DURATION = 0.02  # s: demo-3p reaches its steady state by 7.4 ms; each cross-check takes 1-3 s

@@ -1,4 +1,4 @@
-"""The diagnosis of a user's lumped model (gearcheck.compare.diagnosis): broken copies of the reference, one term
+"""The diagnosis of a user's lumped model (gearcheck.compare.engine.diagnosis): broken copies of the reference, one term
 changed each, are named by the term that was changed; the reference itself, and a mistake the evidence cannot
 see, are said to agree."""
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.compare.diagnosis import KINDS, Evidence, diagnose
+from gearcheck.compare.engine.diagnosis import KINDS, Evidence, diagnose
 from gearcheck.lumped.assembly import build_model
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import generalized_modes

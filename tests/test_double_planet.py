@@ -8,10 +8,10 @@ import pytest
 
 import gearcheck
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.published import four_dof_model, natural_frequencies
-from gearcheck.lumped.published_parameters import MODELS, PaperParameters
+from gearcheck.train.published_parameters import MODELS, PaperParameters
 from gearcheck.mbd_models.published_twin import build_twin, linearise, twin_modes
 
 
@@ -26,7 +26,7 @@ def params(spec):
 
 
 def test_preset_reproduces_table_1_and_pins_the_ratio(spec, params):
-    from gearcheck.lumped.kinematics import kinematics
+    from gearcheck.train.kinematics import kinematics
 
     assert kinematics(spec).ratio == pytest.approx(10920 / 552, rel=1e-12)  # 19.7826..., the paper rounds to 20
     assert params.ratio == pytest.approx(10920 / 552, rel=1e-12)

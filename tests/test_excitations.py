@@ -5,10 +5,10 @@ import pytest
 
 from gearcheck import crosscheck
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.line_of_action import line_of_action
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.line_of_action import line_of_action
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.time_solver import simulate
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.settings import RunSettings
 
@@ -62,7 +62,7 @@ def test_load_ramp_settles_to_the_state_reached_from_the_static_start():
 
 def test_torque_profile_from_a_csv_file(tmp_path):
     """A periodic torque profile (time, torque) next to the train file adds to the input torque."""
-    from gearcheck.lumped.variants import edited_text
+    from gearcheck.train.variants import edited_text
 
     (tmp_path / "pulse.csv").write_text("time_s,torque_nm\n0.0,0.0\n0.005,40.0\n0.01,0.0\n")
     path = tmp_path / "pulsed.toml"

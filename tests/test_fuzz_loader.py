@@ -12,7 +12,7 @@ import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from gearcheck.lumped.loader import load_text, preset_names, preset_text
+from gearcheck.train.loader import load_text, preset_names, preset_text
 from gearcheck.shared.errors import GearcheckError
 
 DOCUMENTS = {name: tomllib.loads(preset_text(name)) for name in preset_names()}

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from gearcheck import mjcf
-from gearcheck.lumped.geometry import reference_tooth_thickness
-from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.train.geometry import reference_tooth_thickness
+from gearcheck.train.loader import load_train, preset_names
 from gearcheck.mbd_models import gear_visuals, linearise, mjcf_builder
 from gearcheck.mbd_models.gear_visuals import gear_mesh, half_angle, phases, section, tooth_outline
 from gearcheck.mbd_models.twin import compile_train

@@ -9,11 +9,11 @@ import pytest
 
 import gearcheck
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.kinematics import kinematics
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.kinematics import kinematics
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.static import static_solution
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 
 DATA = Path(__file__).parent / "data"
 
@@ -51,7 +51,7 @@ def test_unequally_spaced_planets():
 
 
 def test_two_stages_with_a_spline():
-    from gearcheck.lumped.variants import chained
+    from gearcheck.train.variants import chained
 
     spec = chained(2)
     kin = kinematics(spec)
@@ -65,8 +65,8 @@ def test_a_ring_shared_by_two_stages():
     (gearcheck.lumped.assembly.TurningCoupling).  At t = 0 every frame coincides and the natural frequencies
     agree with MuJoCo's (whose rings' slides are world-fixed, so its coupling is constant); the time
     responses agree too, which they would not if the periodic rows were wrong."""
-    from gearcheck.lumped.loader import load_text
-    from gearcheck.lumped.variants import chained_text
+    from gearcheck.train.loader import load_text
+    from gearcheck.train.variants import chained_text
 
     ring = ('\n[[couplings]]\nname = "ring"\nkind = "ring"\nfrom = "stage1.ring"\nto = "stage2.ring"\n'
             "torsional_stiffness = 1.0e8\nradial_stiffness = 1.0e10\n")

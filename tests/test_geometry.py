@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from gearcheck.lumped.geometry import Gear, inverse_involute, involute, mesh_geometry
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.geometry import Gear, inverse_involute, involute, mesh_geometry
+from gearcheck.train.loader import load_train
 
 
 def gear(z, internal=False, x=0.0, m=3e-3, alpha=math.radians(20)):

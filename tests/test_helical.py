@@ -24,7 +24,7 @@ import gearcheck
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.static import static_solution
 from gearcheck.lumped.transmission_error import static_transmission_error
-from gearcheck.lumped.variants import helical_stage
+from gearcheck.train.variants import helical_stage
 
 AXIAL = 5.0e8  # N/m, helical_stage's default axial support stiffness
 

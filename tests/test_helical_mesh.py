@@ -1,5 +1,5 @@
 """Contact-line length, thin-slice and ISO helical stiffness, and quasi-static tip relief
-(lumped.helical_mesh) against closed forms derived by hand.
+(train.helical_mesh) against closed forms derived by hand.
 
 Measured: the slice model equals k_pair cos(beta_b) L(xi) for a constant k_pair at any slice count
 (to 1e-12), and converges as 1/n^2 for a k_pair varying along the path; Maatar & Velex's printed A_k, B_k agree with
@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.lumped import iso6336
-from gearcheck.lumped.helical_mesh import (
+from gearcheck.train import iso6336
+from gearcheck.train.helical_mesh import (
     contact_force,
     contact_line_fourier,
     contact_line_length,

@@ -5,11 +5,11 @@ import math
 import pytest
 
 from gearcheck import crosscheck
-from gearcheck.compare.calibrate import FitParameter, calibrate
-from gearcheck.compare.measure import measure
+from gearcheck.compare.studies.calibrate import FitParameter, calibrate
+from gearcheck.compare.engine.measure import measure
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.kinematics import kinematics
-from gearcheck.lumped.loader import load_train, preset_text
+from gearcheck.train.kinematics import kinematics
+from gearcheck.train.loader import load_train, preset_text
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.settings import RunSettings
 
@@ -99,6 +99,6 @@ def test_calibration_recovers_a_known_transmission_error():
 
 
 def load_train_text(text):
-    from gearcheck.lumped.loader import load_text
+    from gearcheck.train.loader import load_text
 
     return load_text(text, "synthetic")

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.compare.engine import integration_error
+from gearcheck.compare.engine.comparison import integration_error
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.time_solver import default_step
-from gearcheck.lumped.variants import chained
+from gearcheck.train.variants import chained
 
 DURATION = 0.03
 KINDS = ("mesh_force", "bearing_force", "acceleration", "angular_acceleration")

@@ -95,7 +95,7 @@ def test_a_second_run_into_the_same_folder_is_refused(tmp_path, capsys):
 def test_a_closed_pipe_ends_the_program_quietly(tmp_path):
     """`gearcheck mjcf TRAIN | head -1` with more output than a pipe holds: no BrokenPipeError, the
     program ends on SIGPIPE as other command-line tools do."""
-    from gearcheck.lumped.variants import chained_text
+    from gearcheck.train.variants import chained_text
 
     train = tmp_path / "chain.toml"
     train.write_text(chained_text(12), encoding="utf-8")

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from gearcheck.lumped.kinematics import kinematics
-from gearcheck.lumped.loader import load_train
-from gearcheck.lumped.variants import edited
+from gearcheck.train.kinematics import kinematics
+from gearcheck.train.loader import load_train
+from gearcheck.train.variants import edited
 
 
 def test_willis_for_every_stage_of_every_preset(preset):

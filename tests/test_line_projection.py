@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from gearcheck.compare.line_projection import harmonics, jumps
+from gearcheck.compare.engine.line_projection import harmonics, jumps
 
 F = 270.0  # Hz, the "mesh" frequency
 DUTY = 0.37  # of the pulse: +1 on [0, DUTY / F) of each period, -1 elsewhere

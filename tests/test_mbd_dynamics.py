@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.static import static_solution
 from gearcheck.lumped.time_solver import simulate
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 from gearcheck.mbd_models.runner import simulate_mujoco, static_state
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.contact_laws import deadzone

@@ -15,9 +15,9 @@ import pytest
 
 import gearcheck
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.train.loader import load_train, preset_names
 from gearcheck.lumped.modal import modes
-from gearcheck.lumped.variants import chained, edited
+from gearcheck.train.variants import chained, edited
 from gearcheck.mbd_models.twin import compile_train, mesh_jacobian_row
 
 RELATIVE_TOLERANCE = 1e-6

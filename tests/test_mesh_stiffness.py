@@ -1,4 +1,4 @@
-"""The energy-method mesh stiffness (lumped.tooth_stiffness, EnergyMethodStiffness) against
+"""The energy-method mesh stiffness (train.tooth_stiffness, EnergyMethodStiffness) against
 independent formulations, the contact ratio, and both solvers.
 
 Numbers measured on demo-3p (z = 22/20/62, m = 3 mm, b = 40 mm, 20 deg, steel), default
@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.lumped import iso6336, tooth_stiffness
+from gearcheck.train import iso6336, tooth_stiffness
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_text, preset_text
-from gearcheck.lumped.mesh_stiffness import MODELS, EnergyMethodStiffness, energy_stiffness_curve
+from gearcheck.train.loader import load_text, preset_text
+from gearcheck.train.mesh_stiffness import MODELS, EnergyMethodStiffness, energy_stiffness_curve
 from gearcheck.lumped.modal import modes
-from gearcheck.lumped.schema import Context
-from gearcheck.lumped.variants import edited
+from gearcheck.train.schema import Context
+from gearcheck.train.variants import edited
 
 E_STEEL, NU_STEEL = 206e9, 0.3
 UNIT = 1e9  # N/(mm·µm) in N/m²

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
-from gearcheck.lumped.variants import edited, wide_stage
+from gearcheck.train.variants import edited, wide_stage
 
 RIGID = "1.0e16"  # N/m or N·m/rad: supports this stiff perturb a 1e8..1e9 N/m mesh mode by O(1e-8)
 

@@ -13,7 +13,7 @@ import pytest
 
 import gearcheck
 from gearcheck.cli import main
-from gearcheck.compare.mode_pairing import pair_modes
+from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.mbd_models.side import MujocoSide
 

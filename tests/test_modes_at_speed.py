@@ -15,7 +15,7 @@ import pytest
 
 import gearcheck
 from gearcheck.cli import main
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 
 SPEED_FACTORS = (1.0, 4.0)
 
@@ -96,7 +96,7 @@ def test_campbell_diagram_files_and_crossings(tmp_path, capsys):
 
 def test_campbell_shades_the_unstable_range(tmp_path, capsys):
     spec_file = tmp_path / "soft.toml"
-    from gearcheck.lumped.variants import edited_text
+    from gearcheck.train.variants import edited_text
 
     spec_file.write_text(edited_text("demo-3p", SOFT))
     assert main(["campbell", str(spec_file), "--speeds", "40000:46000:7", "--solver", "lumped",

@@ -5,10 +5,10 @@ import pytest
 
 from gearcheck.lumped import periodic_steady_state as periodic_steady_state_module
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.periodic_steady_state import MAX_MESH_PERIODS, common_period, periodic_steady_state
 from gearcheck.lumped.time_solver import default_step, simulate
-from gearcheck.lumped.variants import chained, edited
+from gearcheck.train.variants import chained, edited
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.settings import RunSettings
 

@@ -11,7 +11,7 @@ import pytest
 
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.harmonic import harmonic_response, transmission_error_force
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
 
 

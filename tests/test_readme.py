@@ -4,7 +4,7 @@ exactly two fresh-machine commands, the second of which is what .ci/run runs."""
 import re
 from pathlib import Path
 
-from gearcheck.lumped.docs import BLOCKS, block
+from gearcheck.train.docs import BLOCKS, block
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_generated_references_match_the_code():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     for name, make in BLOCKS.items():
-        assert block(text, name) == make(), f"README {name} reference is stale: python -m gearcheck.lumped.docs"
+        assert block(text, name) == make(), f"README {name} reference is stale: python -m gearcheck.train.docs"
 
 
 def test_two_setup_commands_and_ci_runs_the_test_one():

@@ -11,8 +11,8 @@ import pytest
 import scipy.io
 
 import gearcheck
-from gearcheck.compare.mode_pairing import pair_modes
-from gearcheck.compare.recorded import RecordedSide, read_column_map, read_modes, read_time_series
+from gearcheck.compare.engine.mode_pairing import pair_modes
+from gearcheck.compare.engine.recorded import RecordedSide, read_column_map, read_modes, read_time_series
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.results import train_signals

@@ -15,10 +15,10 @@ import pytest
 from matplotlib.image import imread
 
 import gearcheck
-from gearcheck.compare.junit import junit_xml, write_junit
-from gearcheck.compare.plots import MAX_FAILING, failing_figure, spectra_figure
-from gearcheck.compare.report import MISS, STATUSES, calibration, line_status
-from gearcheck.lumped.kinematics import kinematics
+from gearcheck.compare.presentation.junit import junit_xml, write_junit
+from gearcheck.compare.presentation.plots import MAX_FAILING, failing_figure, spectra_figure
+from gearcheck.compare.presentation.report import MISS, STATUSES, calibration, line_status
+from gearcheck.train.kinematics import kinematics
 
 ROOT = Path(__file__).resolve().parents[1]
 TORSIONAL = f"{ROOT / 'examples' / 'torsional_user_model.py'}:torsional_model"

@@ -5,13 +5,13 @@ Eq. (15), a selection rule, and the quasi-static limit against the static soluti
 import numpy as np
 import pytest
 
-from gearcheck.compare.sensitivity import field_sensitivity
+from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.assembly import build_model, frozen_at
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
-from gearcheck.lumped.loader import preset_text
+from gearcheck.train.loader import preset_text
 from gearcheck.lumped.static import static_solution
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 from gearcheck.shared.errors import SolverError
 
 TEXT = preset_text("rv-reducer")

@@ -6,10 +6,10 @@ import pytest
 
 from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model, frozen_at
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.static import static_solution
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 from gearcheck.shared.settings import RunSettings
 
 CONSTANT_MESH = [(r'stiffness = \{ model = "rectangular", mean = 2.68e8 \}',

@@ -14,10 +14,10 @@ import pytest
 from scipy.linalg import eigh
 from scipy.optimize import brentq, fsolve
 
-from gearcheck.compare import plots
+from gearcheck.compare.presentation import plots
 from gearcheck.lumped.assembly import build_model, frozen_at
-from gearcheck.lumped.cycloid import pin_contacts
-from gearcheck.lumped.loader import load_text, preset_text
+from gearcheck.train.cycloid import pin_contacts
+from gearcheck.train.loader import load_text, preset_text
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.pin_loads import (
     cycloid_element,
@@ -50,7 +50,7 @@ def model():
 def paper_layout():
     """The paper's 4 planets and 3 discs, assembled with the planet-collision check switched off: the stiffness
     model of a reducer that cannot be built (4 planets of 69 teeth collide on a 63.5 mm circle)."""
-    with mock.patch("gearcheck.lumped.spec._check_collision"):
+    with mock.patch("gearcheck.train.spec._check_collision"):
         return build_model(load_text(PAPER_LAYOUT, "paper layout, collision check off"))
 
 
@@ -461,7 +461,7 @@ def test_the_figure_is_deterministic(loads):
 
 
 def test_a_model_without_a_cycloid_stage_is_refused():
-    from gearcheck.lumped.loader import load_train
+    from gearcheck.train.loader import load_train
 
     with pytest.raises(ValueError, match="cycloid stage"):
         pin_loads(build_model(load_train("demo-3p")))

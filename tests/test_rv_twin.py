@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.static import static_solution
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.runner import simulate_mujoco
 from gearcheck.mbd_models.static_state import nominal_speeds, static_state

@@ -12,10 +12,10 @@ import pytest
 from jsonschema import Draft202012Validator
 
 import gearcheck
-from gearcheck.compare.diagnosis import Evidence, diagnose
-from gearcheck.compare.schemas import SCHEMA_FILES, write_schemas
+from gearcheck.compare.engine.diagnosis import Evidence, diagnose
+from gearcheck.compare.presentation.schemas import SCHEMA_FILES, write_schemas
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_text, preset_names, preset_text
+from gearcheck.train.loader import load_text, preset_names, preset_text
 from gearcheck.shared.errors import GearcheckError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -39,7 +39,7 @@ def train_validator():
 
 
 def test_the_shipped_schemas_are_current(tmp_path):
-    """Regenerate them (``python -m gearcheck.compare.schemas schemas/``) and compare byte for byte."""
+    """Regenerate them (``python -m gearcheck.compare.presentation.schemas schemas/``) and compare byte for byte."""
     assert sorted(p.name for p in SHIPPED.iterdir()) == sorted(SCHEMA_FILES)
     for path in write_schemas(tmp_path):
         assert path.read_bytes() == (SHIPPED / path.name).read_bytes(), f"{path.name} is stale: regenerate it"

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_train
+from gearcheck.train.loader import load_train
 from gearcheck.lumped.static import static_solution, stiffness_with_rotation
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 
 
 def input_torque_through_meshes(spec, static):

@@ -18,11 +18,11 @@ import gearcheck
 from gearcheck.cli import main
 from gearcheck.compare import point_backends
 from gearcheck.compare import sweep as sw
-from gearcheck.compare.distributions import Distribution, draw_samples
-from gearcheck.compare.line_projection import harmonics
-from gearcheck.compare.sweep_lines import counted
-from gearcheck.compare.sweep_plots import crossings
-from gearcheck.lumped.kinematics import kinematics
+from gearcheck.compare.studies.distributions import Distribution, draw_samples
+from gearcheck.compare.engine.line_projection import harmonics
+from gearcheck.compare.studies.sweep_lines import counted
+from gearcheck.compare.presentation.sweep_plots import crossings
+from gearcheck.train.kinematics import kinematics
 from gearcheck.shared.errors import GearcheckError, SolverError
 
 FAST = {"solvers": ("lumped",), "duration": 0.03}  # demo-3p: ~0.15 s a point
@@ -64,7 +64,7 @@ def test_a_speed_sweep_gives_one_tidy_table(tmp_path):
 def test_each_line_carries_its_integration_error_and_the_stiffness_switches_do_not_alias(tmp_path):
     """demo-3p's rectangular mesh stiffness makes its forces and accelerations jump twice a mesh cycle: the lines
     at the default step h, corrected for the jumps, against the same run at h / 8 (its error 4096 times smaller)."""
-    from gearcheck.lumped.loader import load_train
+    from gearcheck.train.loader import load_train
     from gearcheck.lumped.side import LumpedSide
     from gearcheck.shared.settings import RunSettings
 

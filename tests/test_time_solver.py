@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_text, load_train, preset_text
+from gearcheck.train.loader import load_text, load_train, preset_text
 from gearcheck.lumped.static import static_solution
 from gearcheck.lumped.time_solver import default_step, mechanical_energy, simulate, stable_step
 from gearcheck.shared.errors import SolverError

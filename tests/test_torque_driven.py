@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 import gearcheck
-from gearcheck.lumped.variants import edited, wide_stage
+from gearcheck.train.variants import edited, wide_stage
 
 TEETH = {3: (30, 24, 78), 4: (30, 24, 78), 5: (21, 24, 69), 6: (30, 24, 78)}  # z_s + z_r divisible by N
 SPEEDS = (500.0, 2000.0, 4000.0, 6000.0)

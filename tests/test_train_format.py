@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 from gearcheck.shared.errors import TrainFileError
 
 STEEL = 7850.0

@@ -19,12 +19,12 @@ import pytest
 
 import gearcheck
 from gearcheck.cli import main
-from gearcheck.lumped import helical_mesh
+from gearcheck.train import helical_mesh
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.tooth_pairs import DYNAMIC_SLICES, mesh_relief
-from gearcheck.lumped.tooth_stiffness import path_of_contact
+from gearcheck.train.tooth_pairs import DYNAMIC_SLICES, mesh_relief
+from gearcheck.train.tooth_stiffness import path_of_contact
 from gearcheck.lumped.transmission_error import mesh_static_transmission_error, static_transmission_error
-from gearcheck.lumped.variants import edited
+from gearcheck.train.variants import edited
 
 
 def with_relief(preset: str, amount_um: float, length_mm: float, gears=("planet",), shape="linear"):

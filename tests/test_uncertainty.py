@@ -1,4 +1,4 @@
-"""Monte Carlo of calibrate-then-predict (gearcheck.compare.uncertainty) on demo-3p with synthetic measurements.
+"""Monte Carlo of calibrate-then-predict (gearcheck.compare.studies.uncertainty) on demo-3p with synthetic measurements.
 
 The 'measurements' are the model's own rms ring acceleration with a 2.5 um transmission error (the only
 excitation: constant mesh stiffness) at 1500 and 1200 rpm; each sample draws the mesh damping ratio and the
@@ -12,11 +12,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from gearcheck.compare.calibrate import FitParameter, calibrate
-from gearcheck.compare.measure import measure
-from gearcheck.compare.uncertainty import NOMINAL, band, drivers, uncertainty_study
+from gearcheck.compare.studies.calibrate import FitParameter, calibrate
+from gearcheck.compare.engine.measure import measure
+from gearcheck.compare.studies.uncertainty import NOMINAL, band, drivers, uncertainty_study
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.loader import load_text, load_train, preset_text
+from gearcheck.train.loader import load_text, load_train, preset_text
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.settings import RunSettings

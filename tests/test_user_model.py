@@ -15,7 +15,7 @@ import scipy.io
 
 import gearcheck
 from gearcheck.cli import main
-from gearcheck.compare.mode_pairing import pair_modes
+from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.matrix_file import read_matrix_file
 from gearcheck.lumped.side import LinearSide, LumpedSide
@@ -235,7 +235,7 @@ def _broken(spec, kind):
 def test_diagnosis_through_the_door_names_the_term(kind, term):
     """A broken copy of the reference given as a user's model: the diagnosis names the broken term first, at
     round-off, and the reference itself scores far worse (a missing Coriolis term only shows at speed)."""
-    from gearcheck.compare.diagnosis import diagnose_side
+    from gearcheck.compare.engine.diagnosis import diagnose_side
     from gearcheck.lumped.assembly import build_model
 
     spec = gearcheck.load("demo-3p")
@@ -247,8 +247,8 @@ def test_diagnosis_through_the_door_names_the_term(kind, term):
 def test_diagnosis_of_the_torsional_model_is_its_reduction():
     """The torsional model agrees with the reference reduced to its coordinates: its disagreement with the
     full reference is the reduction, which the diagnosis says instead of blaming a term."""
-    from gearcheck.compare.diagnosis import diagnose_side
-    from gearcheck.compare.user_model import user_side
+    from gearcheck.compare.engine.diagnosis import diagnose_side
+    from gearcheck.compare.engine.user_model import user_side
     from gearcheck.lumped.assembly import build_model
 
     spec = gearcheck.load("demo-3p")
@@ -260,7 +260,7 @@ def test_diagnosis_of_the_torsional_model_is_its_reduction():
 def test_train_file_registers_its_user_model(tmp_path, capsys):
     """train.user_model names the model (a file relative to the train file) that --model user checks; a train
     without one is refused in one line."""
-    from gearcheck.lumped.loader import preset_text
+    from gearcheck.train.loader import preset_text
 
     write_matrix_file(reference_linear_model(gearcheck.load("demo-3p")), tmp_path / "mine.npz")
     text = preset_text("demo-3p").replace("[train]\n", '[train]\nuser_model = "mine.npz"\n', 1)

@@ -7,7 +7,7 @@ import pytest
 
 import gearcheck
 from gearcheck.cli import main
-from gearcheck.lumped.loader import load_train, preset_names
+from gearcheck.train.loader import load_train, preset_names
 
 XML = Path(__file__).resolve().parent.parent / "xml"
 

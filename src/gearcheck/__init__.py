@@ -46,9 +46,9 @@ from gearcheck.api import (  # noqa: E402
                            sweep,
                            write_report,
 )
-from gearcheck.compare.engine import CrosscheckResult
+from gearcheck.compare.engine.comparison import CrosscheckResult
 from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.spec import TrainSpec
 from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult

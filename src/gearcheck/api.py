@@ -1,7 +1,7 @@
 """The front door: load a train, its modes, a time run of either solver, its MuJoCo model, a cross-check.
 
 Every function takes a train as a preset name (``"hub-drive"``), the path of a train file, or a
-loaded :class:`~gearcheck.lumped.spec.TrainSpec`.  Bad input raises a
+loaded :class:`~gearcheck.train.spec.TrainSpec`.  Bad input raises a
 :class:`~gearcheck.shared.errors.GearcheckError` whose message names the file, field or argument.
 """
 
@@ -9,20 +9,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gearcheck.compare.campbell import CampbellResult
-from gearcheck.compare.campbell import campbell as campbell_diagram
-from gearcheck.compare.crosscheck import crosscheck
-from gearcheck.compare.mode_pairing import ModePairing, pair_modes
-from gearcheck.compare.report import write_report
-from gearcheck.compare.sensitivity import field_sensitivity, lattice
-from gearcheck.compare.user_model import user_side
+from gearcheck.compare.studies.campbell import CampbellResult
+from gearcheck.compare.studies.campbell import campbell as campbell_diagram
+from gearcheck.compare.engine.crosscheck import crosscheck
+from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
+from gearcheck.compare.presentation.report import write_report
+from gearcheck.compare.studies.sensitivity import field_sensitivity, lattice
+from gearcheck.compare.engine.user_model import user_side
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
-from gearcheck.lumped.loader import load_train, preset_names, read_train_text
+from gearcheck.train.loader import load_train, preset_names, read_train_text
 from gearcheck.lumped.side import LumpedSide
-from gearcheck.lumped.spec import TrainSpec
+from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.errors import GearcheckError
@@ -115,7 +115,7 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
     CampbellResult
         ``frequencies(solver)`` (speeds x modes, Hz), ``crossings`` of mesh harmonics with modes,
         instability ``zones``, ``agreement`` of the two solvers; ``to_dict()``; the figure from
-        :func:`gearcheck.compare.plots.campbell_diagram`.
+        :func:`gearcheck.compare.presentation.plots.campbell_diagram`.
     """
     spec = load(train)
     solvers = tuple(SOLVERS) if solver == "both" else (solver,)
@@ -135,7 +135,7 @@ def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
     ModePairing
         ``mac`` (reference modes x twin modes), ``paired`` (each mode's share in its frequency group's twin
         modes: 1 is the same shape), ``findings`` (swapped, missing, spurious modes), ``to_dict()``; the
-        figure from :func:`gearcheck.compare.plots.mac_heatmap`.
+        figure from :func:`gearcheck.compare.presentation.plots.mac_heatmap`.
     """
     spec = load(train)
     if model is None:
@@ -195,7 +195,7 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
     steady state to the mean, RMS and peak-to-peak of every gated quantity and its amplitude and phase at
     the mesh harmonics, each with an estimate of its integration error (the change on doubling the step),
     beside the lumped model's natural frequencies at that speed
-    (:mod:`gearcheck.compare.sweep`).  Points are cached by a hash of their inputs, so an interrupted sweep
+    (:mod:`gearcheck.compare.studies.sweep`).  Points are cached by a hash of their inputs, so an interrupted sweep
     resumes, and the same inputs give the same table, byte for byte.  Worker processes start fresh (forkserver)
     and never run the calling script again, so a script needs no ``if __name__ == "__main__":`` guard.
 
@@ -243,7 +243,7 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
         ``table`` (pyarrow), ``to_pandas()``, ``summary()``, ``write(directory)`` (``sweep.parquet``,
         ``sweep.json``, order plots or a study plot), ``computed``/``cached`` point counts, ``wall_s``.
     """
-    from gearcheck.compare.sweep import sweep as run_sweep
+    from gearcheck.compare.studies.sweep import sweep as run_sweep
 
     return run_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples, seed=seed,
                      solvers=solver, duration=duration, harmonics=harmonics, integration_check=integration_check,
@@ -276,7 +276,7 @@ def sensitivity(train, parameter: str, method: str = "Fourier series", orders=No
     """d|Q_h|/dp of the steady response of ``train`` (a preset name or a train file) to the number at
     ``parameter`` (``stages[0].crank.eccentricity_mm``), in closed form with its finite-difference check and,
     for the Fourier-series method, the paper's Eq. (15) beside it
-    (:class:`~gearcheck.compare.sensitivity.FieldSensitivity`)."""
+    (:class:`~gearcheck.compare.studies.sensitivity.FieldSensitivity`)."""
     if isinstance(train, TrainSpec):
         raise GearcheckError("sensitivity needs the train file (a preset name or a path), not a loaded TrainSpec: "
                              "it moves a number of the file")

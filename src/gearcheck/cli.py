@@ -22,12 +22,12 @@ from pathlib import Path
 import numpy as np
 
 import gearcheck
-from gearcheck.compare import dashboard, history
-from gearcheck.compare.crosscheck import MODELS
-from gearcheck.compare.junit import write_junit
-from gearcheck.compare.progress import ProgressBar
-from gearcheck.compare.report import write_report
-from gearcheck.compare.summary import summary_row, write_summary
+from gearcheck.compare.presentation import dashboard, history
+from gearcheck.compare.engine.crosscheck import MODELS
+from gearcheck.compare.presentation.junit import write_junit
+from gearcheck.compare.presentation.progress import ProgressBar
+from gearcheck.compare.presentation.report import write_report
+from gearcheck.compare.presentation.summary import summary_row, write_summary
 from gearcheck.lumped.describe import describe
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError
@@ -436,7 +436,7 @@ def cmd_modes(args) -> int:
 
 
 def cmd_campbell(args) -> int:
-    from gearcheck.compare.plots import campbell_diagram
+    from gearcheck.compare.presentation.plots import campbell_diagram
 
     with OutputDirectory(args.out) as place:
         result = gearcheck.campbell(args.train, args.speeds, solver=args.solver, harmonics=args.harmonics)
@@ -453,7 +453,7 @@ def cmd_campbell(args) -> int:
 
 
 def cmd_mac(args) -> int:
-    from gearcheck.compare.plots import mac_heatmap
+    from gearcheck.compare.presentation.plots import mac_heatmap
 
     with OutputDirectory(args.out) as place:
         pairing = gearcheck.mode_pairing(args.train, args.model, args.against)
@@ -468,7 +468,7 @@ def cmd_mac(args) -> int:
 
 
 def cmd_ste(args) -> int:
-    from gearcheck.compare import plots
+    from gearcheck.compare.presentation import plots
     from gearcheck.lumped.transmission_error import relief_sweep, static_transmission_error
 
     if args.slices is not None and not 1 <= args.slices <= 1000:
@@ -510,8 +510,9 @@ def cmd_run(args) -> int:
 
 
 def cmd_sensitivity(args) -> int:
-    from gearcheck.compare import plots, sensitivity
-    from gearcheck.lumped.loader import read_train_text
+    from gearcheck.compare.presentation import plots
+    from gearcheck.compare.studies import sensitivity
+    from gearcheck.train.loader import read_train_text
 
     text, source = read_train_text(args.train)
     spec = gearcheck.load(args.train)
@@ -571,7 +572,7 @@ def _coordinate(spec, name: str) -> int:
 
 
 def cmd_pins(args) -> int:
-    from gearcheck.compare.plots import pin_loads as figure
+    from gearcheck.compare.presentation.plots import pin_loads as figure
     from gearcheck.lumped.assembly import build_model
     from gearcheck.lumped.pin_loads import pin_loads
 
@@ -591,7 +592,7 @@ def cmd_pins(args) -> int:
 
 
 def cmd_stiffness(args) -> int:
-    from gearcheck.compare.plots import mesh_stiffness
+    from gearcheck.compare.presentation.plots import mesh_stiffness
 
     spec = gearcheck.load(args.train)
     path = args.output or Path("out") / f"{spec.name}-stiffness.png"
@@ -602,7 +603,7 @@ def cmd_stiffness(args) -> int:
 
 
 def cmd_animate(args) -> int:
-    from gearcheck.mbd_models.animate import animate, animate_mode, check_output
+    from gearcheck.compare.presentation.animate import animate, animate_mode, check_output
 
     for name in ("fps", "slow_motion", "magnify"):
         value = getattr(args, name)
@@ -628,7 +629,7 @@ def cmd_animate(args) -> int:
 
 
 def cmd_view(args) -> int:
-    from gearcheck.mbd_models.live_view import live_view
+    from gearcheck.compare.presentation.live_view import live_view
 
     live_view(gearcheck.load(args.train), slow_motion=args.slow_motion, magnify=args.magnify)
     return 0
@@ -686,10 +687,10 @@ def cmd_mjcf(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
-    from gearcheck.compare.calibrate import FitParameter, calibrate
-    from gearcheck.compare.calibrate_report import write_calibration
-    from gearcheck.compare.measurements import load_measurements
-    from gearcheck.lumped.loader import read_train_text
+    from gearcheck.compare.studies.calibrate import FitParameter, calibrate
+    from gearcheck.compare.presentation.calibrate_report import write_calibration
+    from gearcheck.compare.engine.measurements import load_measurements
+    from gearcheck.train.loader import read_train_text
 
     text, source = read_train_text(args.train)
     spec = gearcheck.load(args.train)
@@ -711,9 +712,9 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from gearcheck.compare.distributions import read_distributions
-    from gearcheck.compare.sweep import check_quantities, parse_speeds, parse_values
-    from gearcheck.compare.sweep_lines import CONVERGED
+    from gearcheck.compare.studies.distributions import read_distributions
+    from gearcheck.compare.studies.sweep import check_quantities, parse_speeds, parse_values
+    from gearcheck.compare.studies.sweep_lines import CONVERGED
 
     speeds = None if args.speeds is None else parse_speeds(args.speeds)
     fields: dict[str, list[float]] = {}

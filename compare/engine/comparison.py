@@ -1,0 +1,383 @@
+"""The cross-check engine: two models of one train, the reference a and the test b, compared.
+
+Any pair of :class:`~gearcheck.shared.side.Side` objects, read by a comparison plan
+(:mod:`gearcheck.compare.engine.plan`):
+
+1. natural frequencies of both, mode by mode;
+2. time runs of both (each from its own static state, or from rest), each twice: at its step h and,
+   for the integration error, at 2 h (at h / 2 where 2 h would be unstable);
+3. every signal the reference gates and the test has, put on one grid: anti-aliased resampling at
+   the lower of the two output rates (:func:`gearcheck.compare.engine.align.resample`), or the grid the two
+   share, sample by sample;
+4. the window: the steady state (:func:`gearcheck.compare.engine.align.steady_state`: every stage's mesh
+   forces steady over their own cycle, or the free vibration of the start decayed), or the whole
+   record of a transient.  A run too short to reach it is extended once, to at most
+   ``EXTENSION_FACTOR`` times the duration asked for; without a steady state the verdict is
+   INCONCLUSIVE;
+5. per signal, lag-aligned waveform metrics, spectral lines and a verdict against the tolerances;
+   signals negligible in both runs (below ``NEGLIGIBLE`` of the largest of their kind, e.g.
+   central-member translations that mesh phasing cancels, or so small that the plan's round-off
+   floor of a solver is more than the tolerance's share of them) are reported as such and not gated;
+6. per signal and solver, a bound on the integration error: the NRMSE of the run against its
+   step-doubled twin (:func:`integration_error`; the error of an integrator of order p >= 1 in its
+   asymptotic range is at most the change on doubling its step, and RK4's is a fifteenth of it).
+   Default steps are halved (at most ``MAX_REFINEMENTS`` times) until the two solvers' bounds
+   together are within ``TARGET_FRACTION`` of every gated tolerance; a quantity whose bounds reach
+   its tolerance is *unresolved* (the comparison cannot tell at that tolerance, and the verdict is
+   INCONCLUSIVE).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from gearcheck.compare.engine.align import (
+    STEADY_THRESHOLD,
+    STEADY_WINDOW_CYCLES,
+    resample,
+    sensor_filter,
+    steady_state,
+    uniform_grid,
+)
+from gearcheck.compare.engine.metrics import modal_metrics, spectral_metrics, waveform_metrics
+from gearcheck.compare.engine.mode_pairing import pair_modes
+from gearcheck.compare.engine.tolerances import Tolerances
+from gearcheck.shared.errors import SolverError
+from gearcheck.shared.outputs import OutputDirectory
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.side import display_name
+
+NEGLIGIBLE = 1e-6
+TARGET_FRACTION = 0.5  # default steps keep both solvers' integration error bounds within this part of a tolerance
+MAX_REFINEMENTS = 2  # halvings of the default steps to get there
+EXTENSION_FACTOR = 8  # a run is extended to its steady state up to this multiple of the duration asked for
+SIDE_SETTINGS = ("method", "dt_s", "steps", "rotating_frame_terms")  # what the report states of the reference run
+
+
+@dataclass
+class QuantityComparison:
+    name: str
+    kind: str
+    unit: str
+    description: str
+    status: str  # pass | fail | negligible
+    metrics: dict
+    spectrum: list[dict]
+    tolerance: float | None
+    measured: list[dict] = field(default_factory=list)
+
+    @property
+    def error_ratio(self) -> float:
+        """The integration error bound over the tolerance (0 without a tolerance)."""
+        return error_bound(self.metrics) / self.tolerance if self.tolerance else 0.0
+
+
+@dataclass
+class CrosscheckResult:
+    """Everything a cross-check found; :func:`gearcheck.compare.presentation.report.write_report` writes it."""
+
+    spec: object
+    settings: dict
+    modal: list[dict]
+    modal_tolerance: float
+    quantities: list[QuantityComparison]
+    steady_start_s: float
+    steady_found: bool
+    results: tuple  # (reference TimeResult, test TimeResult)
+    modal_results: tuple  # (reference ModalResult, test ModalResult)
+    grid: np.ndarray
+    series: dict  # quantity -> (a, b) on the grid
+    wall_times: dict
+    measurements: list[dict] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # findings stated in plain words in the report
+    references: list[str] = field(default_factory=list)  # keys of gearcheck.shared.citations.REFERENCES
+    moved: list[str] | None = None  # metrics moved from a baseline (None: no baseline checked)
+    steady_how: str | None = None  # detected | decayed | transient | None (no steady state)
+    settle_s: float | None = None  # the reference's free vibration decay time (steady-state runs)
+    solvers: tuple = ("lumped", "mujoco")  # the reference's and the test's names
+    diagnosis: object | None = None  # a user's model: the term of the reference that best explains its modes
+
+    @property
+    def failures(self) -> list[str]:
+        bad = [q.name for q in self.quantities if q.status == "fail"]
+        bad += [f"mode {m['mode']}" for m in self.modal if m["rel_error"] > self.modal_tolerance]
+        return bad
+
+    @property
+    def unresolved(self) -> list[str]:
+        """Why the comparison cannot decide: no steady state, or quantities whose integration error bounds
+        reach their tolerance."""
+        reasons = [] if self.steady_found else ["no steady state"]
+        return reasons + [f"{q.name} (integration error)" for q in self.quantities if q.status == "unresolved"]
+
+    @property
+    def verdict(self) -> str:
+        """FAIL (a tolerance exceeded or a baseline metric moved), INCONCLUSIVE (nothing failed, but the run
+        reached no steady state or a quantity is unresolved) or PASS."""
+        if self.failures or self.moved:
+            return "FAIL"
+        return "INCONCLUSIVE" if self.unresolved else "PASS"
+
+    @property
+    def solver_names(self) -> tuple[str, str]:
+        """The reference's and the test's names as reports write them."""
+        return tuple(display_name(name) for name in self.solvers)
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict == "PASS"
+
+    def __getitem__(self, name: str) -> QuantityComparison:
+        for q in self.quantities:
+            if q.name == name:
+                return q
+        raise KeyError(f"no compared quantity {name!r}")
+
+    def write(self, directory) -> dict:
+        """Write report.json, report.md, report.html and the figures as the folder ``directory``, whole or
+        not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the report's data."""
+        from gearcheck.compare.presentation.report import write_report
+
+        with OutputDirectory(directory, "directory") as place:
+            return write_report(self, place.path)
+
+
+def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSettings], tolerances: Tolerances,
+            sensor_band: tuple[float, float] | None = None, progress=None) -> CrosscheckResult:
+    """Cross-check ``test`` against ``reference`` (two :class:`~gearcheck.shared.side.Side`) as ``plan`` reads
+    them; ``settings`` the two runs' settings (the same duration; each side's own step when ``dt`` is None,
+    and then refined as the integration error requires).
+
+    sensor_band: (low, high) Hz of an accelerometer chain applied to both runs' accelerations.
+    progress: callable(fraction) over the runs.
+    """
+    wall = {}
+    started = time.perf_counter()
+    modes_a = reference.modes()
+    wall["lumped_modes_s"] = time.perf_counter() - started
+    started = time.perf_counter()
+    modes_b = test.modes() if getattr(test, "has_modes", True) else None
+    wall["mujoco_modes_s"] = time.perf_counter() - started
+    modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
+
+    asked = settings[0].duration
+    adjustable = [s.dt is None for s in settings]
+    duration, steps, notes = asked, [s.dt for s in settings], []
+    refinements, extended, best = 0, False, None
+    while True:
+        runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
+        attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress)
+        needed = plan.needed_duration() if plan.detect_steady else None
+        rerunnable = all(getattr(side, "rerunnable", True) for side in (reference, test))
+        reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked and rerunnable
+        if attempt.how is None and not extended and reachable:
+            notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
+                         f"the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s, plus "
+                         f"{STEADY_WINDOW_CYCLES} mesh cycles to compare.")
+            duration, extended = needed, True
+            continue
+        if best is not None and attempt.worst >= best.worst:
+            notes.append(f"Halving the steps did not lower the integration error bound ({best.worst:.2g} -> "
+                         f"{attempt.worst:.2g} of a tolerance: round-off, not truncation); the coarser run is "
+                         "reported.")
+            break
+        best = attempt
+        if attempt.worst > TARGET_FRACTION and refinements < MAX_REFINEMENTS and any(adjustable):
+            steps = [run.info["dt_s"] / 2 if free else dt for run, free, dt in zip(attempt.runs, adjustable, steps)]
+            refinements += 1
+            notes.append(f"Default steps halved ({refinements}x): the two solvers' integration error bounds reached "
+                         f"{attempt.worst:.2g} of a tolerance (target {TARGET_FRACTION:g}).")
+            continue
+        break
+    (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
+    t0, how, comparisons, duration = best.t0, best.how, best.comparisons, a.t[-1]
+    if plan.detect_steady and how is None:
+        notes.append("No steady state in this run" + (
+            f": the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s; run at least "
+            f"{needed:.4g} s (--duration)." if needed is not None else
+            ": the reference model has a mode that does not decay."))
+
+    run_settings = {
+        "duration_s": asked, "simulated_s": duration, **plan.operating,
+        "lumped": {k: a.info[k] for k in SIDE_SETTINGS if k in a.info},
+        "mujoco": {k: v for k, v in b.info.items() if k != "wall_time_s" and _plain(v)},
+        "common_sample_rate_hz": fs, "steady_cycle_s": plan.cycle,
+        "integration_check_steps_s": [c.info["dt_s"] if c is not None else None for c in (a_check, b_check)],
+        "sensor_band_hz": list(sensor_band) if sensor_band else None,
+        "tolerances": dict(sorted(tolerances.values.items())),
+    }
+    references = list(getattr(spec, "references", ())) + list(reference.references) + list(test.references)
+    return CrosscheckResult(spec, run_settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
+                            comparisons, t0, how in ("detected", "decayed", "transient"), (a, b), (modes_a, modes_b),
+                            grid, series, wall, notes=notes, references=list(dict.fromkeys(references)),
+                            steady_how=how, settle_s=plan.settle if plan.detect_steady else None,
+                            solvers=(reference.solver, test.solver))
+
+
+@dataclass
+class _Attempt:
+    """Both sides run at one duration and pair of steps, with their checks, aligned and compared."""
+
+    runs: tuple
+    checks: tuple
+    grid: np.ndarray
+    fs: float
+    series: dict
+    t0: float
+    how: str | None
+    comparisons: list
+
+    @property
+    def worst(self) -> float:
+        """The largest integration error bound over its tolerance among the gated quantities."""
+        return max((q.error_ratio for q in self.comparisons if q.status != "negligible"), default=0.0)
+
+    @classmethod
+    def of(cls, sides, settings, plan, tolerances, sensor_band, wall, progress) -> "_Attempt":
+        (a, a_check), (b, b_check) = _run_pairs(sides, settings, wall, progress)
+        names = [n for n in a.names(compared=True) if n in b]
+        grid, fs, series = _common_grid(a, b, names, plan, sensor_band)
+        t0, how = 0.0, "transient"
+        if plan.detect_steady:
+            groups = [(np.stack([series[n][i] for n in forces], axis=1), cycle)
+                      for forces, cycle in plan.steady_groups(names) for i in (0, 1)]
+            t0, how = steady_state(grid, groups, plan.settle)
+            t0 = 0.5 * grid[-1] if how is None else t0
+        errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a)
+                           for run, check in ((a, a_check), (b, b_check))) for n in names}
+        comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors)
+        return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons)
+
+
+def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
+    """Mode by mode; a test model with fewer modes (fewer coordinates: a torsional model) mode by mode with
+    its partner by shape (:func:`gearcheck.compare.engine.mode_pairing.pair_modes`)."""
+    if len(modes_a) == len(modes_b):
+        return modal_metrics(modes_a.frequencies, modes_b.frequencies, modes_a.types, modes_b.types,
+                             modes_a.multiplicity)
+    if not (hasattr(reference, "physical_modes") and hasattr(test, "physical_modes")):
+        raise SolverError(f"the models have different numbers of modes ({len(modes_a)} {reference.solver}, "
+                          f"{len(modes_b)} {test.solver}) and no mode shapes to pair them by")
+    partner = pair_modes(spec.name, reference, test, (modes_a, modes_b)).mac.argmax(axis=0)
+    return modal_metrics(modes_a.frequencies[partner], modes_b.frequencies, [modes_a.types[i] for i in partner],
+                         modes_b.types, [modes_a.multiplicity[i] for i in partner])
+
+
+def _run_pairs(sides, settings, wall, progress):
+    """Each side's run and its integration check (2 h, or h / 2 where 2 h is beyond its stable step); a
+    recorded side (``rerunnable`` False) has no check."""
+    pairs = []
+    for i, (side, run_settings) in enumerate(zip(sides, settings)):
+        label = ("lumped", "mujoco")[i]
+        # progress over both sides: a run counts 1, its check (at most twice the step) 0.5
+        report = (lambda f, i=i: progress((1.5 * i + f) / 3.0)) if progress else None
+        started = time.perf_counter()
+        run = side.run(run_settings, report)
+        wall[f"{label}_run_s"] = time.perf_counter() - started
+        if not getattr(side, "rerunnable", True):
+            pairs.append((run, None))
+            continue
+        check_dt = check_step(side, run.info["dt_s"])
+        report = (lambda f, i=i: progress((1.5 * i + 1.0 + 0.5 * f) / 3.0)) if progress else None
+        started = time.perf_counter()
+        check = side.run(replace(run_settings, dt=check_dt, output_dt=None), report)
+        wall[f"{label}_check_s"] = time.perf_counter() - started
+        pairs.append((run, check))
+    return pairs
+
+
+def check_step(side, h: float) -> float:
+    """The step of the integration check of ``side``'s run at step ``h``: 2 h, or h / 2 where 2 h is beyond
+    the side's stable step."""
+    return 2 * h if 2 * h <= side.stable_step() else 0.5 * h
+
+
+def _common_grid(a, b, names, plan, sensor_band):
+    if plan.resample:
+        fs = min(_rate(a.t), _rate(b.t))
+        grid = uniform_grid(0.0, min(a.t[-1], b.t[-1]), fs)
+        series = {n: (resample(a.t, a[n], grid), resample(b.t, b[n], grid)) for n in names}
+    else:  # one shared step grid, sample by sample
+        n_t = min(a.t.size, b.t.size)
+        grid, fs = a.t[:n_t], 1.0 / a.info["dt_s"]
+        series = {n: (a[n][:n_t], b[n][:n_t]) for n in names}
+    if sensor_band is not None:
+        low, high = sensor_band
+        if not (0 < low < high < 0.5 * fs):
+            raise SolverError(f"sensor band {low:g}-{high:g} Hz must lie inside (0, {0.5 * fs:.6g}) Hz")
+        for n in names:
+            if a.signal(n).kind in ("acceleration", "angular_acceleration"):
+                series[n] = tuple(sensor_filter(x, fs, sensor_band) for x in series[n])
+    return grid, fs, series
+
+
+def _quantities(a, names, series, window, fs, plan, tolerances, errors) -> list[QuantityComparison]:
+    scale: dict[str, float] = {}
+    for n in names:
+        kind = a.signal(n).kind
+        rms = max(float(np.sqrt(np.mean(x[window] ** 2))) for x in series[n])
+        scale[kind] = max(scale.get(kind, 0.0), rms)
+        for other, factor in plan.scale_from(n):
+            scale[other] = max(scale.get(other, 0.0), rms * factor)
+    comparisons = []
+    for n in names:
+        s = a.signal(n)
+        xa, xb = series[n][0][window], series[n][1][window]
+        metrics = waveform_metrics(xa, xb, fs, max_lag=plan.max_lag(n))
+        metrics["integration_error"] = {"reference": errors[n][0], "test": errors[n][1]}
+        lines = [(label, f) for label, f in plan.lines(n, xa.size / fs) if f < 0.45 * fs]
+        tol = tolerances.lookup(n, s.kind, "nrmse")
+        floor = plan.floors.get(s.kind, 0.0) / (tol or 1.0)  # round-off a tolerance's share of the signal
+        status = verdict(metrics, tol, max(NEGLIGIBLE * scale[s.kind], floor) / NEGLIGIBLE)
+        comparisons.append(QuantityComparison(n, s.kind, s.unit, s.description, status, metrics,
+                                              spectral_metrics(xa, xb, fs, lines), tol))
+    return comparisons
+
+
+def integration_error(run, check, name: str, start: float, reference) -> float | None:
+    """A bound on ``run``'s integration error in ``name`` over t >= ``start``, relative to the RMS of the
+    ``reference`` run's signal there (the denominator of the cross-check's NRMSE): rms(x_h - x_2h) when
+    ``check`` took twice the step, 2 rms(x_h - x_h/2) when it took half (each from samples at the same
+    times).  For an integrator of order p >= 1 in its asymptotic range the error of x_h is
+    rms(x_2h - x_h) / (2^p - 1) at most that."""
+    ratio = check.info["dt_s"] / run.info["dt_s"]
+    coarse, fine, factor = (check, run, 1.0) if ratio > 1 else (run, check, 2.0)
+    k = round(coarse.info["dt_s"] / fine.info["dt_s"])
+    fine_t = fine.t[::k]
+    n = min(fine_t.size, coarse.t.size)
+    window = coarse.t[:n] >= start
+    x_ref = reference[name][reference.t >= start]
+    scale = float(np.sqrt(np.mean(x_ref**2))) if x_ref.size else 0.0
+    if scale == 0.0 or not np.any(window):
+        return None
+    diff = coarse[name][:n][window] - fine[name][::k][:n][window]
+    return factor * float(np.sqrt(np.mean(diff**2))) / scale
+
+
+def verdict(metrics: dict, tolerance: float | None, scale: float) -> str:
+    """negligible (below NEGLIGIBLE x the largest of its kind in both solvers); unresolved (the two
+    solvers' integration error bounds together reach the tolerance); else pass or fail on NRMSE."""
+    if max(metrics["reference"]["rms"], metrics["test"]["rms"]) < NEGLIGIBLE * scale:
+        return "negligible"
+    if tolerance is not None and error_bound(metrics) >= tolerance:
+        return "unresolved"
+    if tolerance is None or (metrics["nrmse"] is not None and metrics["nrmse"] <= tolerance):
+        return "pass"
+    return "fail"
+
+
+def error_bound(metrics: dict) -> float:
+    """The two solvers' integration error bounds together (what integration alone could put into the NRMSE)."""
+    errors = metrics.get("integration_error") or {}
+    return sum(e for e in errors.values() if e is not None)
+
+
+def _plain(value) -> bool:
+    return isinstance(value, (int, float, str, bool)) or value is None
+
+
+def _rate(t: np.ndarray) -> float:
+    return (t.size - 1) / (t[-1] - t[0])

@@ -1,0 +1,596 @@
+"""Cross-check reports: ``report.json`` (versioned schema), ``report.md``, ``report.html`` and PNGs.
+
+Everything that changes from run to run for the same inputs (the timestamp and the wall
+times) lives in one place: the ``volatile`` field of the JSON and the single ``Run:``
+line of the Markdown and HTML.  Everything else is identical byte for byte.
+
+JSON schema ``gearcheck.crosscheck`` version 1: every number that has a unit is an object
+``{"value": x, "unit": "..."}``; dimensionless ratios carry unit ``"1"``.  :func:`report_schema` is that
+schema in JSON Schema (draft 2020-12); :func:`gearcheck.compare.presentation.junit.write_schemas` writes it with the
+train file's (the repository ships them in ``schemas/``).
+
+A report is read at a glance: a verdict banner with the count of every status, failing rows first in
+every table, every spectral line flagged against its quantity's tolerance (advisory), and the measured
+values explained in plain sentences (is the train calibrated; is it the model or the solvers that miss).
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import hashlib
+import html
+import json
+import math
+import platform
+import re
+import subprocess
+from importlib import metadata
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from gearcheck.compare.engine.align import STEADY_THRESHOLD
+from gearcheck.compare.engine.diagnosis import KINDS
+from gearcheck.train.json_schema import DRAFT
+from gearcheck.train.loader import preset_text
+from gearcheck.train.schema import MEASUREMENT
+from gearcheck.shared.citations import cite
+from gearcheck.shared.side import display_name
+
+SCHEMA = "gearcheck.crosscheck"
+SCHEMA_VERSION = 1
+RATIO = "1"
+STATUSES = ("fail", "unresolved", "pass", "negligible")  # the order of every table's rows
+STATUS_WORDS = {"fail": "fail", "unresolved": "inconclusive (unresolved)", "pass": "pass",
+                "negligible": "not gated (negligible)"}
+# A measured value is missed by a model when its error is beyond twice the relative standard uncertainty a
+# train file's [[measurements]] entry has by default (a 95 % band).
+MISS = 2 * MEASUREMENT.fields["uncertainty"].default
+# The header `gearcheck calibrate` writes on a calibrated train file (gearcheck.compare.studies.calibrate)
+CALIBRATED = re.compile(r"# Calibrated by `gearcheck calibrate` from (.+?): (.+)\.\n")
+# Where a preset's calibrated comparison with its measurements lives (gearcheck's repository)
+CALIBRATED_COMPARISONS = {
+    "hub-drive": "docs/hub-drive-calibration/ in gearcheck's repository (the stage I transmission error and the "
+                 "drag fitted at 606 rpm, 1823 rpm predicted, both solvers reading the calibrated train file)",
+}
+
+
+def _u(value, unit):
+    return None if value is None else {"value": value, "unit": unit}
+
+
+def git_revision() -> str | None:
+    try:
+        run = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                             cwd=Path(__file__).parent, timeout=5)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return run.stdout.strip() or None if run.returncode == 0 else None
+
+
+def provenance(result) -> dict:
+    try:
+        version = metadata.version("gearcheck")
+    except metadata.PackageNotFoundError:  # pragma: no cover - running from a bare checkout
+        version = "unknown"
+    return {
+        "gearcheck_version": version, "git_revision": git_revision(), "mujoco_version": mujoco.__version__,
+        "numpy_version": np.__version__, "python": platform.python_version(),
+        "machine": f"{platform.system()} {platform.machine()}",
+        "lumped_solver": result.settings["lumped"], "mujoco_solver": result.settings["mujoco"],
+        "train_file": result.spec.path, "train_sha256": result.spec.text_hash,
+    }
+
+
+def calibration(spec) -> dict | None:
+    """``{"from", "fitted"}`` when the train file is one ``gearcheck calibrate`` wrote (its header), else None
+    (the file's own parameters; also when the file can no longer be read as the run read it)."""
+    name = spec.path.removeprefix("preset:")
+    try:
+        text = preset_text(name) if spec.path.startswith("preset:") else Path(spec.path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    if hashlib.sha256(text.encode("utf-8")).hexdigest() != spec.text_hash:
+        return None
+    match = CALIBRATED.match(text)
+    return None if match is None else {"from": match[1], "fitted": match[2].split(", ")}
+
+
+def line_status(rel_error: float | None, quantity_status: str, tolerance: float | None) -> str:
+    """A spectral line's flag: ``negligible`` with its quantity (or without a reference amplitude), ``fail``
+    when |relative error| exceeds the quantity's NRMSE tolerance, else ``pass``.  Advisory: the verdict gates
+    the waveform (NRMSE), to which a line contributes only its share."""
+    if quantity_status == "negligible" or rel_error is None:
+        return "negligible"
+    return "fail" if tolerance is not None and abs(rel_error) > tolerance else "pass"
+
+
+def _count(statuses, keys) -> dict[str, int]:
+    statuses = list(statuses)
+    return {k: statuses.count(k) for k in keys}
+
+
+def to_dict(result) -> dict:
+    spec = result.spec
+    stats_units = lambda q, s: {k: _u(v, q.unit) for k, v in s.items()}  # noqa: E731
+    quantities = []
+    for q in result.quantities:
+        m = q.metrics
+        rms = m["reference"]["rms"]
+        quantities.append({
+            "name": q.name, "kind": q.kind, "unit": q.unit, "description": q.description, "status": q.status,
+            "tolerance_nrmse": _u(q.tolerance, RATIO),
+            "lumped": stats_units(q, m["reference"]), "mujoco": stats_units(q, m["test"]),
+            "errors": {"rel_rms": _u(m["rel_rms"], RATIO), "rel_peak_to_peak": _u(m["rel_peak_to_peak"], RATIO),
+                       "rel_peak": _u(m["rel_peak"], RATIO), "nrmse": _u(m["nrmse"], RATIO),
+                       "nrmse_ac": _u(m["nrmse_ac"], RATIO), "correlation": _u(m["correlation"], RATIO),
+                       "lag": _u(m["lag_s"], "s")},
+            "integration_error": {"lumped": _u(m["integration_error"]["reference"], RATIO),
+                                  "mujoco": _u(m["integration_error"]["test"], RATIO)},
+            "spectrum": [{"line": s["line"], "frequency": _u(s["frequency_hz"], "Hz"),
+                          "lumped": _u(s["reference"], q.unit), "mujoco": _u(s["test"], q.unit),
+                          "rel_error": _u(s["rel_error"], RATIO),
+                          "nrmse_part": _u(abs(s["test"] - s["reference"]) / (math.sqrt(2) * rms) if rms else None,
+                                           RATIO),
+                          "status": line_status(s["rel_error"], q.status, q.tolerance)} for s in q.spectrum],
+            "measured": q.measured,
+        })
+    modes = [{"mode": r["mode"], "type": r["type"], "multiplicity": r["multiplicity"],
+              "lumped": _u(r["reference_hz"], "Hz"), "mujoco": _u(r["test_hz"], "Hz"),
+              "mujoco_type": r["test_type"], "rel_error": _u(r["rel_error"], RATIO),
+              "status": "pass" if r["rel_error"] <= result.modal_tolerance else "fail"} for r in result.modal]
+    counts = {"quantities": _count((q["status"] for q in quantities), STATUSES),
+              "modes": _count((m["status"] for m in modes), ("fail", "pass")),
+              "spectral_lines": _count((s["status"] for q in quantities for s in q["spectrum"]),
+                                       ("fail", "pass", "negligible"))}
+    return {
+        "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
+        "train": {"name": spec.name, "description": spec.description, "source": spec.source},
+        "calibration": calibration(spec),
+        "provenance": provenance(result),
+        "settings": _settings_with_units(result.settings),
+        "verdict": {"verdict": result.verdict, "passed": result.passed, "failures": result.failures,
+                    "unresolved": result.unresolved, "moved_from_baseline": result.moved, "counts": counts},
+        "steady_state": {"start": _u(result.steady_start_s, "s"), "detected": result.steady_found,
+                         "how": result.steady_how, "settling_time": _u(result.settle_s, "s")},
+        "modes": modes,
+        "modes_tolerance": _u(result.modal_tolerance, RATIO),
+        "solvers": {"reference": result.solvers[0], "test": result.solvers[1]},
+        "diagnosis": result.diagnosis.to_dict() if result.diagnosis is not None else None,
+        "quantities": quantities,
+        "measurements": result.measurements,
+        "notes": result.notes,
+        "references": cite(result.references),
+        "volatile": {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+                     "wall_time": {k: _u(v, "s") for k, v in result.wall_times.items()}},
+    }
+
+
+SETTING_UNITS = {"duration_s": ("duration", "s"), "simulated_s": ("simulated", "s"),
+                 "input_speed_rpm": ("input_speed", "rpm"), "output_torque_nm": ("output_torque", "N·m"),
+                 "common_sample_rate_hz": ("common_sample_rate", "Hz"), "sensor_band_hz": ("sensor_band", "Hz"),
+                 "steady_cycle_s": ("steady_cycle", "s"), "integration_check_steps_s": ("integration_check_steps", "s")}
+
+
+def _settings_with_units(settings: dict) -> dict:
+    out = {}
+    for key, value in settings.items():
+        if key in SETTING_UNITS:
+            name, unit = SETTING_UNITS[key]
+            out[name] = _u(value, unit)
+        elif key == "tolerances":
+            out[key] = {k: _u(v, RATIO) for k, v in value.items()}
+        else:
+            out[key] = value
+    return out
+
+
+# ------------------------------------------------------------------------------ Markdown
+def _fmt(x, digits=4) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, str):
+        return x
+    if x == 0:
+        return "0"
+    return f"{x:.{digits}g}"
+
+
+def _run_line(data) -> str:
+    wall = ", ".join(f"{k.replace('_s', '')} {v['value']:.3g} s" for k, v in data["volatile"]["wall_time"].items())
+    return f"Run: {data['volatile']['timestamp']}; wall times: {wall}"
+
+
+def solver_names(data) -> tuple[str, str]:
+    """How the report names the reference (a) and the test (b): the built-in solvers as "lumped" and "MuJoCo",
+    a user's model by its own name."""
+    names = data.get("solvers", {"reference": "lumped", "test": "mujoco"})
+    return tuple(display_name(names[k]) for k in ("reference", "test"))
+
+
+def failing_first(rows: list[list[str]]) -> list[list[str]]:
+    """Rows whose last cell is a status: fail, then unresolved, pass, negligible; stable otherwise."""
+    return sorted(rows, key=lambda r: STATUSES.index(r[-1]) if r[-1] in STATUSES else len(STATUSES))
+
+
+def _counts_text(counts: dict[str, int]) -> str:
+    return ", ".join(f"{n} {STATUS_WORDS[k]}" for k, n in counts.items())
+
+
+def banner(data) -> tuple[str, str, list[str]]:
+    """(verdict, the counts in one line, the reasons: what failed, moved or cannot be decided)."""
+    v, counts = data["verdict"], data["verdict"]["counts"]
+    lines = counts["spectral_lines"]
+    parts = [f"quantities: {_counts_text(counts['quantities'])}"]
+    if data["modes"]:
+        parts.append(f"modes: {_counts_text(counts['modes'])}")
+    parts.append(f"spectral lines beyond tolerance (advisory): {lines['fail']} of {lines['fail'] + lines['pass']}")
+    reasons = []
+    if v["failures"]:
+        reasons.append("Beyond tolerance: " + ", ".join(v["failures"]))
+    if v["moved_from_baseline"]:
+        reasons.append("Moved from the baseline: " + "; ".join(v["moved_from_baseline"]))
+    if v["unresolved"]:
+        reasons.append("Cannot decide: " + ", ".join(v["unresolved"]))
+    return v["verdict"], "; ".join(parts), reasons
+
+
+LINE_RULE = ("A line is flagged fail when its relative amplitude error exceeds its quantity's NRMSE tolerance. "
+             "The flags are advisory and leave the verdict alone: the verdict gates the whole waveform (NRMSE), "
+             "to which a line contributes at least |A_b − A_a|/(√2 RMS_a) (column 'NRMSE part'), so a large "
+             "relative error on a line that carries little of the signal does not fail its quantity. The table "
+             "lists the world-y accelerations and the forces; report.json holds every quantity's lines.")
+
+
+def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], list[str]]]:
+    """(title, header, rows, notes) of every table, failing rows first, shared by the Markdown and HTML writers."""
+    A, B = solver_names(data)
+    tables = []
+    if data["modes"]:  # a recording without a modes file has none
+        tables.append(("Natural frequencies", ["mode", "type", "mult.", f"{A} [Hz]", f"{B} [Hz]", "rel. diff.",
+                                               "tol.", "status"],
+                       [[str(m["mode"]), m["type"], str(m["multiplicity"]), f"{m['lumped']['value']:.6f}",
+                         f"{m['mujoco']['value']:.6f}", f"{m['rel_error']['value']:.2e}",
+                         f"{data['modes_tolerance']['value']:.0e}", m["status"]] for m in data["modes"]], []))
+    rows = []
+    for q in data["quantities"]:
+        e, ie = q["errors"], q["integration_error"]
+        rows.append([q["name"], q["unit"], _fmt(q["lumped"]["rms"]["value"]), _fmt(q["mujoco"]["rms"]["value"]),
+                     _fmt(q["lumped"]["peak_to_peak"]["value"]), _fmt(q["mujoco"]["peak_to_peak"]["value"]),
+                     _fmt(e["rel_rms"] and e["rel_rms"]["value"], 3), _fmt(e["nrmse"] and e["nrmse"]["value"], 3),
+                     _fmt(e["correlation"] and e["correlation"]["value"], 6), _fmt(e["lag"]["value"] * 1e6, 3),
+                     _fmt(ie["lumped"] and ie["lumped"]["value"], 2), _fmt(ie["mujoco"] and ie["mujoco"]["value"], 2),
+                     _fmt(q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"], 3), q["status"]])
+    tables.append(("Time-domain quantities (steady window)",
+                   ["quantity", "unit", f"RMS {A}", f"RMS {B}", f"p-p {A}", f"p-p {B}", "rel. RMS err.",
+                    "NRMSE", "correlation", "lag [µs]", f"integr. err. {A}", f"integr. err. {B}", "tol. NRMSE",
+                    "status"], rows, []))
+    rows = []
+    for q in data["quantities"]:
+        if q["name"].endswith(".ay.world") or q["name"].endswith(".force"):
+            tol = _fmt(q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"], 3)
+            for s in q["spectrum"]:
+                rows.append([q["name"], s["line"], f"{s['frequency']['value']:.6g}", _fmt(s["lumped"]["value"]),
+                             _fmt(s["mujoco"]["value"]), _fmt(s["rel_error"] and s["rel_error"]["value"], 3),
+                             _fmt(s["nrmse_part"] and s["nrmse_part"]["value"], 2), tol, s["status"]])
+    tables.append(("Spectral lines (Hann-windowed amplitude)",
+                   ["quantity", "line", "f [Hz]", A, B, "rel. err.", "NRMSE part", "tol.", "status"], rows,
+                   [LINE_RULE]))
+    if data["measurements"]:
+        def value(x, digits=4):
+            return _fmt(x and x["value"], digits)
+
+        tables.append(("Measured reference values",
+                       ["quantity", "metric", "chain band [Hz]", "measured", "published model", A, B,
+                        "err. published", f"err. {A}", f"err. {B}", "source"],
+                       [[m["quantity"], m["metric"], "—" if m["sensor_band"] is None else
+                         "–".join(f"{f:g}" for f in m["sensor_band"]["value"]), value(m["measured"]),
+                         value(m["published_model"]), value(m["lumped"]), value(m["mujoco"]),
+                         value(m["error_published_model"], 3), value(m["error_lumped"], 3), value(m["error_mujoco"], 3),
+                         m["source"]] for m in data["measurements"]],
+                       measurement_notes(data)))
+    return [(title, header, failing_first(rows), note) for title, header, rows, note in tables]
+
+
+def _percent(x: float) -> str:
+    return f"{100 * x:+.1f} %"
+
+
+def measurement_notes(data) -> list[str]:
+    """Plain sentences on the measured values: whose parameters the model has (the train file's own or a
+    calibrated file), where the calibrated comparison lives, and, row by row, whether it is the model or the
+    solvers that miss."""
+    A, B = solver_names(data)
+    name, cal, train_file = data["train"]["name"], data["calibration"], data["provenance"]["train_file"]
+    reading = ("Each row reads both solvers through the measuring chain's band and takes the test's statistic over "
+               "the steady window.")
+    if cal is None:
+        where = CALIBRATED_COMPARISONS.get(name)
+        notes = [f"{reading} These rows compare the train file's own parameters ({train_file}), which are not "
+                 "calibrated to these measurements, with the test."
+                 + (f" The calibrated comparison: {where}." if where else
+                    f" `gearcheck calibrate {train_file.removeprefix('preset:')} --fit FIELD=LOW:HIGH` fits "
+                    "chosen fields of the train file to them.")]
+    else:
+        notes = [f"{reading} The train file was calibrated to measurements by `gearcheck calibrate` from "
+                 f"{cal['from']} ({', '.join(cal['fitted'])})."]
+    tolerance = {q["name"]: q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"] for q in data["quantities"]}
+    for m in data["measurements"]:
+        what = f"{m['quantity']} {m['metric']}"
+        a, b, measured = m["lumped"]["value"], m["mujoco"]["value"], m["measured"]["value"]
+        ea, eb = m["error_lumped"]["value"], m["error_mujoco"]["value"]
+        apart = abs(b - a) / abs(a) if a else math.inf
+        tol = tolerance.get(m["quantity"]) or 0.0
+        if apart > tol:
+            notes.append(f"{what}: {A} and {B} differ from each other by {100 * apart:.3g} % (beyond the quantity's "
+                         f"tolerance of {100 * tol:g} %): read the quantity's row before the measurement.")
+        elif abs(ea) > MISS and abs(eb) > MISS and ea * eb > 0:
+            published = m["error_published_model"]
+            notes.append(f"{what}: both solvers miss the test by the same amount ({A} {_percent(ea)}, {B} "
+                         f"{_percent(eb)}; they agree with each other to {100 * apart:.2g} %): it is the model, "
+                         "its parameters, not the solvers, that disagrees with the test"
+                         + (f" (the source's own model: {_percent(published['value'])})." if published else "."))
+        else:
+            notes.append(f"{what}: {A} {_percent(ea)}, {B} {_percent(eb)} from the measured {measured:.4g} "
+                         f"{m['measured']['unit']}" + (f", within twice the default measurement uncertainty "
+                                                       f"({100 * MISS:g} %)." if max(abs(ea), abs(eb)) <= MISS
+                                                       else "."))
+    return notes
+
+
+UNIT_SUFFIXES = (("_rad_s", "rad/s"), ("_s", "s"), ("_hz", "Hz"))
+
+
+def _settings_line(settings: dict) -> str:
+    parts = []
+    for key, value in settings.items():
+        unit = ""
+        for suffix, name in UNIT_SUFFIXES:
+            if key.endswith(suffix):
+                key, unit = key[: -len(suffix)], f" {name}"
+                break
+        shown = _fmt(value, 6) if isinstance(value, float) else value
+        parts.append(f"{key.replace('_', ' ')} {shown}{unit}")
+    return ", ".join(parts)
+
+
+def _summary_lines(data) -> list[str]:
+    s = data["settings"]
+    steady = data["steady_state"]
+    how = {"detected": "detected: the mesh forces repeat cycle after cycle",
+           "decayed": f"the free vibration of the start decayed to {STEADY_THRESHOLD:g}",
+           "transient": "the whole transient",
+           None: "NO steady state: second half shown, verdict inconclusive"}[steady["how"]]
+    steps = [f"{x:.4g} s" if x is not None else "none: a recording" for x in s["integration_check_steps"]["value"]]
+    p = data["provenance"]
+    A, B = solver_names(data)
+    return [
+        f"Train: {data['train']['name']} — {data['train']['description']} ({data['train']['source']})",
+        f"Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
+        f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})",
+        f"Reference ({A}): {_settings_line(s['lumped'])}",
+        f"Test ({B}): {_settings_line(s['mujoco'])}",
+        f"gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "
+        f"NumPy {p['numpy_version']}, Python {p['python']}, {p['machine']}; train {p['train_file']} "
+        f"sha256 {p['train_sha256'][:16]}…",
+        f"Metrics: NRMSE = rms(b − a)/rms(a) after removing the lag; {A} = a (reference), {B} = b; "
+        "'negligible' = below 1e-6 of the largest quantity of its kind in both solvers (not gated).",
+        "Integration error: a bound per solver, rms(x_h − x_2h)/rms(a) against the same run at twice the step "
+        f"(check steps {', '.join(steps)}; an order-p integrator's error is at most that, RK4's "
+        "a fifteenth of it); 'unresolved' = the two bounds together reach the tolerance.",
+    ]
+
+
+def write_markdown(data, path: Path, figures: list[str]) -> None:
+    verdict, counts, reasons = banner(data)
+    lines = [f"# gearcheck cross-check: {data['train']['name']}", "", f"Verdict: **{verdict}** — {counts}", ""]
+    if reasons or "failing.png" in figures:
+        lines += [f"{r}." for r in reasons]
+        lines += ["Failing quantities plotted: [failing.png](failing.png)."] if "failing.png" in figures else []
+        lines.append("")
+    lines += [f"- {line}" for line in _summary_lines(data)]
+    lines += ["", _run_line(data), ""]
+    if data["notes"]:
+        lines += ["## Findings", ""] + [f"{note}\n" for note in data["notes"]]
+    for title, header, rows, notes in markdown_tables(data):
+        lines += [f"## {title}", ""] + [f"{note}\n" for note in notes]
+        lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        lines += ["| " + " | ".join(r) + " |" for r in rows]
+        lines.append("")
+    lines += ["## Figures", ""] + [f"![{f}]({f})" for f in figures] + [""]
+    lines += ["## References", ""] + [f"- [{r['key']}] {r['citation']}" for r in data["references"]] + [""]
+    path.write_text("\n".join(lines), encoding="utf-8")
+
+
+OPEN_ROWS = 12  # a table longer than this, with nothing failing or unresolved in it, starts folded in the HTML
+
+STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+         "table{border-collapse:collapse;font-size:0.85em;margin-bottom:1.5em}"
+         "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}th{background:#eee}"
+         "td:first-child{text-align:left}.fail{background:#fdd}.pass{background:#dfd}.unresolved{background:#ffd}"
+         ".negligible{color:#777}summary{font-size:1.2em;font-weight:bold;margin:0.8em 0;cursor:pointer}"
+         ".banner{padding:0.8em 1.2em;border-radius:6px;color:#fff;margin:1em 0}"
+         ".banner .verdict{font-size:2em;font-weight:bold;margin-right:0.6em}.banner p{margin:0.4em 0 0}"
+         ".banner a{color:#fff}.PASS{background:#2e7d32}.FAIL{background:#c62828}"
+         ".INCONCLUSIVE{background:#e08a00}img{max-width:100%}")
+
+
+def write_html(data, path: Path, figure_paths: list[Path]) -> None:
+    esc = html.escape
+    parts = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
+             f"<title>gearcheck cross-check: {esc(data['train']['name'])}</title>",
+             f"<style>{STYLE}</style></head><body>",
+             f"<h1>gearcheck cross-check: {esc(data['train']['name'])}</h1>"]
+    verdict, counts, reasons = banner(data)
+    names = [fig.name for fig in figure_paths]
+    parts.append(f"<div class=\"banner {verdict}\"><span class=\"verdict\">{verdict}</span>{esc(counts)}"
+                 + "".join(f"<p>{esc(r)}.</p>" for r in reasons)
+                 + ("<p><a href=\"#failing.png\">Failing quantities plotted</a>.</p>" if "failing.png" in names
+                    else "") + "</div>")
+    parts.append("<ul>" + "".join(f"<li>{esc(line)}</li>" for line in _summary_lines(data)) + "</ul>")
+    parts.append(f"<p>{esc(_run_line(data))}</p>")
+    if data["notes"]:
+        parts.append("<h2>Findings</h2>" + "".join(f"<p>{esc(note)}</p>" for note in data["notes"]))
+    for title, header, rows, notes in markdown_tables(data):
+        statuses = [r[-1] for r in rows if r[-1] in STATUSES]
+        folded = len(rows) > OPEN_ROWS and not {"fail", "unresolved"} & set(statuses)
+        tally = _counts_text({k: statuses.count(k) for k in STATUSES if k in statuses})
+        parts.append(f"<details{'' if folded else ' open'}><summary>{esc(title)}"
+                     + (f" — {esc(tally)}" if tally else "") + "</summary>"
+                     + "".join(f"<p>{esc(note)}</p>" for note in notes)
+                     + "<table><tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>")
+        for r in rows:
+            cls = f" class=\"{r[-1]}\"" if r[-1] in STATUSES else ""
+            parts.append(f"<tr{cls}>" + "".join(f"<td>{esc(c)}</td>" for c in r) + "</tr>")
+        parts.append("</table></details>")
+    parts.append("<h2>Figures</h2>")
+    for fig in figure_paths:
+        encoded = base64.b64encode(fig.read_bytes()).decode("ascii")
+        parts.append(f"<figure id=\"{esc(fig.name)}\"><img alt=\"{esc(fig.name)}\" "
+                     f"src=\"data:image/png;base64,{encoded}\"><figcaption>{esc(fig.name)}</figcaption></figure>")
+    parts.append("<h2>References</h2><ul>" + "".join(f"<li>[{esc(r['key'])}] {esc(r['citation'])}</li>"
+                                                     for r in data["references"]) + "</ul>")
+    parts.append("</body></html>\n")
+    path.write_text("\n".join(parts), encoding="utf-8")
+
+
+def write_report(result, directory) -> dict:
+    """Write report.json, report.md, report.html and the PNG figures into the folder ``directory`` (made if
+    missing); return the JSON dict.  :meth:`CrosscheckResult.write` writes them whole or not at all."""
+    from gearcheck.compare.presentation.plots import FIGURES  # matplotlib only when a report is written
+
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    data = to_dict(result)
+    figures = []
+    for name, draw in FIGURES.items():
+        if draw(result, out / name) is not False:  # False: nothing to draw (no modes, nothing failing)
+            figures.append(name)
+    (out / "report.json").write_text(json.dumps(data, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+    write_markdown(data, out / "report.md", figures)
+    write_html(data, out / "report.html", [out / f for f in figures])
+    return data
+
+
+# ------------------------------------------------------------------------------ JSON Schema of report.json
+def _value(unit: str | None = None, value: dict | None = None, nullable: bool = False) -> dict:
+    """A ``{"value", "unit"}`` object (``unit`` fixed when given), or null when ``nullable``."""
+    schema = {"type": "object", "properties": {"value": value or {"type": "number"},
+                                               "unit": {"const": unit} if unit else {"type": "string"}},
+              "required": ["value", "unit"], "additionalProperties": False}
+    return {"anyOf": [schema, {"type": "null"}]} if nullable else schema
+
+
+def _object(properties: dict, required=None, closed: bool = True, description: str | None = None) -> dict:
+    out = {"type": "object"} | ({"description": description} if description else {})
+    out |= {"properties": properties, "required": list(properties) if required is None else required}
+    return out | ({"additionalProperties": False} if closed else {})
+
+
+def _array(items: dict, description: str | None = None) -> dict:
+    return {"type": "array"} | ({"description": description} if description else {}) | {"items": items}
+
+
+STRING, NUMBER, BOOLEAN = {"type": "string"}, {"type": "number"}, {"type": "boolean"}
+NULLABLE_STRING, NULLABLE_NUMBER = {"type": ["string", "null"]}, {"type": ["number", "null"]}
+
+
+def report_schema() -> dict:
+    """The JSON Schema (draft 2020-12) of ``report.json``, schema ``gearcheck.crosscheck`` version 1, as
+    :func:`to_dict` writes it."""
+    ratio, ratio_or_null = _value(RATIO), _value(RATIO, nullable=True)
+    stats = _object({k: {"$ref": "#/$defs/value"} for k in ("mean", "rms", "peak_to_peak", "peak")})
+    measurement = _object({
+        "quantity": STRING, "metric": {"enum": list(MEASUREMENT.fields["metric"].choices)}, "source": STRING,
+        "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
+        "measured": {"$ref": "#/$defs/value"}, "lumped": {"$ref": "#/$defs/value"},
+        "mujoco": {"$ref": "#/$defs/value"}, "published_model": _value(nullable=True),
+        "error_lumped": ratio, "error_mujoco": ratio, "error_published_model": ratio_or_null,
+    }, description="a measured value beside both solvers' statistic of it; errors (model - measured)/|measured|")
+    candidate = _object({
+        "term": STRING, "kind": {"enum": list(KINDS)}, "score": NUMBER,
+        "parts": {"type": "object", "additionalProperties": NUMBER}, "row": STRING, "coordinate": STRING,
+        "member": STRING, "factor": NUMBER, "coordinates": _array(STRING),
+        "equivalents": _array({"$ref": "#/$defs/candidate"}),
+    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference")
+    quantity = _object({
+        "name": STRING, "kind": STRING, "unit": STRING, "description": STRING,
+        "status": {"enum": list(STATUSES)}, "tolerance_nrmse": ratio_or_null,
+        "lumped": stats, "mujoco": stats,
+        "errors": _object({"rel_rms": ratio_or_null, "rel_peak_to_peak": ratio_or_null, "rel_peak": ratio_or_null,
+                           "nrmse": ratio_or_null, "nrmse_ac": ratio_or_null, "correlation": ratio_or_null,
+                           "lag": _value("s")}),
+        "integration_error": _object({"lumped": ratio_or_null, "mujoco": ratio_or_null}),
+        "spectrum": _array(_object({
+            "line": STRING, "frequency": _value("Hz"), "lumped": {"$ref": "#/$defs/value"},
+            "mujoco": {"$ref": "#/$defs/value"}, "rel_error": ratio_or_null,
+            "nrmse_part": ratio_or_null, "status": {"enum": ["fail", "pass", "negligible"]},
+        }), "spectral lines; status advisory: fail when |rel_error| exceeds the quantity's NRMSE tolerance"),
+        "measured": _array({"$ref": "#/$defs/measurement"}),
+    }, description="one compared signal: 'lumped' is the reference (a), 'mujoco' the test (b) whatever solvers")
+    counts = lambda keys: _object({k: {"type": "integer", "minimum": 0} for k in keys})  # noqa: E731
+    seconds = _value("s")
+    return {
+        "$schema": DRAFT,
+        "title": f"gearcheck cross-check report ({SCHEMA} version {SCHEMA_VERSION})",
+        "description": "report.json of `gearcheck crosscheck`. Numbers with a unit are {value, unit} objects; "
+                       "ratios have unit '1'. 'lumped' and 'mujoco' name the reference and the test side, whatever "
+                       "their solvers ('solvers'). Only 'volatile' changes between runs of the same inputs.",
+        "type": "object",
+        "properties": {
+            "schema": {"const": SCHEMA}, "schema_version": {"const": SCHEMA_VERSION},
+            "train": _object({"name": STRING, "description": STRING, "source": STRING}),
+            "calibration": {"anyOf": [_object({"from": STRING, "fitted": _array(STRING)}), {"type": "null"}],
+                            "description": "the calibrated train file's origin and fitted fields (its header), "
+                                           "null for a train file's own parameters"},
+            "provenance": _object({
+                "gearcheck_version": STRING, "git_revision": NULLABLE_STRING, "mujoco_version": STRING,
+                "numpy_version": STRING, "python": STRING, "machine": STRING, "lumped_solver": {"type": "object"},
+                "mujoco_solver": {"type": "object"}, "train_file": STRING, "train_sha256": STRING}),
+            "settings": _object({
+                "duration": seconds, "simulated": seconds, "input_speed": _value("rpm"),
+                "output_torque": _value("N·m"), "lumped": {"type": "object"}, "mujoco": {"type": "object"},
+                "common_sample_rate": _value("Hz"), "steady_cycle": seconds,
+                "integration_check_steps": _value("s", {"type": "array", "items": NULLABLE_NUMBER}),
+                "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
+                "tolerances": {"type": "object", "additionalProperties": ratio},
+            }, closed=False, description="run settings; a published 4-DOF model's run adds its own"),
+            "verdict": _object({
+                "verdict": {"enum": ["PASS", "FAIL", "INCONCLUSIVE"]}, "passed": BOOLEAN,
+                "failures": _array(STRING), "unresolved": _array(STRING),
+                "moved_from_baseline": {"anyOf": [_array(STRING), {"type": "null"}],
+                                        "description": "null: no baseline checked"},
+                "counts": _object({"quantities": counts(STATUSES), "modes": counts(("fail", "pass")),
+                                   "spectral_lines": counts(("fail", "pass", "negligible"))}),
+            }),
+            "steady_state": _object({"start": seconds, "detected": BOOLEAN,
+                                     "how": {"enum": ["detected", "decayed", "transient", None]},
+                                     "settling_time": _value("s", nullable=True)}),
+            "modes": _array(_object({
+                "mode": {"type": "integer"}, "type": STRING, "multiplicity": {"type": "integer"},
+                "lumped": _value("Hz"), "mujoco": _value("Hz"), "mujoco_type": STRING, "rel_error": ratio,
+                "status": {"enum": ["fail", "pass"]}})),
+            "modes_tolerance": ratio,
+            "solvers": _object({"reference": STRING, "test": STRING}),
+            "diagnosis": {"anyOf": [_object({
+                "train": STRING, "agrees": BOOLEAN, "reduced_to": {"type": ["integer", "null"]},
+                "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
+                "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
+                "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"})}),
+                {"type": "null"}], "description": "a user's model: the term of the reference that best explains "
+                                                  "its modes; null otherwise"},
+            "quantities": _array(quantity),
+            "measurements": _array({"$ref": "#/$defs/measurement"}),
+            "notes": _array(STRING),
+            "references": _array(_object({"key": STRING, "citation": STRING})),
+            "volatile": _object({"timestamp": {"type": "string", "format": "date-time"},
+                                 "wall_time": {"type": "object", "additionalProperties": seconds}}),
+        },
+        "required": ["schema", "schema_version", "train", "calibration", "provenance", "settings", "verdict",
+                     "steady_state", "modes", "modes_tolerance", "solvers", "diagnosis", "quantities",
+                     "measurements", "notes", "references", "volatile"],
+        "additionalProperties": False,
+        "$defs": {"value": _value(), "measurement": measurement, "candidate": candidate},
+    }

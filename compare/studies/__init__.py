@@ -1,0 +1,2 @@
+"""Studies made of many runs or comparisons: sweeps, Monte Carlo, calibration, uncertainty, sensitivity,
+Campbell diagrams."""

@@ -1,0 +1,219 @@
+"""Least-squares calibration of uncertain train parameters against measured amplitudes.
+
+A parameter is addressed by its path in the train file, in the file's own units
+(``stages[0].mesh.ste[0].amplitude_um``, ``operating.output_torque``), with bounds.  The fit
+minimises sum_i ((ln y_i(p) - ln m_i)/s_i)^2 over ln p, y_i the lumped model's statistic of
+measurement i read through its measuring chain (:func:`gearcheck.compare.engine.measure.measure`), m_i the
+measured value and s_i its relative uncertainty (``uncertainty``, default 0.1): relative
+errors, and positive parameters by construction.  Parameter uncertainties come from the
+Jacobian at the optimum, cov(ln p) = (J^T J)^-1 with the residuals already divided by s_i;
+they are the measurement uncertainties propagated, valid also when the fit is exactly
+determined (as many measurements as parameters), where the residuals carry no information.
+
+The honest protocol for a paper's table: fit on the measurements at one speed
+(``fit_speeds``), then predict the others and report the prediction errors.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field
+
+import numpy as np
+import tomli_w
+from scipy.optimize import least_squares
+
+from gearcheck.compare.engine.align import STEADY_THRESHOLD
+from gearcheck.compare.engine.measure import MIN_CYCLES, measure
+from gearcheck.lumped.assembly import build_model
+from gearcheck.train.kinematics import kinematics
+from gearcheck.train.loader import load_text, load_train
+from gearcheck.lumped.modal import settling_time
+from gearcheck.train.spec import beside
+from gearcheck.lumped.time_solver import simulate
+from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.units import rad_s_to_rpm
+
+SPEED_MATCH = 1e-6
+LOG_STEP = 0.05  # finite-difference step in ln p: a peak of a simulated signal is only piecewise smooth
+# in the parameters, so a 5 % step sees the trend, not the jitter of which sample is the largest
+
+
+@dataclass
+class FitParameter:
+    """A number of a train file addressed by its path (``stages[0].sun.mass``), as ``option`` names it."""
+
+    path: str
+    low: float
+    high: float
+    keys: list = field(default_factory=list)
+    option: str = "--fit"
+
+    @classmethod
+    def parse(cls, text: str, option: str = "--fit") -> "FitParameter":
+        """``PATH`` or ``PATH=LOW:HIGH`` (bounds in the file's units; default 1/100 to 100 times the file's
+        value, which is the start; a value outside the bounds starts at their geometric mean)."""
+        path, _, bounds = text.partition("=")
+        keys = []
+        for part in path.split("."):
+            m = re.fullmatch(r"([A-Za-z_][\w\-]*)((?:\[\d+\])*)", part)
+            if not m:
+                raise GearcheckError(f"{option} {text!r}: {part!r} is not a key or key[index]")
+            keys.append(m.group(1))
+            keys += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+        low = high = math.nan
+        if bounds:
+            try:
+                low, high = (float(b) for b in bounds.split(":"))
+            except ValueError:
+                raise GearcheckError(f"{option} {text!r}: bounds must be LOW:HIGH numbers") from None
+            if not (0 < low < high and math.isfinite(high)):
+                raise GearcheckError(f"{option} {text!r}: need 0 < LOW < HIGH")
+        return cls(path, low, high, keys, option)
+
+    def get(self, document):
+        node = document
+        try:
+            for k in self.keys:
+                node = node[k]
+        except (KeyError, IndexError, TypeError):
+            raise GearcheckError(f"{self.option} {self.path}: no such field in the train file") from None
+        if isinstance(node, bool) or not isinstance(node, (int, float)):
+            raise GearcheckError(f"{self.option} {self.path}: {node!r} is not a number")
+        if node <= 0:
+            raise GearcheckError(f"{self.option} {self.path}: the value {node} must be positive (it is varied "
+                                 "in proportion)")
+        return float(node)
+
+    def set(self, document, value: float) -> None:
+        node = document
+        for k in self.keys[:-1]:
+            node = node[k]
+        node[self.keys[-1]] = value
+
+
+@dataclass
+class Calibration:
+    names: list[str]
+    start: np.ndarray
+    fitted: np.ndarray
+    relative_uncertainty: np.ndarray  # standard uncertainty of each fitted value, relative
+    entries: list[dict]
+    speeds_rpm: list[float]
+    used: list[bool]  # which entries the fit used
+    before: list[float]  # model statistics with the start values
+    after: list[float]  # with the fitted values
+    evaluations: int
+    document: dict  # the calibrated train file, parsed
+    source: str  # where the original came from (its relative file references are resolved from there)
+    header: str
+
+    def text(self, directory=None) -> str:
+        """The calibrated train file; file references rewritten relative to ``directory`` if given."""
+        doc = copy.deepcopy(self.document)
+        if directory is not None:
+            for table, key in (("train", "measurements_file"), ("train", "user_model"), ("operating", "torque_csv")):
+                name = doc.get(table, {}).get(key)
+                if name is not None and ":" not in name:  # a file, not module:factory
+                    doc[table][key] = os.path.relpath(beside(self.source, name), directory)
+        return self.header + tomli_w.dumps(doc)
+
+    def rows(self) -> list[dict]:
+        out = []
+        for entry, rpm, used, b, a in zip(self.entries, self.speeds_rpm, self.used, self.before, self.after):
+            m = entry["value"]
+            out.append({"quantity": entry["quantity"], "metric": entry["metric"], "speed_rpm": rpm,
+                        "measured": m, "published_model": entry.get("published_model"), "before": b, "after": a,
+                        "error_before": (b - m) / abs(m), "error_after": (a - m) / abs(m),
+                        "error_published_model": None if entry.get("published_model") is None
+                        else (entry["published_model"] - m) / abs(m),
+                        "role": "fit" if used else "prediction"})
+        return out
+
+
+def _speeds(entries, default_rpm):
+    out = []
+    for e in entries:
+        speed = e.get("speed")  # rad/s
+        out.append(default_rpm if speed is None else rad_s_to_rpm(speed))
+    return out
+
+
+def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParameter], duration: float,
+              fit_speeds: list[float] | None = None, progress=None) -> Calibration:
+    """Fit ``fits`` of the train file ``text`` to the measurement ``entries`` (lumped solver)."""
+    document = tomllib.loads(text)
+    if not entries:
+        raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or --measurements")
+    base_spec = load_text(text, source)
+    base_rpm = rad_s_to_rpm(base_spec.operating.input_speed)
+    rpm = _speeds(entries, base_rpm)
+    used = [fit_speeds is None or any(abs(r - f) <= SPEED_MATCH * f for f in fit_speeds) for r in rpm]
+    cycle = 1.0 / min(kinematics(base_spec).mesh_frequency.values()) * base_rpm / min(rpm)  # at the lowest speed
+    if duration < MIN_CYCLES * cycle:
+        raise GearcheckError(f"duration {duration:g} s is shorter than a cycle of the slowest mesh ({cycle:.4g} s), "
+                             "the least a measured statistic needs")
+    if not any(used):
+        raise GearcheckError(f"no measurement at the fit speeds {fit_speeds} rpm (have {sorted(set(rpm))})")
+    start = np.array([f.get(document) for f in fits])
+    for i, (f, x0) in enumerate(zip(fits, start)):
+        if math.isnan(f.low):
+            f.low, f.high = x0 / 100, x0 * 100
+        if not f.low <= x0 <= f.high:  # the file's value lies outside the bounds: start in their middle
+            start[i] = math.sqrt(f.low * f.high)
+    evaluations = 0
+
+    def model(values, which) -> list[float]:
+        nonlocal evaluations
+        doc = tomllib.loads(text)
+        for f, v in zip(fits, values):
+            f.set(doc, float(v))
+        spec = load_text(tomli_w.dumps(doc), source)
+        out = [math.nan] * len(entries)
+        for speed in sorted({rpm[i] for i in which}):
+            lumped = build_model(load_train(spec, speed))
+            result = simulate(lumped, RunSettings(duration))
+            cycle = 1.0 / float(np.min(lumped.excitation.frequency))
+            idx = [i for i in which if rpm[i] == speed]
+            settle = settling_time(lumped, STEADY_THRESHOLD)
+            for i, value in zip(idx, measure(result, [entries[i] for i in idx], cycle, settle)):
+                out[i] = value
+            evaluations += 1
+            if progress is not None:
+                progress(evaluations)
+        return out
+
+    fit_idx = [i for i, u in enumerate(used) if u]
+    measured = np.array([entries[i]["value"] for i in fit_idx])
+    sigma = np.array([entries[i]["uncertainty"] for i in fit_idx])
+
+    def residual(log_values):
+        y = np.array(model(np.exp(log_values), fit_idx))[fit_idx]
+        return (np.log(np.maximum(y, 1e-300)) - np.log(measured)) / sigma
+
+    solution = least_squares(residual, np.log(start), bounds=(np.log([f.low for f in fits]),
+                                                              np.log([f.high for f in fits])),
+                             diff_step=LOG_STEP, x_scale=1.0, xtol=1e-4, ftol=1e-6)
+    fitted = np.exp(solution.x)
+    J = solution.jac
+    try:
+        cov = np.linalg.inv(J.T @ J)
+        rel_unc = np.sqrt(np.clip(np.diag(cov), 0, None))
+    except np.linalg.LinAlgError:
+        rel_unc = np.full(len(fits), math.inf)
+    everything = list(range(len(entries)))
+    before = model(start, everything)
+    after = model(fitted, everything)
+    doc = tomllib.loads(text)
+    for f, v in zip(fits, fitted):
+        f.set(doc, float(v))
+    header = (f"# Calibrated by `gearcheck calibrate` from {source}: "
+              + ", ".join(f"{f.path} = {v:.6g}" for f, v in zip(fits, fitted))
+              + ".\n# The original file carries the comments that document every value.\n")
+    return Calibration([f.path for f in fits], start, fitted, rel_unc, entries, rpm, used, before, after,
+                       evaluations, doc, source, header)

@@ -1,0 +1,105 @@
+"""Campbell diagram: natural frequencies of a turning train over a speed range, both solvers.
+
+At each input speed the gyroscopic eigenproblem of each solver (:func:`gearcheck.api.modes` with a
+speed; Cooley & Parker 2012): frequencies, growth rates and stability.  Mesh-frequency lines
+(harmonics of every distinct mesh frequency, proportional to the speed) are drawn with their
+crossings of the natural-frequency curves (the speeds where a mesh harmonic excites a mode), and
+speeds at which a mode grows (divergence or flutter) are shaded as instability zones.  The curves
+are the modes ordered by frequency at each speed, so two modes that cross swap curves there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gearcheck.train.kinematics import kinematics
+from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.units import rpm_to_rad_s
+
+
+@dataclass
+class CampbellResult:
+    train: str
+    speeds_rpm: np.ndarray
+    results: dict[str, list[ModalResult]]  # solver -> one modal result per speed
+    mesh_lines: list[dict]  # {"mesh": ids, "harmonic": h, "hz_per_rpm": slope}
+    crossings: list[dict] = field(default_factory=list)
+    zones: list[dict] = field(default_factory=list)  # {"solver", "from_rpm", "to_rpm"}
+
+    def frequencies(self, solver: str) -> np.ndarray:
+        """(n_speeds, n_modes) in Hz."""
+        return np.array([r.frequencies for r in self.results[solver]])
+
+    @property
+    def agreement(self) -> float | None:
+        """The largest relative difference of the two solvers' elastic frequencies over all speeds."""
+        if len(self.results) < 2:
+            return None
+        a, b = (self.frequencies(s) for s in self.results)
+        elastic = a > 0
+        return float(np.max(np.abs(a - b)[elastic] / a[elastic]))
+
+    def to_dict(self) -> dict:
+        return {
+            "train": self.train, "unit": "Hz", "speeds_rpm": self.speeds_rpm.tolist(),
+            "solvers": {s: [{"speed_rpm": float(v), "stable": r.stable,
+                             "modes": [{"frequency_hz": float(f), "growth_rate_1_s": float(g), "stability": st,
+                                        "type": t} for f, g, st, t in zip(r.frequencies, r.growth, r.stability,
+                                                                          r.types)]}
+                            for v, r in zip(self.speeds_rpm, rs)] for s, rs in self.results.items()},
+            "max_relative_difference": self.agreement,
+            "mesh_lines": self.mesh_lines, "crossings": self.crossings, "instability_zones": self.zones,
+        }
+
+
+def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics: int = 3) -> CampbellResult:
+    """The Campbell diagram of ``spec`` at ``speeds_rpm`` (ascending, >= 0); ``modes_at(solver, speed_rad_s)``
+    gives one solver's :class:`ModalResult` at a speed; ``harmonics`` mesh harmonics are drawn."""
+    speeds = np.asarray(speeds_rpm, dtype=float)
+    results = {s: [modes_at(s, rpm_to_rad_s(v)) for v in speeds] for s in solvers}
+    lines = _mesh_lines(spec, harmonics)
+    out = CampbellResult(spec.name, speeds, results, lines)
+    reference = solvers[0]
+    f = out.frequencies(reference)
+    for line in lines:
+        excitation = line["hz_per_rpm"] * speeds
+        for mode in range(f.shape[1]):
+            gap = f[:, mode] - excitation
+            for i in np.where((np.sign(gap[:-1]) * np.sign(gap[1:]) <= 0) & (gap[:-1] != gap[1:]))[0]:
+                s = speeds[i] + (speeds[i + 1] - speeds[i]) * gap[i] / (gap[i] - gap[i + 1])
+                if f[i, mode] > 0:
+                    out.crossings.append({"speed_rpm": float(s), "frequency_hz": float(line["hz_per_rpm"] * s),
+                                          "mode": mode + 1, "meshes": line["meshes"], "harmonic": line["harmonic"]})
+    for solver, rs in results.items():
+        unstable = np.array([not r.stable for r in rs])
+        for start, stop in _runs(unstable):
+            out.zones.append({"solver": solver, "from_rpm": float(speeds[start]), "to_rpm": float(speeds[stop])})
+    return out
+
+
+def _mesh_lines(spec, harmonics: int) -> list[dict]:
+    """Each distinct mesh frequency per rpm of the input, with the meshes that have it, times 1..harmonics."""
+    kin = kinematics(spec)
+    per_rpm: dict[float, list[str]] = {}
+    rpm = spec.operating.input_speed * 30.0 / np.pi
+    for mesh_id, f in kin.mesh_frequency.items():
+        key = round(f / rpm, 12)
+        per_rpm.setdefault(key, []).append(mesh_id)
+    return [{"meshes": sorted(ids), "harmonic": h, "hz_per_rpm": slope * h}
+            for slope, ids in sorted(per_rpm.items()) for h in range(1, harmonics + 1)]
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of every run of True in ``mask``."""
+    runs, start = [], None
+    for i, flag in enumerate(mask):
+        if flag and start is None:
+            start = i
+        if not flag and start is not None:
+            runs.append((start, i - 1))
+            start = None
+    if start is not None:
+        runs.append((start, len(mask) - 1))
+    return runs

@@ -1,0 +1,763 @@
+"""The sweep engine: speed sweeps, parameter studies and Monte Carlo, on local processes or a Dask cluster.
+
+A *point* is one train file (the user's, with swept fields edited in its own units), one input speed, the
+solvers to run and the run settings.  :func:`run_point` runs each solver on it (the same sides the cross-check
+runs, :class:`~gearcheck.lumped.side.LumpedSide` and :class:`~gearcheck.mbd_models.side.MujocoSide`), each
+twice as the cross-check does, at its step and at its check step (2 h, or h / 2), finds the steady window by
+the cross-check's rule
+(:func:`gearcheck.compare.engine.align.steady_state` over the plan's mesh-force groups; without a steady state the
+second half, flagged ``steady = "none"``) and reduces it to a tidy table, one row per (solver, quantity,
+metric, mesh, order):
+
+* ``mean``, ``rms``, ``peak_to_peak`` of every quantity the cross-check gates, over the steady window;
+* ``harmonic``: amplitude and phase of each of them at the mesh harmonics k f_mesh, k = 1..``harmonics``, of
+  every distinct mesh frequency of the train (``mesh`` names its stages, e.g. ``I``), by the Hann-windowed
+  projection the cross-check's spectra use, A = 2 |sum w x e^{-i 2 pi f t}| / sum w, phase of cos(2 pi f t +
+  phase) with t the run's own time; ``resolved`` is False where the window cannot separate the line from
+  its neighbours or from DC (T |f - f'| < 2, the Hann main lobe).  The lines are projected with the jumps of
+  a switching mesh stiffness taken out (:func:`gearcheck.compare.engine.line_projection.harmonics`): a plain sum
+  aliases them onto the lines, by the same amount in both solvers, which then agree on a wrong number -- the
+  cross-check of two solvers cannot see an error they share.  ``integration_error`` estimates the error of
+  a statistic or line by its change on doubling the step (|X_h - X_2h|, or 2 |X_h - X_h/2|; for a line the
+  change of its complex amplitude), which bounds it for an integrator of order p >= 1 in its asymptotic
+  range (against runs at h / 8 on demo-3p it stayed within a factor of 2 of the error on the lines that
+  count); a line whose estimate exceeds a tenth of it (:mod:`gearcheck.compare.studies.sweep_lines`) is left out of the
+  peaks and drawn faint in the plots;
+* ``natural_frequency``: the reference lumped model's gyroscopic natural frequencies at the point's speed
+  (Cooley & Parker 2012), one row per elastic mode, so order plots overlay them (``solver`` "lumped").
+
+The engine (:func:`execute`) hashes each point's canonical inputs (:attr:`Point.key`: the edited train file's
+canonical TOML text and the digest of a torque CSV it reads, speed, solvers, settings, gearcheck's version),
+skips points whose ``KEY.parquet`` already lies in the cache folder (an interrupted sweep resumes; a changed
+input is a new key), runs the others through a :class:`concurrent.futures.Executor` (processes by default;
+in-process for one worker) or on a Dask distributed cluster (``scheduler``: an address or a
+``distributed.Client``; :mod:`gearcheck.compare.studies.point_backends`), writes each finished point into the cache
+at once (whole or not at all), and concatenates the points in index order with their inputs as columns
+(``point``, ``sample``, ``seed``, ``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no time stamps, so the same
+inputs give a byte-identical Parquet file.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import importlib.metadata
+import io
+import itertools
+import json
+import math
+import os
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import tomli_w
+from threadpoolctl import threadpool_limits
+
+from gearcheck.compare.studies import point_backends as backends
+from gearcheck.compare.engine.align import STEADY_THRESHOLD, steady_state
+from gearcheck.compare.studies.calibrate import FitParameter
+from gearcheck.compare.studies.distributions import Distribution, draw_samples
+from gearcheck.compare.engine.comparison import check_step
+from gearcheck.compare.engine.line_projection import harmonics
+from gearcheck.compare.engine.plan import TrainPlan
+from gearcheck.compare.studies.sweep_lines import counted, measured
+from gearcheck.train.loader import load_text, load_train, read_train_text
+from gearcheck.lumped.modal import settling_time
+from gearcheck.lumped.side import LumpedSide
+from gearcheck.train.spec import TrainSpec, beside
+from gearcheck.lumped.time_solver import step_limits
+from gearcheck.mbd_models.side import MujocoSide
+from gearcheck.shared.errors import GearcheckError, SolverError
+from gearcheck.shared.outputs import OutputDirectory, check_place
+from gearcheck.shared.results import train_signals
+from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.units import rad_s_to_rpm
+
+FORMAT = 2  # of the table; part of every point's key
+SOLVERS = ("lumped", "mujoco")
+DURATION = 0.5  # s simulated per point and solver
+HARMONICS = 3
+STATISTICS = ("mean", "rms", "peak_to_peak")
+MAX_POINTS = 1_000_000
+MAX_REFINE = 64
+
+POINT_SCHEMA = pa.schema([
+    ("solver", pa.string()), ("quantity", pa.string()), ("kind", pa.string()), ("unit", pa.string()),
+    ("metric", pa.string()), ("mesh", pa.string()), ("order", pa.int64()), ("frequency_hz", pa.float64()),
+    ("amplitude", pa.float64()), ("phase_rad", pa.float64()), ("resolved", pa.bool_()),
+    ("integration_error", pa.float64()), ("steady", pa.string()),
+    ("steady_start_s", pa.float64()), ("dt_s", pa.float64()), ("error", pa.string()),
+])
+"""The columns :func:`run_point` gives (what the cache holds per point)."""
+
+COLUMNS = {  # every column of the sweep table: (unit, meaning)
+    "point": ("", "index of the point in the sweep (the table's order)"),
+    "sample": ("", "index of the point's parameter set: a grid combination or a Monte Carlo draw (0 without)"),
+    "seed": ("", "Monte Carlo seed (null without)"),
+    "speed_rpm": ("rpm", "input speed"),
+    "solver": ("", "lumped or mujoco"),
+    "quantity": ("", "a gated signal of the cross-check (modeK for a natural frequency)"),
+    "kind": ("", "the signal's kind (acceleration, mesh_force, ...; the mode type for a natural frequency)"),
+    "unit": ("", "unit of amplitude (Hz for a natural frequency)"),
+    "metric": ("", "mean, rms, peak_to_peak, harmonic, natural_frequency or failed"),
+    "mesh": ("", "stages of the mesh frequency of a harmonic"),
+    "order": ("", "harmonic order k (mode number of a natural frequency, 0 for a statistic)"),
+    "frequency_hz": ("Hz", "k f_mesh at this speed, or the natural frequency"),
+    "amplitude": ("unit", "the statistic, or the harmonic's amplitude"),
+    "phase_rad": ("rad", "phase of the harmonic, cos(2 pi f t + phase), t from the run's start"),
+    "resolved": ("", "the steady window separates the line from its neighbours and from DC"),
+    "integration_error": ("unit", "estimate of the integration error of amplitude: its change on doubling the "
+                                  "step (null without the check)"),
+    "steady": ("", "detected, decayed or none (then the second half of the run)"),
+    "steady_start_s": ("s", "start of the steady window"),
+    "dt_s": ("s", "the solver's step"),
+    "error": ("", "why a solver failed at this point (metric failed)"),
+    "key": ("", "SHA-256 of the point's inputs: its cache file's name"),
+}
+
+
+def version() -> str:
+    return importlib.metadata.version("gearcheck")
+
+
+# ----------------------------------------------------------------------------- fields of the train file
+@dataclass(frozen=True)
+class Field:
+    """A number of the train file by its path (``stages[0].mesh.ste[0].amplitude_um``, the calibration's
+    addressing), in the file's own units; ``option`` names it in messages."""
+
+    path: str
+    keys: tuple
+    option: str = "--set"
+
+    @classmethod
+    def parse(cls, path: str, option: str = "--set") -> "Field":
+        if "=" in path or not path:
+            raise GearcheckError(f"{option} {path!r}: not a field path such as stages[0].sun.mass")
+        return cls(path, tuple(FitParameter.parse(path, option).keys), option)
+
+    def check(self, document) -> float | int | None:
+        """The field's value in ``document`` (None where its table exists but the file leaves it to its
+        default); refused where there is no such table or the value is not a number."""
+        node = document
+        for i, k in enumerate(self.keys):
+            last = i == len(self.keys) - 1
+            if isinstance(k, int):
+                if not isinstance(node, list) or not -len(node) <= k < len(node):
+                    raise GearcheckError(f"{self.option} {self.path}: no such field in the train file "
+                                         f"(no element {k} there)")
+            elif not isinstance(node, dict) or (k not in node and not last):
+                raise GearcheckError(f"{self.option} {self.path}: no such field in the train file ({k!r} is not there)")
+            elif k not in node:
+                return None
+            node = node[k]
+        if isinstance(node, bool) or not isinstance(node, (int, float)):
+            raise GearcheckError(f"{self.option} {self.path}: {node!r} is not a number")
+        return node
+
+    def set(self, document, value) -> None:
+        node = document
+        for k in self.keys[:-1]:
+            node = node[k]
+        node[self.keys[-1]] = value
+
+
+def parse_values(text: str, option: str = "--set") -> tuple[str, list[float]]:
+    """``FIELD=v1,v2,...`` or ``FIELD=A:B:N`` (N values from A to B) -> (FIELD, values)."""
+    path, eq, values = text.partition("=")
+    if not eq or not values.strip():
+        raise GearcheckError(f"{option} {text!r}: give FIELD=v1,v2,... or FIELD=A:B:N")
+    return path.strip(), _numbers(values, f"{option} {text!r}", positive=False)
+
+
+def parse_speeds(text: str, option: str = "--speeds") -> list[float]:
+    """``A:B:N`` (N speeds from A to B rpm) or ``v1,v2,...``: every speed > 0."""
+    return _numbers(text, f"{option} {text!r}", positive=True)
+
+
+def _numbers(text: str, what: str, positive: bool) -> list[float]:
+    text = str(text).strip()
+    try:
+        if ":" in text:
+            parts = text.split(":")
+            if len(parts) != 3:
+                raise ValueError
+            low, high, count = float(parts[0]), float(parts[1]), int(parts[2])
+        else:
+            values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise GearcheckError(f"{what}: must be A:B:N or v1,v2,... numbers") from None
+    if ":" in text:
+        if not (math.isfinite(low) and math.isfinite(high)):
+            raise GearcheckError(f"{what}: A and B must be finite")
+        if count < 1 or low > high or (count == 1) != (low == high) or count > MAX_POINTS:
+            raise GearcheckError(f"{what}: an empty or reversed range (needs A < B and N >= 2, or A:A:1)")
+        values = [low + (high - low) * i / max(count - 1, 1) for i in range(count)]
+    if not values or not all(math.isfinite(v) for v in values):
+        raise GearcheckError(f"{what}: every value must be a finite number")
+    if positive and min(values) <= 0:
+        raise GearcheckError(f"{what}: every speed must be > 0 rpm, got {min(values):g}")
+    return values
+
+
+# ----------------------------------------------------------------------------- points
+@dataclass(frozen=True)
+class Point:
+    """One run of the sweep: what :func:`run_point` needs, and nothing that varies between two runs."""
+
+    index: int
+    text: str  # the edited train file, canonical TOML
+    source: str  # where it came from: its relative file references resolve from there
+    speed_rpm: float | None  # None: the file's own
+    solvers: tuple[str, ...]
+    duration: float
+    harmonics: int
+    sample: int = 0
+    values: tuple = ()  # ((field path, value), ...) of the swept fields
+    seed: int | None = None
+    extra: str = ""  # digest of files the train reads (a torque CSV)
+    check: bool = True  # each run's integration check (a second run at 2 h or h / 2)
+    refine: int = 1  # each solver's default step divided by this
+
+    @property
+    def key(self) -> str:
+        """SHA-256 of the point's canonical inputs: the edited train file's text and the files it reads, not
+        where it lies nor the point's index (the same run in two sweeps shares it)."""
+        data = {"format": FORMAT, "gearcheck": version(), "train": self.text,
+                "speed_rpm": self.speed_rpm, "solvers": list(self.solvers), "duration_s": self.duration,
+                "harmonics": self.harmonics, "files": self.extra, "integration_check": self.check,
+                "refine": self.refine}
+        return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
+
+
+@dataclass
+class SweepPlan:
+    train: str
+    points: list[Point]
+    fields: list[str]
+    settings: dict
+
+
+def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
+               solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS,
+               integration_check: bool = True, refine: int = 1) -> SweepPlan:
+    """The points of a sweep, validated before anything runs (every edited train file loads, every speed is
+    one the train can turn at).  ``fields``: {path: [values]} (a grid over all of them); ``distributions``:
+    {path: "normal(mean, sd)" or Distribution} with ``samples`` draws seeded ``seed``; ``speeds`` in rpm
+    (None: the file's); ``integration_check``: run each solver a second time for its integration error;
+    ``refine``: each solver's default step divided by it.  Parameter sets are the outer loop, speeds the inner."""
+    if isinstance(train, TrainSpec):
+        raise GearcheckError("a sweep needs the train file (a preset name or a path), not a loaded TrainSpec: "
+                             "it edits the file's numbers and hashes its text")
+    solvers = _solvers(solvers)
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
+        raise GearcheckError(f"--duration {duration!r}: needs a positive number of seconds")
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
+        raise GearcheckError(f"--harmonics {harmonics!r}: needs an integer from 1 to 20")
+    if not isinstance(integration_check, bool):
+        raise GearcheckError(f"integration_check {integration_check!r}: needs True or False")
+    if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:
+        raise GearcheckError(f"--refine {refine!r}: needs an integer from 1 to {MAX_REFINE}")
+    text, source = read_train_text(train)
+    base = load_text(text, source)
+    document = tomllib.loads(text)
+    fields = dict(fields or {})
+    distributions = dict(distributions or {})
+    if fields and distributions:
+        raise GearcheckError("--set (a grid) and --vary (Monte Carlo): give one or the other")
+    if samples is not None and not distributions:
+        raise GearcheckError("--samples: Monte Carlo needs --vary FIELD=DISTRIBUTION (or --distributions FILE)")
+    grid = {}
+    for path, values in fields.items():
+        f = Field.parse(path, "--set")
+        grid[f] = _checked_values(path, values, f.check(document))
+    laws = {}
+    for path, law in distributions.items():
+        f = Field.parse(path, "--vary")
+        f.check(document)
+        laws[f] = law if isinstance(law, Distribution) else Distribution.parse(law, f"--vary {path}")
+    if len({f.path for f in list(grid) + list(laws)}) != len(grid) + len(laws):
+        raise GearcheckError("a field is given twice")
+    if speeds is not None:
+        speeds = [float(s) for s in speeds]
+        if not speeds:
+            raise GearcheckError("--speeds: an empty list of speeds")
+        bad = [s for s in speeds if not (math.isfinite(s) and s > 0)]
+        if bad:
+            raise GearcheckError(f"--speeds: every speed must be a positive number of rpm, got {bad[0]:g}")
+        if any(f.keys[:2] == ("operating", "input_speed_rpm") for f in list(grid) + list(laws)):
+            raise GearcheckError("operating.input_speed_rpm is swept by --speeds: give it there only")
+    if laws:
+        n = 32 if samples is None else samples
+        sets = draw_samples({f: d for f, d in laws.items()}, n, seed)
+        options = "--vary"
+    else:
+        sets = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
+        options = "--set"
+        seed = None
+    count = len(sets) * (len(speeds) if speeds else 1)
+    if count > MAX_POINTS:
+        raise GearcheckError(f"{count} points: more than the {MAX_POINTS} a sweep holds")
+    extra = _files_digest(document, source)
+    points = []
+    for i, values in enumerate(sets):
+        doc = copy.deepcopy(document)
+        for f, v in values.items():
+            f.set(doc, v)
+        canonical = tomli_w.dumps(doc)
+        where = ", ".join(f"{f.path}={v!r}" for f, v in values.items())
+        try:
+            spec = load_text(canonical, source) if values else base
+        except GearcheckError as exc:
+            raise GearcheckError(f"{options} {where}" + (f" (sample {i})" if laws else "") + f": {exc}") from None
+        if speeds and (i == 0 or values):  # bounds and pitch-line speed grow with the speed: the ends decide
+            for speed in sorted({min(speeds), max(speeds)}):
+                try:
+                    load_train(spec, speed)
+                except GearcheckError as exc:
+                    raise GearcheckError(f"--speeds {speed:g}" + (f" ({where})" if values else "") + f": {exc}"
+                                         ) from None
+        for speed in speeds or [None]:
+            points.append(Point(len(points), canonical, source, speed, solvers, float(duration), harmonics, i,
+                                tuple((f.path, float(v)) for f, v in values.items()), seed, extra, integration_check,
+                                refine))
+    settings = {"train": base.name, "source": source, "solvers": list(solvers), "duration_s": float(duration),
+                "harmonics": harmonics, "integration_check": integration_check, "refine": refine,
+                "speeds_rpm": speeds,
+                "grid": {f.path: [float(v) for v in vs] for f, vs in grid.items()},
+                "distributions": {f.path: str(d) for f, d in laws.items()},
+                "samples": len(sets) if laws else None, "seed": seed, "gearcheck": version()}
+    return SweepPlan(base.name, points, [f.path for f in list(grid) + list(laws)], settings)
+
+
+def check_quantities(train, quantities) -> None:
+    """Refuse a quantity to plot that the train does not gate (before anything runs)."""
+    spec = load_train(train)
+    gated = [s.name for s in train_signals(spec) if s.compared]
+    for q in quantities:
+        if q not in gated:
+            raise GearcheckError(f"--quantity {q}: not a gated quantity of {spec.name} (e.g. {', '.join(gated[:3])})")
+
+
+def _solvers(solvers) -> tuple[str, ...]:
+    if isinstance(solvers, str):
+        solvers = SOLVERS if solvers == "both" else (solvers,)
+    solvers = tuple(solvers)
+    bad = [s for s in solvers if s not in SOLVERS]
+    if bad or not solvers or len(set(solvers)) != len(solvers):
+        raise GearcheckError(f"--solver {', '.join(map(str, solvers)) or '(none)'}: choose lumped, mujoco or both")
+    return solvers
+
+
+def _checked_values(path: str, values, current) -> list:
+    """The values of a grid field; a field the file holds as an integer (teeth, planets) stays one."""
+    values = [values] if isinstance(values, (int, float)) else list(values)
+    if not values:
+        raise GearcheckError(f"--set {path}: an empty list of values")
+    for v in values:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise GearcheckError(f"--set {path}={v!r}: every value must be a finite number")
+    if isinstance(current, int) and all(float(v).is_integer() and abs(v) < 2**53 for v in values):
+        return [int(v) for v in values]
+    return [float(v) for v in values]
+
+
+def _files_digest(document: dict, source: str) -> str:
+    """SHA-256 of the files the train file reads that change its dynamics (a torque CSV)."""
+    name = document.get("operating", {}).get("torque_csv")
+    if not isinstance(name, str):
+        return ""
+    try:
+        return hashlib.sha256(Path(beside(source, name)).read_bytes()).hexdigest()
+    except OSError:
+        return ""
+
+
+# ----------------------------------------------------------------------------- one point
+def mesh_groups(spec, kin) -> list[tuple[str, float]]:
+    """(label, Hz) of each distinct mesh frequency of the train, lowest first; the label names the stages of
+    its meshes (``I``, ``II``; ``I+II`` where two stages share a frequency)."""
+    groups: dict[float, list[str]] = {}
+    exact: dict[float, float] = {}
+    for mesh in spec.meshes:
+        f = kin.mesh_frequency[mesh.id]
+        key = round(f, 6)
+        exact.setdefault(key, f)
+        if mesh.stage not in groups.setdefault(key, []):
+            groups[key].append(mesh.stage)
+    return [("+".join(stages), exact[key]) for key, stages in sorted(groups.items())]
+
+
+class _Rows:
+    def __init__(self):
+        self.columns = {name: [] for name in POINT_SCHEMA.names}
+
+    def add(self, **values) -> None:
+        for name in self.columns:
+            self.columns[name].append(values.get(name))
+
+    def table(self) -> pa.Table:
+        return pa.table(self.columns, schema=POINT_SCHEMA)
+
+
+def run_point(point: Point) -> tuple[bytes, float, float]:
+    """Run ``point``: (its table as Parquet bytes, wall time in s, CPU time of this process in s).  A solver that
+    fails on the point (it diverges, or refuses a step) gives one row ``metric = "failed"`` with the reason; the
+    others still run.  The point runs on one BLAS thread: the cores go to the workers, and a point's numbers are
+    then the same to the last bit whichever backend runs it (a multi-threaded BLAS sums in another order)."""
+    with threadpool_limits(limits=1):
+        return _run_point(point)
+
+
+def _run_point(point: Point) -> tuple[bytes, float, float]:
+    started, cpu = time.perf_counter(), time.process_time()
+    spec = load_train(load_text(point.text, point.source), point.speed_rpm)
+    lumped = LumpedSide(spec)
+    model = lumped.model
+    plan = TrainPlan.of(spec, model.kin, step_limits(model).omega_max, point.duration,
+                        settling_time(model, STEADY_THRESHOLD))
+    rows = _Rows()
+    modal = lumped.modes_at_speed(spec.operating.input_speed)
+    for k, (f, kind) in enumerate(zip(modal.frequencies, modal.types), start=1):
+        if kind != "rigid" and f > 0:
+            rows.add(solver="lumped", quantity=f"mode{k}", kind=kind, unit="Hz", metric="natural_frequency",
+                     order=k, frequency_hz=float(f))
+    lines = [(label, k, k * f) for label, f in mesh_groups(spec, model.kin) for k in range(1, point.harmonics + 1)]
+    for solver in point.solvers:
+        side = lumped if solver == "lumped" else MujocoSide(spec)
+        try:
+            result = side.run(RunSettings(point.duration, dt=side.default_step() / point.refine))
+            check = (side.run(RunSettings(point.duration, dt=check_step(side, result.info["dt_s"])))
+                     if point.check else None)
+        except SolverError as exc:
+            rows.add(solver=solver, quantity="", metric="failed", error=str(exc))
+            continue
+        reduce_run(result, plan, lines, rows, solver, check, model.excitation.switch_times)
+    sink = io.BytesIO()
+    pq.write_table(rows.table(), sink, compression="zstd")
+    return sink.getvalue(), time.perf_counter() - started, time.process_time() - cpu
+
+
+def reduce_run(result, plan, lines, rows: _Rows, solver: str, check=None, switch_times=None) -> None:
+    """The steady window of ``result`` reduced to statistics and mesh harmonics (rows of ``rows``), each with its
+    integration error estimate from ``check``, the same run at 2 h or h / 2 (None: no estimate).  ``switch_times(t0,
+    t1)``: the instants where the mesh stiffness jumps, which the harmonics are corrected for
+    (:func:`gearcheck.compare.engine.line_projection.harmonics`)."""
+    t = result.t
+    names = result.names(compared=True)
+    groups = [(np.stack([result[n] for n in forces], axis=1), cycle) for forces, cycle in plan.steady_groups(names)]
+    start, how = steady_state(t, groups, plan.settle) if groups else (None, None)
+    if start is None:
+        start, how = 0.5 * t[-1], "none"
+    freqs = np.array([f for _, _, f in lines])
+    stats, full, fs, span = _window(result, names, start, freqs, switch_times)
+    resolved = [bool(f < 0.45 * fs and f * span >= 2.0 and all(abs(f - g) * span >= 2.0 for g in freqs if g != f))
+                for f in freqs]
+    dt = float(result.info.get("dt_s", np.nan))
+    if check is None:
+        stat_error = dict.fromkeys(STATISTICS, np.full(len(names), np.nan))
+        line_error = np.full(full.shape, np.nan)
+    else:  # the estimate of compare.engine.integration_error, per statistic and line
+        factor = 1.0 if check.info["dt_s"] > dt else 2.0
+        check_stats, check_full, _, _ = _window(check, names, start, freqs, switch_times)
+        stat_error = {m: factor * np.abs(stats[m] - check_stats[m]) for m in STATISTICS}
+        line_error = factor * np.abs(full - check_full)
+    common = {"solver": solver, "steady": how, "steady_start_s": float(start), "dt_s": dt}
+    for j, name in enumerate(names):
+        s = result.signal(name)
+        info = {"quantity": name, "kind": s.kind, "unit": s.unit, **common}
+        for metric in STATISTICS:
+            rows.add(**info, metric=metric, order=0, amplitude=float(stats[metric][j]),
+                     integration_error=_number(stat_error[metric][j]))
+        for (label, k, f), value, error, ok in zip(lines, full[:, j], line_error[:, j], resolved):
+            rows.add(**info, metric="harmonic", mesh=label, order=k, frequency_hz=float(f),
+                     amplitude=float(abs(value)), phase_rad=float(np.angle(value)) if np.isfinite(value) else np.nan,
+                     resolved=ok, integration_error=_number(error))
+
+
+def _window(result, names, start: float, freqs: np.ndarray, switch_times=None):
+    """(statistics {metric: per quantity}, complex harmonics at ``freqs`` (lines x quantities), sampling rate,
+    window span) of ``result``'s quantities ``names`` over t >= ``start``, corrected for the jumps at
+    ``switch_times(t0, t1)``."""
+    t = result.t
+    window = t >= start
+    tw = t[window]
+    x = result.values[window][:, [result._index[n] for n in names]]
+    fs = (t.size - 1) / (t[-1] - t[0])
+    stats = {"mean": x.mean(axis=0), "rms": np.sqrt(np.mean(x**2, axis=0)), "peak_to_peak": np.ptp(x, axis=0)}
+    switches = switch_times(tw[0], tw[-1]) if switch_times is not None and tw.size > 1 else ()
+    return stats, harmonics(tw, x, freqs, fs, switches), fs, (tw[-1] - tw[0] if tw.size > 1 else 0.0)
+
+
+def _number(value) -> float | None:
+    return float(value) if np.isfinite(value) else None
+
+
+# ----------------------------------------------------------------------------- running many points
+@dataclass
+class Execution:
+    tables: dict  # key -> Parquet bytes
+    computed: int
+    cached: int
+    point_wall_s: list = field(default_factory=list)  # of the points computed here
+    point_cpu_s: list = field(default_factory=list)
+    backend: str = "in-process"
+
+
+def execute(points, *, workers: int | None = None, scheduler=None, executor=None, cache=None,
+            progress=None) -> Execution:
+    """Run every point not in ``cache`` (a folder, or None) through the chosen backend; see the module doc.
+    ``workers``: processes (default: the cores this process may use; 1 runs in this process);
+    ``executor``: any :class:`concurrent.futures.Executor` (left running); ``scheduler``: a Dask scheduler's
+    address or a ``distributed.Client``.  ``progress`` is called with the fraction of points done."""
+    unique = list(dict.fromkeys(p.key for p in points))
+    todo = {p.key: p for p in points}
+    tables: dict[str, bytes] = {}
+    cache = None if cache is None else Path(cache)
+    if cache is not None:
+        for key in unique:
+            path = cache / f"{key}.parquet"
+            if path.is_file():
+                data = path.read_bytes()
+                if _readable(data):
+                    tables[key] = data
+    cached = len(tables)
+    pending = [todo[k] for k in unique if k not in tables]
+    done = [cached]
+    walls: list[float] = []
+    cpus: list[float] = []
+
+    def finished(point: Point, result: tuple[bytes, float, float]) -> None:
+        key, (data, wall, cpu) = point.key, result
+        if cache is not None:
+            _store(cache / f"{key}.parquet", data)
+        tables[key] = data
+        walls.append(wall)
+        cpus.append(cpu)
+        done[0] += 1
+        if progress is not None:
+            progress(done[0] / len(unique))
+
+    if progress is not None and unique:
+        progress(done[0] / len(unique))
+    workers = _workers(workers)
+    if scheduler is not None:
+        backend = "dask"
+        backends.run_dask(run_point, pending, scheduler, finished)
+    elif executor is not None:
+        backend = type(executor).__name__
+        backends.run_futures(executor, run_point, pending, finished)
+    elif workers == 1 or len(pending) <= 1:
+        backend = "in-process"
+        for p in pending:
+            finished(p, run_point(p))
+    else:
+        backend = f"processes ({min(workers, len(pending))})"
+        backends.run_pool(run_point, pending, min(workers, len(pending)), finished)
+    return Execution(tables, len(pending), cached, walls, cpus, backend)
+
+
+def _workers(workers) -> int:
+    if workers is None:
+        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 4096:
+        raise GearcheckError(f"--workers {workers!r}: needs an integer from 1 to 4096")
+    return workers
+
+
+def _readable(data: bytes) -> bool:
+    try:
+        return pq.read_table(io.BytesIO(data)).schema.equals(POINT_SCHEMA)
+    except Exception:  # a damaged cache file is run again
+        return False
+
+
+def _store(path: Path, data: bytes) -> None:
+    """Write a cache file whole or not at all (a temporary file renamed; the umask's permissions)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem[:16]}.{os.getpid()}.{os.urandom(4).hex()}.partial")
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if tmp.exists():
+            tmp.unlink()
+        raise
+
+
+# ----------------------------------------------------------------------------- the table
+def assemble(plan: SweepPlan, tables: dict) -> pa.Table:
+    """The sweep table: every point's rows, in point order, with the point's inputs as leading columns."""
+    parts = []
+    for p in plan.points:
+        t = pq.read_table(io.BytesIO(tables[p.key]))
+        n = t.num_rows
+        inputs = {"point": pa.array([p.index] * n, pa.int64()), "sample": pa.array([p.sample] * n, pa.int64()),
+                  "seed": pa.array([p.seed] * n, pa.int64()),
+                  "speed_rpm": pa.array([_speed_of(p)] * n, pa.float64())}
+        values = dict(p.values)
+        inputs |= {name: pa.array([values[name]] * n, pa.float64()) for name in plan.fields}
+        columns = inputs | {name: t.column(name) for name in POINT_SCHEMA.names}
+        columns["key"] = pa.array([p.key] * n, pa.string())
+        parts.append(pa.table(columns, schema=table_schema(plan)))
+    if not parts:
+        return table_schema(plan).empty_table()
+    return pa.concat_tables(parts).combine_chunks()
+
+
+_SPEEDS: dict[tuple[str, str], float] = {}
+
+
+def _speed_of(point: Point) -> float:
+    """The point's speed in rpm: its own, or its train file's."""
+    if point.speed_rpm is not None:
+        return point.speed_rpm
+    key = (point.text, point.source)
+    if key not in _SPEEDS:
+        _SPEEDS[key] = rad_s_to_rpm(load_text(point.text, point.source).operating.input_speed)
+    return _SPEEDS[key]
+
+
+def table_schema(plan: SweepPlan) -> pa.Schema:
+    head = [("point", pa.int64()), ("sample", pa.int64()), ("seed", pa.int64()), ("speed_rpm", pa.float64())]
+    head += [(name, pa.float64()) for name in plan.fields]
+    meta = {"gearcheck.sweep": json.dumps(plan.settings, sort_keys=True),
+            "gearcheck.units": json.dumps({k: {"unit": u, "description": d} for k, (u, d) in COLUMNS.items()}
+                                          | {f: {"unit": "file", "description": "swept train-file field, in the "
+                                                 "file's own unit"} for f in plan.fields}, sort_keys=True)}
+    return pa.schema(head + list(POINT_SCHEMA) + [("key", pa.string())], metadata=meta)
+
+
+def parquet_bytes(table: pa.Table) -> bytes:
+    sink = io.BytesIO()
+    pq.write_table(table, sink, compression="zstd")
+    return sink.getvalue()
+
+
+# ----------------------------------------------------------------------------- the result
+@dataclass
+class SweepResult:
+    """A finished sweep: ``table`` (pyarrow; ``to_pandas()``), its plan, and how it ran."""
+
+    plan: SweepPlan
+    table: pa.Table
+    computed: int
+    cached: int
+    wall_s: float
+    point_wall_s: list
+    point_cpu_s: list
+    backend: str
+
+    @property
+    def train(self) -> str:
+        return self.plan.train
+
+    @property
+    def settings(self) -> dict:
+        return self.plan.settings
+
+    def to_pandas(self):
+        return self.table.to_pandas()
+
+    def parquet(self) -> bytes:
+        """The table as Parquet bytes: the same inputs give the same bytes."""
+        return parquet_bytes(self.table)
+
+    def summary(self) -> dict:
+        frame = self.to_pandas()
+        peaks = []
+        lines = frame[(frame["metric"] == "harmonic") & measured(frame)].dropna(subset=["amplitude"])
+        harmonic = lines[counted(lines)]
+        for (solver, quantity), rows in harmonic.groupby(["solver", "quantity"], sort=False):
+            if quantity not in self.headline():
+                continue
+            top = rows.loc[rows["amplitude"].idxmax()]
+            peaks.append({"solver": solver, "quantity": quantity, "mesh": top["mesh"], "order": int(top["order"]),
+                          "amplitude": float(top["amplitude"]), "unit": top["unit"],
+                          "speed_rpm": float(top["speed_rpm"]), "frequency_hz": float(top["frequency_hz"])})
+        failed = frame[frame["metric"] == "failed"]
+        steady = frame[frame["metric"] == "rms"].drop_duplicates(["point", "solver"])
+        return {"train": self.train, "points": len(self.plan.points), "rows": self.table.num_rows,
+                "settings": self.settings, "peaks": peaks,
+                "no_steady_state": int((steady["steady"] == "none").sum()),
+                "lines": int(len(lines)), "unconverged_lines": int(len(lines) - len(harmonic)),
+                "failed": [{"point": int(r.point), "solver": r.solver, "error": r.error} for r in failed.itertuples()]}
+
+    def headline(self) -> list[str]:
+        """Carrier and ring accelerations (world y) and the first sun and ring mesh forces of each stage."""
+        spec = load_text(self.plan.points[0].text, self.plan.points[0].source)
+        names = []
+        for stage in spec.stages:
+            for member in (stage.carrier, *[c for c in stage.centrals if spec.members[c].kind == "ring"]):
+                names.append(f"{member}.ay.world")
+            names += [f"{m.id}.force" for m in spec.meshes if m.stage == stage.name and m.planet_index == 0]
+        present = set(self.table.column("quantity").to_pylist())
+        return [n for n in names if n in present]
+
+    def write(self, directory, quantities=None) -> list[Path]:
+        """Write ``sweep.parquet``, ``sweep.json`` and the figures as the folder ``directory``, whole or not at
+        all; returns the files written."""
+        with OutputDirectory(directory, "directory") as place:
+            names = self.write_files(place.path, quantities)
+        return [Path(directory) / n for n in names]
+
+    def write_files(self, folder: Path, quantities=None) -> list[str]:
+        from gearcheck.compare.presentation import sweep_plots
+
+        folder = Path(folder)
+        (folder / "sweep.parquet").write_bytes(self.parquet())
+        frame = self.to_pandas()
+        quantities = list(quantities) if quantities else self.headline()
+        present = set(frame["quantity"])
+        missing = [q for q in quantities if q not in present]
+        if missing:
+            raise GearcheckError(f"--quantity {missing[0]}: not a gated quantity of {self.train}")
+        written = ["sweep.parquet"]
+        for name, png in sweep_plots.figures(frame, self.plan, quantities).items():
+            (folder / name).write_bytes(png)
+            written.append(name)
+        data = self.summary()
+        data["figures"] = written[1:]
+        data["timing"] = {"wall_s": self.wall_s, "computed": self.computed, "cached": self.cached,
+                          "backend": self.backend, "point_wall_s": self.point_wall_s,
+                          "point_cpu_s": self.point_cpu_s}
+        (folder / "sweep.json").write_text(json.dumps(data, indent=2, default=_plain) + "\n", encoding="utf-8")
+        return written + ["sweep.json"]
+
+
+def _plain(value):
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (np.floating,)):
+        return float(value)
+    return str(value)
+
+
+def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
+          solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS, integration_check: bool = True,
+          refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None,
+          progress=None) -> SweepResult:
+    """Plan, run (resuming from ``cache``) and assemble a sweep; see :func:`plan_sweep` and :func:`execute`."""
+    started = time.perf_counter()
+    plan = plan_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples,
+                      seed=seed, solvers=solvers, duration=duration, harmonics=harmonics,
+                      integration_check=integration_check, refine=refine)
+    if cache is not None:
+        check_place(Path(cache), "--cache")
+    if scheduler is not None and executor is not None:
+        raise GearcheckError("--scheduler runs on a Dask cluster: give it or an executor, not both")
+    if scheduler is not None and workers is not None:
+        raise GearcheckError("--workers counts local processes: a Dask cluster (--scheduler) has its own workers")
+    run = execute(plan.points, workers=workers, scheduler=scheduler, executor=executor, cache=cache,
+                  progress=progress)
+    table = assemble(plan, run.tables)
+    return SweepResult(plan, table, run.computed, run.cached, time.perf_counter() - started, run.point_wall_s,
+                       run.point_cpu_s, run.backend)
+

@@ -1,0 +1,192 @@
+"""What drives the train: torques, mesh stiffness variation and transmission error.
+
+All functions of time here follow the nominal kinematics (the "nominal clock"), so the lumped
+solver and the MuJoCo runner evaluate exactly the same excitation.  Signs: a static transmission
+error e > 0 compresses the mesh, so the mesh force is k(t) f(delta - e) + c (d delta/dt - de/dt); a mesh
+with tip relief sums its tooth pairs instead of k(t) (:meth:`Excitation.tooth_pairs`).
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+
+import numpy as np
+
+from gearcheck.train.kinematics import Kinematics
+from gearcheck.train.line_of_action import line_of_action
+from gearcheck.train.mesh_stiffness import ConstantStiffness, stiffness_model
+from gearcheck.train.tooth_pairs import ToothPairs, relieved
+
+
+def smooth_ramp(t, duration: float):
+    """0 -> 1 over ``duration`` with zero slope at both ends (1 when duration is 0); array-valued."""
+    t = np.asarray(t, dtype=float)
+    if duration <= 0.0:
+        return np.ones_like(t)
+    s = np.clip(t / duration, 0.0, 1.0)
+    return s * s * (3.0 - 2.0 * s)
+
+
+class Excitation:
+    """Time functions of one train at its operating point."""
+
+    def __init__(self, spec, kin: Kinematics):
+        self.spec = spec
+        self.kin = kin
+        meshes = spec.meshes
+        self.mesh_ids = [m.id for m in meshes]
+        self.frequency = np.array([kin.mesh_frequency[m.id] for m in meshes])
+        self.phase = np.array([kin.mesh_phase[m.id] for m in meshes])
+        self.models = [stiffness_model(m) for m in meshes]
+        self.mean_stiffness = np.array([model.mean for model in self.models])
+        self.max_stiffness = np.array([model.maximum for model in self.models])
+        self.backlash = np.array([m.backlash for m in meshes])
+        # meshes whose gears carry a tip relief: their force is the sum over their tooth pairs
+        self.relieved = np.array([j for j, m in enumerate(meshes) if relieved(m)], dtype=int)
+        self._pairs = [ToothPairs(meshes[j], self.mean_stiffness[j]) for j in self.relieved]
+        self._ste = [(i, h, a, p) for i, m in enumerate(meshes) for (h, a, p) in m.ste]
+        self._eccentric = list(self._eccentric_terms(spec, kin))
+        op = spec.operating
+        # torque ripple harmonics: (member "input" | "output", amplitude, angular frequency rad/s, phase rad)
+        self.ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
+        self._function = None
+        self._profile = None if op.torque_profile is None else tuple(np.asarray(x) for x in op.torque_profile)
+        if op.torque_function:
+            module, _, name = op.torque_function.partition(":")
+            self._function = getattr(importlib.import_module(module), name)
+
+    # ------------------------------------------------------------------ meshes
+    def mesh_position(self, t, mesh: int | None = None) -> np.ndarray:
+        """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...), or (...) for the one
+        mesh of index ``mesh``."""
+        t = np.asarray(t, dtype=float)
+        if mesh is not None:
+            return self.frequency[mesh] * t - self.phase[mesh]
+        return np.multiply.outer(t, self.frequency) - self.phase
+
+    def stiffness(self, t) -> np.ndarray:
+        """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...)."""
+        t = np.asarray(t, dtype=float)
+        k = np.empty(t.shape + (len(self.models),))
+        for j, model in enumerate(self.models):  # one mesh at a time: no (..., n_mesh) temporary
+            k[..., j] = model(self.mesh_position(t, j))
+        return k
+
+    def tooth_pairs(self, t):
+        """(k_j, e_j) of the relieved meshes' tooth pairs (:class:`~gearcheck.train.tooth_pairs.ToothPairs`):
+        shape (..., n_relieved, pairs) for t of shape (...), each mesh's pairs padded to the largest count
+        with k = 0, e = inf; (None, None) when no mesh is relieved.  The mesh force is
+        sum_j k_j max(0, delta - e(t) - e_j) + c (d delta/dt - de/dt)."""
+        if not self._pairs:
+            return None, None
+        xi = self.mesh_position(t)[..., self.relieved]
+        size = max(p.size for p in self._pairs)
+        k = np.zeros(xi.shape + (size,))
+        e = np.full(xi.shape + (size,), np.inf)
+        for r, pairs in enumerate(self._pairs):
+            k[..., r, :pairs.size], e[..., r, :pairs.size] = pairs(xi[..., r])
+        return k, e
+
+    def switch_times(self, t0: float, t1: float) -> np.ndarray:
+        """Sorted times in (t0, t1) at which some mesh's stiffness jumps (its model's ``breaks``)."""
+        times = []
+        for f, phase, model in zip(self.frequency, self.phase, self.models):
+            for b in model.breaks:
+                if f > 0:  # xi = f t - phase = n + b
+                    n = np.arange(math.floor(f * t0 - phase - b), math.ceil(f * t1 - phase - b) + 1)
+                    times.append((n + b + phase) / f)
+        t = np.concatenate(times) if times else np.empty(0)
+        return np.unique(t[(t > t0) & (t < t1)])
+
+    def periodic_terms(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """(the frequencies in Hz of the drive's periodic terms: time-varying mesh stiffness, transmission error
+        harmonics, eccentricities, torque ripple, a torque profile repeated; those of the time-varying meshes
+        alone; the terms without a period, named)."""
+        varying = np.array([not isinstance(m, ConstantStiffness) for m in self.models], dtype=bool)
+        meshes = np.abs(self.frequency[varying])
+        freqs = [meshes]
+        freqs += [np.array([h * abs(self.frequency[i])]) for i, h, _, _ in self._ste]
+        freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, *_ in self._eccentric]
+        freqs += [np.array([abs(omega) / (2 * math.pi)]) for _, _, omega, _ in self.ripple]
+        if self._profile is not None:
+            times = self._profile[0]
+            freqs.append(np.array([1.0 / (times[-1] - times[0])]))
+        op = self.spec.operating
+        aperiodic = [] if self._function is None else [f"the torque function {op.torque_function}"]
+        if op.ramp > 0:
+            aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
+        return np.concatenate(freqs), meshes, aperiodic
+
+    @property
+    def has_transmission_error(self) -> bool:
+        return bool(self._ste or self._eccentric)
+
+    def transmission_error(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Static transmission error e(t) and its rate per mesh, in m and m/s; shape (..., n_mesh)."""
+        t = np.asarray(t, dtype=float)
+        e = np.zeros(t.shape + (len(self.mesh_ids),))
+        de = np.zeros_like(e)
+        for i, h, amp, phi in self._ste:
+            arg = 2 * np.pi * h * (self.frequency[i] * t - self.phase[i]) + phi
+            e[..., i] += amp * np.cos(arg)
+            de[..., i] -= amp * 2 * np.pi * h * self.frequency[i] * np.sin(arg)
+        for i, amp, omega, beta0, dx, dy in self._eccentric:
+            beta = omega * t + beta0
+            e[..., i] += amp * (np.cos(beta) * dx + np.sin(beta) * dy)
+            de[..., i] += amp * omega * (-np.sin(beta) * dx + np.cos(beta) * dy)
+        return e, de
+
+    @staticmethod
+    def _eccentric_terms(spec, kin):
+        """Eccentricity and installation error of a gear: its pitch-circle centre offset, turning with the
+        gear (eccentricity) or with its mount (installation error: the housing for a central gear, the
+        carrier for a planet) relative to the carrier frame, projected on the line of action (+ for the
+        central gear, - for the planet)."""
+        for i, mesh in enumerate(spec.meshes):
+            stage = spec.stage_of(mesh.planet)
+            planet = spec.members[mesh.planet]
+            loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
+            w_c = kin.speeds[stage.carrier]
+            for gear, member, sign, base in ((mesh.central_gear, mesh.central, 1.0, 0.0),
+                                             (mesh.planet_gear, mesh.planet, -1.0, planet.angle)):
+                mount = w_c if member == mesh.planet else 0.0
+                dx, dy = sign * loa.direction
+                for amplitude, omega, phase in ((gear.eccentricity, kin.speeds[member] - w_c, gear.eccentricity_phase),
+                                                (gear.installation_error, mount - w_c, gear.installation_error_phase)):
+                    if amplitude > 0.0:
+                        yield i, amplitude, omega, base + phase, dx, dy
+
+    # ------------------------------------------------------------------ torques
+    def _ripple_omega(self, ripple) -> float:
+        if ripple.frequency is not None:
+            return 2 * math.pi * ripple.frequency
+        member = self.spec.input if ripple.member == "input" else self.spec.output
+        return ripple.order * abs(self.kin.speeds[member])
+
+    def torques(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(torque on the input member, torque on the output member) in N·m, signed; array-valued.
+
+        A shaft-driven input gets its mean torque from the shaft spring; only ripple and
+        a user function act on it directly.  The load is ramped in over ``ramp_s``.
+        """
+        t = np.asarray(t, dtype=float)
+        op = self.spec.operating
+        ramp = smooth_ramp(t, op.ramp)
+        t_in_mean = self.kin.input_torque
+        t_out_mean = self.kin.output_torque
+        t_in = np.zeros_like(t) if op.input_shaft_stiffness is not None else t_in_mean * ramp
+        t_out = t_out_mean * ramp
+        for member, amp, omega, phase in self.ripple:
+            wave = amp * np.cos(omega * t + phase) * ramp
+            if member == "input":
+                t_in = t_in + t_in_mean * wave
+            else:
+                t_out = t_out + t_out_mean * wave
+        if self._function is not None:
+            t_in = t_in + np.vectorize(self._function, otypes=[float])(t)
+        if self._profile is not None:
+            times, values = self._profile
+            phase = times[0] + np.mod(t - times[0], times[-1] - times[0])
+            t_in = t_in + np.interp(phase, times, values)
+        return t_in, t_out

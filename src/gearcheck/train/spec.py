@@ -1,0 +1,803 @@
+"""The validated train description (``TrainSpec``) built from a parsed train file.
+
+This is the single source both models are built from.  It holds the members (sun,
+ring, carrier, planets of every stage), their gears, supports and bearings, the
+meshes with their operating geometry, the interstage couplings and the operating
+point, all in SI units.  Every geometric rule of a planetary stage is checked here
+with an error that names the file and the field.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+import math
+from dataclasses import dataclass, field, replace
+from math import gcd
+from pathlib import Path
+
+import numpy as np
+
+from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, palmgren_stiffness
+from gearcheck.train.files import read_text, read_toml
+from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
+from gearcheck.train.mesh_stiffness import MODELS
+from gearcheck.train.schema import Context, parse_measurements
+from gearcheck.shared.errors import GearcheckError, TrainFileError
+
+MIN_TEETH = 6
+MAX_BACKLASH = 0.5  # modules: beyond, the backlash is more than the tooth space leaves
+MAX_TOLERANCE = 1e6  # a relative error of a million is no tolerance
+MAX_ERROR = 0.1  # modules: a transmission error or an eccentricity that large is a broken or misplaced gear
+CENTRE_DISTANCE_TOLERANCE = 1e-6  # m: sun-planet and ring-planet operating centre distances must match
+CARRIER_RADIUS_TOLERANCE = 1e-6  # m: a stated carrier radius must be the operating centre distance
+CYCLOID_FIELDS = {"lobes": "cycloid.lobes", "pins": "cycloid.pins", "eccentricity": "crank.eccentricity_mm",
+                  "pin_circle_radius": "cycloid.pin_circle_radius_mm", "pin_radius": "cycloid.pin_radius_mm",
+                  "contact_length": "cycloid.thickness_mm"}  # the train file's keys of the geometry's fields
+HOLDABLE = ("sun", "ring", "carrier", "pin_wheel")  # members on the housing's axis: held, coupled, input, output
+
+
+@dataclass(frozen=True)
+class Support:
+    radial_stiffness: float
+    radial_damping: float = 0.0
+    torsional_stiffness: float = 0.0
+    torsional_damping: float = 0.0
+    axial_stiffness: float = 0.0
+    axial_damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Member:
+    """A rigid body of the train: a central member (sun, ring, carrier) or a planet."""
+
+    id: str  # "stage1.sun", "stage1.planet2"
+    stage: str
+    kind: str  # sun | ring | carrier | planet
+    mass: float
+    inertia: float
+    support: Support | None = None  # central members: support on the housing
+    bearing: Support | None = None  # planets: bearing on the carrier pin
+    gears: dict[str, Gear] = field(default_factory=dict)
+    angle: float = 0.0  # planets: angle psi_n on the carrier circle
+    radius: float = 0.0  # planets: carrier radius (position of the centre)
+
+    @property
+    def is_planet(self) -> bool:
+        return self.kind == "planet"
+
+    @property
+    def orbits(self) -> bool:
+        """Sits on a pin of its carrier (a planet, an RV reducer's crankshaft): its translations are along the
+        carrier's radial and tangential axes at its place."""
+        return self.kind in ("planet", "crank")
+
+    @property
+    def label(self) -> str:
+        return self.id.replace(".", "_")
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """A central gear meshing with one planet gear."""
+
+    id: str  # "stage1.planet2.ring"
+    stage: str
+    central: str  # member id
+    planet: str  # member id
+    central_gear: Gear
+    planet_gear: Gear
+    geometry: MeshGeometry
+    stiffness: dict  # model name and its parameters
+    damping_ratio: float | None
+    damping_coefficient: float | None
+    backlash: float  # total backlash 2b along the line of action
+    ste: tuple[tuple[int, float, float], ...]  # (harmonic, amplitude m, phase rad)
+    planet_index: int
+
+    @property
+    def internal(self) -> bool:
+        return self.central_gear.internal
+
+    @property
+    def label(self) -> str:
+        stage, planet, central = self.id.split(".")
+        return f"{stage}_{planet}_{central}_mesh"
+
+
+@dataclass(frozen=True)
+class Coupling:
+    name: str
+    kind: str
+    a: str
+    b: str
+    torsional_stiffness: float
+    torsional_damping: float
+    radial_stiffness: float
+    radial_damping: float
+
+
+@dataclass(frozen=True)
+class Ripple:
+    member: str  # "input" | "output"
+    order: float | None
+    frequency: float | None  # Hz
+    amplitude: float
+    phase: float
+
+
+@dataclass(frozen=True)
+class Operating:
+    input_speed: float  # rad/s
+    output_torque: float  # N·m, from input_torque times the ratio when that was given
+    input_shaft_stiffness: float | None
+    input_shaft_damping: float
+    ripple: tuple[Ripple, ...]
+    torque_function: str | None
+    torque_profile: tuple[tuple[float, ...], tuple[float, ...]] | None  # (times, torques) from torque_csv
+    ramp: float
+    input_torque: float | None = None  # N·m, as the train file gave it
+
+
+@dataclass(frozen=True)
+class CycloidStage:
+    """An RV reducer's cycloid-pin stage on a planetary stage's carrier: one crankshaft per planet, splined to
+    it and borne in the carrier; one eccentric per disc on every crankshaft; discs that orbit on the
+    eccentrics and mesh with the pin wheel's pins (Yang, Chen & Wang 2018; geometry in
+    :mod:`gearcheck.train.cycloid`)."""
+
+    geometry: CycloidGeometry
+    phases: tuple[float, ...]  # rad: each disc's eccentric from the cranks' first eccentric
+    cranks: tuple[str, ...]  # member ids, crank k at planet k's place
+    discs: tuple[str, ...]
+    pin_wheel: str | None  # member id; None: rigid and fixed
+    spline: Support  # planet to crank: radial (bending) and torsional
+    needle: Support  # eccentric to disc, radial
+    contact_stiffness: float | None  # N/m per pin contact; None: Palmgren's law at the rated load
+    contact_damping: float
+    clearance: float  # m
+
+    def pin_stiffness(self, output_torque: float) -> float:
+        """The stiffness of one pin contact: as given, or Palmgren's line contact linearised at the largest
+        pin force F_max = 4 T_c / (Z_p r_c) of a rigid disc carrying T_c about its centre: its share of the
+        output torque times Z_c / Z_p (the pins' arms about the pin wheel's centre are Z_p / Z_c times those
+        about the disc's; the input's share of the reaction, 1/ratio, neglected)."""
+        if self.contact_stiffness is not None:
+            return self.contact_stiffness
+        g = self.geometry
+        torque = abs(output_torque) / len(self.discs) * g.lobes / g.pins
+        return palmgren_stiffness(4.0 * torque / (g.pins * g.rolling_radius), g.contact_length)
+
+
+@dataclass(frozen=True)
+class Stage:
+    name: str
+    carrier_radius: float
+    planet_angles: tuple[float, ...]
+    equally_spaced: bool
+    centrals: tuple[str, ...]  # member ids of sun/ring gears
+    planets: tuple[str, ...]
+    carrier: str
+    helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
+    cycloid: CycloidStage | None = None  # an RV reducer's second stage on this carrier
+
+
+@dataclass(frozen=True)
+class TrainSpec:
+    """A validated gear train in SI units."""
+
+    name: str
+    description: str
+    source: str
+    path: str  # file it was read from ("preset:NAME" for presets)
+    input: str
+    output: str
+    held: tuple[str, ...]
+    members: dict[str, Member]
+    stages: tuple[Stage, ...]
+    meshes: tuple[MeshSpec, ...]
+    couplings: tuple[Coupling, ...]
+    operating: Operating
+    text_hash: str = ""
+    references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
+    measurements: tuple[dict, ...] = ()  # measured reference values, SI (see schema.MEASUREMENT)
+    tolerances: dict = field(default_factory=dict)  # cross-check tolerance overrides, flat keys
+    user_model: str | None = None  # a user's model of the train (a file path or module:factory), --model user
+
+    def member(self, member_id: str) -> Member:
+        return self.members[member_id]
+
+    def stage_of(self, member_id: str) -> Stage:
+        name = self.members[member_id].stage
+        return next(s for s in self.stages if s.name == name)
+
+    def with_operating(self, **changes) -> "TrainSpec":
+        """A copy with operating-point fields replaced (e.g. ``input_speed``)."""
+        return replace(self, operating=replace(self.operating, **changes))
+
+
+def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
+    """Turn a schema-checked document into a :class:`TrainSpec`, applying the geometric rules."""
+    fail = lambda path, msg: TrainFileError(source, path, msg)  # noqa: E731
+    members: dict[str, Member] = {}
+    stages: list[Stage] = []
+    meshes: list[MeshSpec] = []
+    names = [s["name"] for s in data["stages"]]
+    for i, name in enumerate(names):
+        if names.index(name) != i:
+            raise fail(f"stages[{i}].name", f"duplicate stage name {name!r}")
+
+    for i, st in enumerate(data["stages"]):
+        path = f"stages[{i}]"
+        stage_members, stage, stage_meshes = _build_stage(st, path, fail)
+        members.update(stage_members)
+        stages.append(stage)
+        meshes.extend(stage_meshes)
+
+    train = data["train"]
+    for key in ("input", "output"):
+        if train[key] not in members:
+            raise fail(f"train.{key}", f"no member {train[key]!r}{_known(train[key], members)}")
+    for j, ref in enumerate(train["held"]):
+        if ref in train["held"][:j]:
+            raise fail(f"train.held[{j}]", f"{ref} is held twice")
+        if ref not in members:
+            raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
+        if members[ref].kind not in HOLDABLE:
+            raise fail(f"train.held[{j}]", f"{ref} is a {members[ref].kind}; only a sun, ring, carrier or pin wheel "
+                                           "can be held")
+        if members[ref].support.torsional_stiffness <= 0.0:
+            raise fail(f"train.held[{j}]", f"{ref} is held but its support.torsional_stiffness is 0; "
+                                           "a held member is held by a support stiffness")
+        if ref in (train["input"], train["output"]):
+            raise fail(f"train.held[{j}]", f"{ref} cannot be both held and the input or output")
+    if train["input"] == train["output"]:
+        raise fail("train.output", "the output must differ from the input")
+
+    couplings = []
+    for j, c in enumerate(data["couplings"]):
+        for key in ("from", "to"):
+            if c[key] not in members:
+                raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{_known(c[key], members)}")
+            if members[c[key]].kind not in HOLDABLE:
+                raise fail(f"couplings[{j}].{key}", f"{c[key]} is a {members[c[key]].kind}; a coupling joins "
+                                                    "central members (sun, ring, carrier, pin wheel)")
+        if members[c["from"]].stage == members[c["to"]].stage:
+            raise fail(f"couplings[{j}]", "a coupling joins members of different stages")
+        couplings.append(Coupling(c["name"], c["kind"], c["from"], c["to"], c["torsional_stiffness"],
+                                  c["torsional_damping"], c["radial_stiffness"], c["radial_damping"]))
+
+    op = data["operating"]
+    ripples = []
+    for j, r in enumerate(op["ripple"]):
+        if (r["order"] is None) == (r["frequency_hz"] is None):
+            raise fail(f"operating.ripple[{j}]", "give exactly one of order or frequency_hz")
+        ripples.append(Ripple(r["member"], r["order"], r["frequency_hz"], r["amplitude"], r["phase"]))
+    if op["torque_function"] is not None:
+        _check_torque_function(op["torque_function"], fail)
+    profile = _torque_profile(op["torque_csv"], source, fail) if op["torque_csv"] is not None else None
+    if op["input_torque"] is not None and op["output_torque"] is not None:
+        raise fail("operating.input_torque", "give input_torque or output_torque, not both")
+    for i, stage in enumerate(stages):
+        if stage.cycloid and stage.cycloid.contact_stiffness is None and not (op["output_torque"]
+                                                                              or op["input_torque"]):
+            raise fail(f"stages[{i}].cycloid.contact.stiffness", "missing: give it, or a load (operating."
+                                                                 "output_torque) to linearise Palmgren's law at")
+    operating = Operating(op["input_speed"], op["output_torque"] or 0.0, op["input_shaft_stiffness"],
+                          op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
+                          op["input_torque"])
+
+    return TrainSpec(
+        name=train["name"], description=train["description"], source=train["source"], path=source,
+        input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
+        stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
+        text_hash=text_hash, references=tuple(train["references"]),
+        measurements=tuple(_measurements(data, source, fail)),
+        tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
+        user_model=_user_model(train["user_model"], source),
+    )
+
+
+def flat_tolerances(table: dict, fail) -> dict[str, float]:
+    """``[tolerances]`` entries as flat ``KIND.METRIC`` keys (TOML dotted keys arrive nested),
+    each a positive finite number."""
+    flat = {}
+
+    def walk(node, prefix):
+        for key, value in node.items():
+            name = f"{prefix}.{key}" if prefix else key
+            if isinstance(value, dict):
+                walk(value, name)
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or not 0 < value <= MAX_TOLERANCE:
+                raise fail(name, f"must be a positive number up to {MAX_TOLERANCE:g}, got {value!r}")
+            elif "." not in name:
+                raise fail(name, "expected KIND.METRIC or QUANTITY.METRIC")
+            else:
+                flat[name] = float(value)
+
+    walk(table, "")
+    return flat
+
+
+def _known(ref: str, members) -> str:
+    close = difflib.get_close_matches(ref, list(members), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
+
+
+def beside(source: str, name: str):
+    """A file named in a train file: relative to that file (presets and their edited variants: the presets
+    folder)."""
+    base = Path(__file__).parent / "presets" if source.startswith("preset:") else Path(source).parent
+    return base / name
+
+
+def _user_model(name: str | None, source: str) -> str | None:
+    """train.user_model: a file of matrices named relative to the train file, or ``module:factory`` as given."""
+    if name is None or ":" in name:
+        return name
+    return str(beside(source, name))
+
+
+def _measurements(data: dict, source: str, fail) -> list[dict]:
+    """Inline [[measurements]] plus those of train.measurements_file, checked."""
+
+    entries = list(data["measurements"])
+    name = data["train"]["measurements_file"]
+    if name is not None:
+        path = beside(source, name)
+        try:
+            document = read_toml(path, "measurements file")
+        except TrainFileError:
+            raise
+        except GearcheckError as exc:
+            raise fail("train.measurements_file", str(exc)) from None
+        entries += parse_measurements(document, str(path))
+    return entries
+
+
+def _torque_profile(name: str, source: str, fail):
+    """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
+    path = beside(source, name)
+    try:
+        lines = read_text(path, "torque profile").splitlines()
+    except GearcheckError as exc:
+        raise fail("operating.torque_csv", str(exc)) from None
+    if lines and not _numbers(lines[0]):
+        lines = lines[1:]  # a header line
+    try:
+        data = np.loadtxt(lines, delimiter=",", ndmin=2)
+    except ValueError as exc:
+        raise fail("operating.torque_csv", f"{path}: {exc}") from None
+    if data.ndim != 2 or data.shape[1] != 2 or data.shape[0] < 2:
+        raise fail("operating.torque_csv", f"{path} needs two columns (time, torque) and at least two rows")
+    if not np.all(np.isfinite(data)) or np.any(np.diff(data[:, 0]) <= 0):
+        raise fail("operating.torque_csv", f"{path}: times must increase strictly and all values be finite")
+    return tuple(data[:, 0]), tuple(data[:, 1])
+
+
+def _numbers(line: str) -> bool:
+    try:
+        [float(x) for x in line.split(",")]
+        return True
+    except ValueError:
+        return False
+
+
+def _check_torque_function(ref: str, fail):
+    """The function must import and map a time in s to a finite torque in N·m: it is called once at t = 0."""
+    module, _, func = ref.partition(":")
+    try:
+        obj = getattr(importlib.import_module(module), func)
+    except Exception as exc:  # whatever the user's module raises on import
+        raise fail("operating.torque_function", f"cannot import {ref!r}: {type(exc).__name__}: {exc}") from None
+    if not callable(obj):
+        raise fail("operating.torque_function", f"{ref!r} is not callable")
+    try:
+        value = obj(0.0)
+    except Exception as exc:  # a wrong signature, or an error inside the user's function
+        raise fail("operating.torque_function", f"{ref}(0.0) raised {type(exc).__name__}: {exc} (it must map a time "
+                                                "in s to a torque in N·m)") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(value):
+        raise fail("operating.torque_function", f"{ref}(0.0) returned {value!r}; it must return a finite torque in N·m")
+
+
+def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:
+    def pick(key, unit_key):
+        value = raw.get(key)
+        if value is None:
+            value = stage.get(key)
+        if value is None:
+            raise fail(f"{path}.{unit_key}", "missing required field (give it on the gear or the stage)")
+        return value
+
+    teeth = raw["teeth"]
+    if teeth < MIN_TEETH:
+        raise fail(f"{path}.teeth", f"an involute gear needs at least {MIN_TEETH} teeth, got {teeth}")
+    beta = raw["helix_angle"]
+    if beta is None:  # the stage's angle is the planets'; a sun's helix runs the other way
+        beta = -stage["helix_angle"] if not internal and name.startswith("sun") else stage["helix_angle"]
+    normal_module = pick("module", "module_mm")
+    normal_alpha = pick("pressure_angle", "pressure_angle_deg")
+    module = normal_module / math.cos(beta)  # transverse (ISO 21771): m_t = m_n / cos(beta)
+    alpha = normal_alpha if beta == 0.0 else math.atan(math.tan(normal_alpha) / math.cos(beta))
+    _check_small(raw["eccentricity"], MAX_ERROR, normal_module, f"{path}.eccentricity_um", "eccentricity", fail)
+    _check_small(raw["installation_error"], MAX_ERROR, normal_module, f"{path}.installation_error_um",
+                 "installation error", fail)
+    relief = raw["tip_relief"] or {"amount": 0.0, "length": 0.0, "shape": "linear"}
+    _check_small(relief["amount"], MAX_ERROR, normal_module, f"{path}.tip_relief.amount_um", "tip relief", fail)
+    base = raw["base_radius"] if raw["base_radius"] is not None else 0.5 * module * teeth * math.cos(alpha)
+    pitch = 0.5 * module * teeth
+    if not 0.5 * pitch < base < pitch:  # cos a between 0.5 and 1: pressure angles of 0 to 60 deg
+        raise fail(f"{path}.base_radius_mm", f"base radius {base * 1e3:.4g} mm does not fit the pitch radius "
+                                             f"{pitch * 1e3:.4g} mm (it must lie between half of it and all of it)")
+    return Gear(
+        name=name, teeth=teeth, module=module, pressure_angle=alpha, face_width=pick("face_width", "face_width_mm"),
+        addendum=pick("addendum_coefficient", "addendum_coefficient"),
+        dedendum=pick("dedendum_coefficient", "dedendum_coefficient"),
+        profile_shift=raw["profile_shift"], internal=internal, base_radius=base,
+        eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"], helix_angle=beta,
+        installation_error=raw["installation_error"], installation_error_phase=raw["installation_error_phase"],
+        relief_amount=relief["amount"], relief_length=relief["length"],
+        relief_power=2 if relief["shape"] == "parabolic" else 1,
+    )
+
+
+def _body(raw: dict, radius: float, path: str, fail, gear: Gear | None = None) -> tuple[float, float]:
+    """(mass, inertia) of a member: as given, or from ``density`` as an annulus (a gear's default from its
+    bore to its pitch circle over its face width; a ring's from its pitch circle out); ``radius`` is the
+    one ``inertia_over_r2`` refers to."""
+    if raw["inertia"] is not None and raw["inertia_over_r2"] is not None:
+        raise fail(f"{path}.inertia", "give inertia or inertia_over_r2, not both")
+    mass = raw["mass"]
+    inertia = raw["inertia"] if raw["inertia_over_r2"] is None else raw["inertia_over_r2"] * radius**2
+    if mass is not None and inertia is not None:
+        return mass, inertia
+    if raw["density"] is None:
+        missing = "mass" if mass is None else "inertia"
+        raise fail(f"{path}.{missing}", f"missing: give {missing}"
+                   + (" (or inertia_over_r2)" if missing == "inertia" else "") + ", or a density to derive it from")
+    pitch = gear.pitch_radius if gear is not None else None
+    inner = raw["inner_radius"]
+    outer = raw["outer_radius"]
+    if gear is not None and gear.internal:
+        inner = pitch if inner is None else inner
+        if outer is None:
+            raise fail(f"{path}.outer_radius_mm", "a ring's mass from its density needs its outer radius")
+    elif gear is not None:
+        inner, outer = inner or 0.0, pitch if outer is None else outer
+    elif outer is None or raw["thickness"] is None:
+        raise fail(f"{path}.{'outer_radius_mm' if outer is None else 'thickness_mm'}",
+                   "a carrier's mass from its density needs its outer radius and thickness")
+    inner = inner or 0.0
+    if not inner < outer:
+        raise fail(f"{path}.inner_radius_mm", f"must be less than the outer radius {outer * 1e3:.6g} mm, got "
+                                              f"{inner * 1e3:.6g} mm")
+    width = raw["thickness"] if raw["thickness"] is not None else gear.face_width
+    annulus_mass = raw["density"] * math.pi * (outer**2 - inner**2) * width
+    mass = annulus_mass if mass is None else mass
+    return mass, inertia if inertia is not None else 0.5 * mass * (outer**2 + inner**2)
+
+
+def _support(raw: dict) -> Support:
+    return Support(raw["radial_stiffness"], raw["radial_damping"], raw.get("torsional_stiffness", 0.0),
+                   raw.get("torsional_damping", 0.0), raw["axial_stiffness"], raw["axial_damping"])
+
+
+def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:
+    merged: dict = {"stiffness": None, "damping": None, "backlash": None, "ste": []}
+    for layer in (stage_mesh, gear_mesh):
+        if layer:
+            for key, value in layer.items():
+                if value is not None and value != []:
+                    merged[key] = value
+    return merged
+
+
+def _build_stage(st: dict, path: str, fail):
+    name = st["name"]
+    n = st["planets"]
+    # --- planet gears
+    planet_raw = st["planet"]
+    if planet_raw["gears"] is not None and planet_raw["gears"]:
+        if planet_raw["teeth"] is not None:
+            raise fail(f"{path}.planet.teeth", "give teeth on each of planet.gears, not on the planet")
+        planet_gears = {g: _gear(g, raw, st, False, f"{path}.planet.gears.{g}", fail)
+                        for g, raw in planet_raw["gears"].items()}
+    else:
+        if planet_raw["teeth"] is None:
+            raise fail(f"{path}.planet.teeth", "missing required field (or give planet.gears)")
+        planet_gears = {"planet": _gear("planet", planet_raw, st, False, f"{path}.planet", fail)}
+
+    # --- central gears (sun, ring, sun_*, ring_*)
+    central_keys = [k for k in st if (k in ("sun", "ring") or k.startswith(("sun_", "ring_"))) and st[k] is not None]
+    if not central_keys:
+        raise fail(path, "a stage needs at least one central gear (sun or ring)")
+    centrals: dict[str, tuple[Gear, str, dict]] = {}
+    for key in central_keys:
+        raw = st[key]
+        gpath = f"{path}.{key}"
+        internal = key.startswith("ring")
+        gear = _gear(key, raw, st, internal, gpath, fail)
+        if raw["planet_gear"] is None:
+            if len(planet_gears) > 1:
+                raise fail(f"{gpath}.planet_gear", f"missing required field for compound planets "
+                                                   f"(one of {', '.join(planet_gears)})")
+            pg = next(iter(planet_gears))
+        else:
+            pg = raw["planet_gear"]
+            if pg not in planet_gears:
+                raise fail(f"{gpath}.planet_gear", f"no planet gear {pg!r} (have {', '.join(planet_gears)})")
+        centrals[key] = (gear, pg, raw)
+
+    # --- an RV reducer: crankshafts in place of planet pins, and no ring (the cranks set the planets' spin)
+    rv = st["crank"] is not None or st["cycloid"] is not None
+    if rv:
+        for key in ("crank", "cycloid"):
+            if st[key] is None:
+                raise fail(f"{path}.{key}", "missing: an RV reducer's stage needs both [crank] and [cycloid]")
+        rings = [key for key in central_keys if key.startswith("ring")]
+        if rings:
+            raise fail(f"{path}.{rings[0]}", "an RV reducer's planets are turned by their crankshafts: a ring "
+                                             "would lock them (remove the ring, or the crank and cycloid tables)")
+        if planet_raw["bearing"] is not None:
+            raise fail(f"{path}.planet.bearing", "an RV reducer's planets sit on their crankshafts (give the "
+                                                 "crank's bearing and spline instead)")
+    elif planet_raw["bearing"] is None:
+        raise fail(f"{path}.planet.bearing", "missing required field")
+
+    # --- every gear an involute gear, every pair an involute mesh
+    planet_paths = {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}"
+                    for name in planet_gears}
+    for gear, gpath in [(planet_gears[n], p) for n, p in planet_paths.items()] + \
+            [(g, f"{path}.{key}") for key, (g, _, _) in centrals.items()]:
+        problem = gear_problem(gear)
+        if problem:
+            raise fail(f"{gpath}.{problem[0]}", problem[1])
+    geoms = {}
+    for key, (gear, pg, _) in centrals.items():
+        planet = planet_gears[pg]
+        if gear.internal and gear.teeth <= planet.teeth:
+            raise fail(f"{path}.{key}.teeth", f"a ring needs more teeth than its planet gear ({planet.teeth}), "
+                                              f"got {gear.teeth}")
+        try:
+            geoms[key] = mesh_geometry(gear, planet)
+        except ValueError as exc:
+            raise fail(f"{path}.{key}.profile_shift", f"no operating geometry with the planet: {exc}") from None
+        problem = mesh_problem(gear, planet, geoms[key])
+        if problem:
+            where = f"{path}.{key}" if problem[0] == "central" else planet_paths[pg]
+            raise fail(f"{where}.teeth", f"meshing {key} with the planet: {problem[1]}")
+
+    # --- operating centre distances must agree (ring teeth consistent with sun and planet)
+    first = central_keys[0]
+    a0 = geoms[first].centre_distance
+    for key in central_keys[1:]:
+        a = geoms[key].centre_distance
+        if abs(a - a0) > CENTRE_DISTANCE_TOLERANCE:
+            g, pg, _ = centrals[key]
+            hint = ""
+            if g.internal and not centrals[first][0].internal and len(planet_gears) == 1:
+                zs, zp = centrals[first][0].teeth, planet_gears[pg].teeth
+                hint = f"; with zero profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth"
+            raise fail(f"{path}.{key}.teeth", f"{key} with {g.teeth} teeth meets the planet at centre distance "
+                                              f"{a * 1e3:.4f} mm but {first} at {a0 * 1e3:.4f} mm{hint}")
+
+    # --- planet angles and the assembly condition
+    if st["planet_angles"] is None:
+        angles = tuple(2.0 * math.pi * k / n for k in range(n))
+        equally = True
+    else:
+        if len(st["planet_angles"]) != n:
+            raise fail(f"{path}.planet_angles_deg", f"has {len(st['planet_angles'])} angles for {n} planets")
+        angles = tuple(st["planet_angles"])
+        spacing = [((angles[k] - angles[0]) - 2 * math.pi * k / n) for k in range(n)]
+        equally = max(abs(s) for s in spacing) < 1e-12
+    _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
+    carrier_radius = a0
+    stated = st["carrier_radius"]
+    if stated is not None and abs(stated - a0) > CARRIER_RADIUS_TOLERANCE:
+        raise fail(f"{path}.carrier_radius_mm", f"{stated * 1e3:.6g} mm, but the gears mesh at an operating centre "
+                                                f"distance of {a0 * 1e3:.6g} mm: the pins must sit there (change the "
+                                                "teeth or profile shifts, or the radius)")
+    _check_collision(planet_gears, angles, carrier_radius, path, fail)
+
+    # --- members
+    members: dict[str, Member] = {}
+    for key, (gear, _, raw) in centrals.items():
+        mid = f"{name}.{key}"
+        members[mid] = Member(mid, name, "ring" if gear.internal else "sun",
+                              *_body(raw, gear.base_radius, f"{path}.{key}", fail, gear), support=_support(raw["support"]),
+                              gears={key: gear})
+    carrier_raw = st["carrier"]
+    carrier_id = f"{name}.carrier"
+    members[carrier_id] = Member(carrier_id, name, "carrier", *_body(carrier_raw, carrier_radius, f"{path}.carrier", fail),
+                                 support=_support(carrier_raw["support"]))
+    first_planet_gear = next(iter(planet_gears.values()))
+    planet_mass, planet_inertia = _body(planet_raw, first_planet_gear.base_radius, f"{path}.planet", fail,
+                                        first_planet_gear)
+    planet_ids = []
+    for k, psi in enumerate(angles):
+        pid = f"{name}.planet{k + 1}"
+        planet_ids.append(pid)
+        members[pid] = Member(pid, name, "planet", planet_mass, planet_inertia,
+                              bearing=None if rv else _support(planet_raw["bearing"]), gears=dict(planet_gears),
+                              angle=psi, radius=carrier_radius)
+    cycloid = _cycloid_stage(st, members, angles, carrier_radius, path, fail) if rv else None
+
+    # --- meshes
+    for layer, lpath in [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]:
+        if layer and layer["stiffness"] is not None:
+            _check_stiffness(layer["stiffness"], f"{lpath}.stiffness", fail)
+    meshes = []
+    for key, (gear, pg, raw) in centrals.items():
+        mesh = _merge_mesh(st["mesh"], raw["mesh"])
+        mpath = f"{path}.{key}.mesh"
+        if mesh["stiffness"] is None:
+            raise fail(f"{mpath}.stiffness", "missing required field (give it here or in the stage's [mesh])")
+        damping = mesh["damping"] or {"ratio": None, "coefficient": None}
+        if damping["ratio"] is not None and damping["coefficient"] is not None:
+            raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")
+        ste = tuple((s["harmonic"], s["amplitude"], s["phase"]) for s in mesh["ste"])
+        _check_small(mesh["backlash"] or 0.0, MAX_BACKLASH, gear.module, f"{mpath}.backlash_um", "backlash", fail)
+        if mesh["backlash"] and (gear.relief_amount or planet_gears[pg].relief_amount):
+            raise fail(f"{mpath}.backlash_um", "a mesh with tip relief is modelled on its drive flanks only: give "
+                                               "it no backlash")
+        for j, (_, amplitude, _) in enumerate(ste):
+            _check_small(amplitude, MAX_ERROR, gear.module, f"{mpath}.ste[{j}].amplitude_um",
+                         "transmission error amplitude", fail)
+        for k, pid in enumerate(planet_ids):
+            meshes.append(MeshSpec(
+                id=f"{pid}.{key}", stage=name, central=f"{name}.{key}", planet=pid, central_gear=gear,
+                planet_gear=planet_gears[pg], geometry=geoms[key], stiffness=dict(mesh["stiffness"]),
+                damping_ratio=damping["ratio"], damping_coefficient=damping["coefficient"],
+                backlash=mesh["backlash"] or 0.0, ste=ste, planet_index=k,
+            ))
+    helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
+    if helical:
+        _check_helical(st, centrals, meshes, path, fail)
+    if helical and rv:
+        raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
+    stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in central_keys),
+                  tuple(planet_ids), carrier_id, helical, cycloid)
+    return members, stage, meshes
+
+
+def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path: str, fail) -> CycloidStage:
+    """Crankshaft, disc and pin-wheel members of an RV reducer's stage (added to ``members``) and its
+    cycloid-pin stage, its geometry checked."""
+    name, crank, cyc = st["name"], st["crank"], st["cycloid"]
+    geometry = CycloidGeometry(lobes=cyc["lobes"], pins=cyc["pins"], eccentricity=crank["eccentricity"],
+                               pin_circle_radius=cyc["pin_circle_radius"], pin_radius=cyc["pin_radius"],
+                               contact_length=cyc["thickness"])
+    problem = cycloid_problem(geometry)
+    if problem:
+        field_name, message = problem
+        raise fail(f"{path}.{CYCLOID_FIELDS[field_name]}", message)
+    n_discs = cyc["discs"]
+    if cyc["phases"] is None:
+        phases = tuple(2.0 * math.pi * j / n_discs for j in range(n_discs))
+    else:
+        if len(cyc["phases"]) != n_discs:
+            raise fail(f"{path}.cycloid.phases_deg", f"has {len(cyc['phases'])} angles for {n_discs} discs")
+        phases = tuple(cyc["phases"])
+    cranks = []
+    for k, psi in enumerate(angles):
+        cid = f"{name}.crank{k + 1}"
+        cranks.append(cid)
+        members[cid] = Member(cid, name, "crank", crank["mass"], crank["inertia"],
+                              bearing=Support(crank["bearing"]["radial_stiffness"], crank["bearing"]["radial_damping"]),
+                              angle=psi, radius=carrier_radius)
+    discs = []
+    for j in range(n_discs):
+        did = f"{name}.disc{j + 1}"
+        discs.append(did)
+        members[did] = Member(did, name, "disc", cyc["mass"], cyc["inertia"])
+    wheel = None
+    if st["pin_wheel"] is not None:
+        wheel = f"{name}.pin_wheel"
+        raw = st["pin_wheel"]
+        members[wheel] = Member(wheel, name, "pin_wheel", raw["mass"], raw["inertia"],
+                                support=_support(raw["support"]))
+    spline = crank["spline"]
+    contact = cyc["contact"]
+    return CycloidStage(
+        geometry, phases, tuple(cranks), tuple(discs), wheel,
+        Support(spline["radial_stiffness"], spline["radial_damping"], spline["torsional_stiffness"],
+                spline["torsional_damping"]),
+        Support(cyc["bearing"]["radial_stiffness"], cyc["bearing"]["radial_damping"]),
+        contact["stiffness"], contact["damping"], contact["clearance"])
+
+
+SPUR_ONLY_STIFFNESS = {"rectangular": "its wave counts tooth pairs from the transverse contact ratio alone",
+                       "energy": "its energy method slices spur teeth"}
+
+
+def _check_helical(st: dict, centrals, meshes, path: str, fail) -> None:
+    """A helical stage's members move axially: each needs an axial support (else its axial motion is free and
+    the meshes' axial forces push it away), and its meshes a stiffness model that sees the helix."""
+    for key in list(centrals) + ["carrier"]:
+        if not st[key]["support"]["axial_stiffness"]:
+            raise fail(f"{path}.{key}.support.axial_stiffness", "a helical stage needs it > 0: the meshes' axial "
+                                                                "forces act on every member")
+    if not st["planet"]["bearing"]["axial_stiffness"]:
+        raise fail(f"{path}.planet.bearing.axial_stiffness", "a helical stage needs it > 0: the sun and ring meshes "
+                                                             "push each planet axially")
+    for mesh in meshes:
+        model = mesh.stiffness["model"]
+        if model in SPUR_ONLY_STIFFNESS:
+            key = mesh.central.split(".")[-1]
+            raise fail(f"{path}.{key}.mesh.stiffness.model", f"{model!r} is for spur gears "
+                                                            f"({SPUR_ONLY_STIFFNESS[model]}); a helical mesh "
+                                                            "needs 'contact-line' or 'constant'")
+
+
+def _check_small(value: float, limit: float, module: float, path: str, what: str, fail) -> None:
+    """A deviation from the perfect mesh (backlash, transmission error, eccentricity) well below the
+    teeth: at ``limit`` modules the teeth would leave each other's flanks or hit the mate's tip."""
+    if value > limit * module:
+        raise fail(path, f"{what} {value * 1e6:.4g} µm is over {limit:g} of the module {module * 1e3:.4g} mm: "
+                         "no tooth pair stays on its flanks")
+
+
+def _check_stiffness(params: dict, path: str, fail):
+    """Check a ``stiffness`` table against its model's parameter table; store SI values in place."""
+    name = params["model"]
+    if name not in MODELS:
+        close = difflib.get_close_matches(name, list(MODELS), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{hint}")
+    values = {k: v for k, v in params.items() if k != "model"}
+    checked = MODELS[name].parameters.parse(values, path, Context(fail("", "").source))
+    params.clear()
+    params.update({"model": name, **checked})
+
+
+def _assembly_number(a: tuple[Gear, Gear], b: tuple[Gear, Gear]) -> tuple[int, int]:
+    """Numerator and denominator of the planet-spacing condition for central gears a, b.
+
+    Each argument is (central gear, planet gear it meshes).  A planet can be placed at
+    angle psi when psi/(2 pi) * (z_A z_b +/- z_B z_a) / gcd(z_a, z_b) is an integer:
+    '+' for a sun and a ring, '-' for two gears of the same kind.  Simple planets
+    (z_a = z_b) reduce this to the classical (z_s + z_r) psi / (2 pi) integer.
+    """
+    (ga, pa), (gb, pb) = a, b
+    sign = 1 if ga.internal != gb.internal else -1
+    num = ga.teeth * pb.teeth + sign * gb.teeth * pa.teeth
+    return abs(num), gcd(pa.teeth, pb.teeth)
+
+
+def _check_assembly(centrals, planet_gears, angles, equally, n, path, fail):
+    keys = list(centrals)
+    for i in range(len(keys)):
+        for j in range(i + 1, len(keys)):
+            ga, pa, _ = centrals[keys[i]]
+            gb, pb, _ = centrals[keys[j]]
+            num, den = _assembly_number((ga, planet_gears[pa]), (gb, planet_gears[pb]))
+            for k, psi in enumerate(angles):
+                count = psi / (2 * math.pi) * num / den
+                if abs(count - round(count)) > 1e-6:
+                    if equally:
+                        simple = len(planet_gears) == 1 and ga.internal != gb.internal
+                        formula = (f"(z_s + z_r)/N = {num // den}/{n}" if simple
+                                   else f"{num}/({den}·{n})")
+                        raise fail(f"{path}.planets", f"{n} equally spaced planets cannot be assembled: "
+                                                      f"{formula} is not an integer")
+                    raise fail(f"{path}.planet_angles_deg[{k}]",
+                               f"planet at {math.degrees(psi):.4f} deg cannot mesh with both "
+                               f"{keys[i]} and {keys[j]}: psi/360·{num}/{den} = {count:.4f} is not an integer")
+
+
+def _check_collision(planet_gears, angles, carrier_radius, path, fail):
+    tip = max(g.tip_radius for g in planet_gears.values())
+    order = sorted(angles)
+    n = len(order)
+    if n < 2:
+        return
+    for k in range(n):
+        gap = (order[(k + 1) % n] - order[k]) % (2 * math.pi) or 2 * math.pi
+        chord = 2.0 * carrier_radius * math.sin(gap / 2.0)
+        if chord <= 2.0 * tip:
+            raise fail(f"{path}.planets", f"adjacent planets collide: centre spacing {chord * 1e3:.3f} mm "
+                                          f"<= tip diameter {2 * tip * 1e3:.3f} mm")

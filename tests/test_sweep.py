@@ -16,8 +16,8 @@ import pytest
 
 import gearcheck
 from gearcheck.cli import main
-from gearcheck.compare import point_backends
-from gearcheck.compare import sweep as sw
+from gearcheck.compare.studies import point_backends
+from gearcheck.compare.studies import sweep as sw
 from gearcheck.compare.studies.distributions import Distribution, draw_samples
 from gearcheck.compare.engine.line_projection import harmonics
 from gearcheck.compare.studies.sweep_lines import counted

@@ -19,7 +19,7 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 
-from gearcheck.compare import sweep as sw
+from gearcheck.compare.studies import sweep as sw
 from gearcheck.shared.outputs import MARKER
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX sessions and /proc")

@@ -11,8 +11,8 @@ chunk, and runs RK4 through them in compiled code.  Its right-hand side is that 
 * mesh m: f = k_m g(a_m.q - e_m) + c_m (a_m.v - e_m'), g the backlash dead zone (or the identity), or for a
   relieved mesh sum_j k_j max(0, a_m.q - e_m - e_j) over its tooth pairs;
 * the turning elements, whose rows move with time, at each stage's own time: the radial couplings between
-  frames (:meth:`gearcheck.lumped.assembly.TurningCoupling.forces`) and the cycloid stages' needle bearings,
-  compression-only pin contacts and orbit loads (:meth:`gearcheck.lumped.cycloid_rows.CycloidRows.forces`; the
+  frames (:meth:`gearcheck.lumped.elements.coupling.TurningCoupling.forces`) and the cycloid stages' needle bearings,
+  compression-only pin contacts and orbit loads (:meth:`gearcheck.lumped.elements.cycloid.CycloidRows.forces`; the
   pins' normals and arms from one sine and cosine per disc by the angle-addition formulas, as
   :func:`gearcheck.train.cycloid.pin_contacts` states them).
 
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from gearcheck.lumped.assembly import TurningCoupling
-from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.elements.coupling import TurningCoupling
+from gearcheck.lumped.elements.cycloid import CycloidRows
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,6 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from gearcheck.lumped.compiled_steps import Sparse, Turning, rk4_steps
-from gearcheck.lumped.cycloid_rows import CycloidRows
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
@@ -348,7 +347,7 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
     static_bearing = [static.row_forces[static.row_names.index(r.name)] for r in bearings]
-    cycloids = [e for e in model.turning if isinstance(e, CycloidRows)]
-    pins = np.concatenate([e.pin_forces(t, q, v) for e in cycloids], axis=1) if cycloids else None
+    contacts = [e for e in model.turning if e.has_contacts]
+    pins = np.concatenate([e.pin_forces(t, q, v) for e in contacts], axis=1) if contacts else None
     return train_result(spec, "lumped", t, acc, angle, delta, force, k, static.mesh_force, static_bearing,
                         bearing_force, settle, info, raw, pins)

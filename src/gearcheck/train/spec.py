@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass, field, replace
 from math import gcd
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -22,6 +23,7 @@ from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, palmgren_s
 from gearcheck.train.files import read_text, read_toml
 from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
 from gearcheck.train.mesh_stiffness import MODELS
+from gearcheck.train.parts import train_parts
 from gearcheck.train.schema import Context, parse_measurements
 from gearcheck.shared.errors import GearcheckError, TrainFileError
 
@@ -47,13 +49,25 @@ class Support:
     axial_damping: float = 0.0
 
 
+# Where a member's two translations are measured, by the frame its centre is carried in: "axis", on the stage's
+# axis (sun, ring, carrier, pin wheel), along the axes that turn with the stage's carrier; "pin", on a pin of
+# the carrier (planets, crankshafts), along the carrier's radial and tangential axes at the pin; "eccentric", on
+# the eccentrics of the crankshafts (cycloid discs), along the carrier's axes like a central member.
+TRANSLATIONS = {"axis": ("x", "y"), "pin": ("radial", "tangential"), "eccentric": ("x", "y")}
+ROTATION = "theta"  # absolute, about the stage axis
+AXIAL = "z"  # translation along the stage axis (absolute, like the others)
+FRAMES = {"sun": "axis", "ring": "axis", "carrier": "axis", "pin_wheel": "axis", "planet": "pin", "crank": "pin",
+          "disc": "eccentric"}
+
+
 @dataclass(frozen=True)
 class Member:
-    """A rigid body of the train: a central member (sun, ring, carrier) or a planet."""
+    """A rigid body of the train: a central member (sun, ring, carrier, pin wheel), a planet, or an RV
+    reducer's crankshaft or cycloid disc."""
 
     id: str  # "stage1.sun", "stage1.planet2"
     stage: str
-    kind: str  # sun | ring | carrier | planet
+    kind: str  # sun | ring | carrier | planet | crank | disc | pin_wheel
     mass: float
     inertia: float
     support: Support | None = None  # central members: support on the housing
@@ -61,16 +75,29 @@ class Member:
     gears: dict[str, Gear] = field(default_factory=dict)
     angle: float = 0.0  # planets: angle psi_n on the carrier circle
     radius: float = 0.0  # planets: carrier radius (position of the centre)
+    axial: bool = False  # slides along its stage's axis (every member of a helical stage)
 
     @property
     def is_planet(self) -> bool:
         return self.kind == "planet"
 
     @property
+    def frame(self) -> str:
+        """Where its translations are measured (:data:`TRANSLATIONS`)."""
+        return FRAMES[self.kind]
+
+    @property
     def orbits(self) -> bool:
         """Sits on a pin of its carrier (a planet, an RV reducer's crankshaft): its translations are along the
         carrier's radial and tangential axes at its place."""
-        return self.kind in ("planet", "crank")
+        return self.frame == "pin"
+
+    @property
+    def dofs(self) -> tuple[str, ...]:
+        """Its degrees of freedom, defined here once for both models and the result names: two translations
+        (:data:`TRANSLATIONS`), the absolute rotation ``theta``, and ``z`` along the stage axis when it slides
+        axially."""
+        return TRANSLATIONS[self.frame] + (ROTATION,) + ((AXIAL,) if self.axial else ())
 
     @property
     def label(self) -> str:
@@ -81,6 +108,7 @@ class Member:
 class MeshSpec:
     """A central gear meshing with one planet gear."""
 
+    element: ClassVar[str] = "mesh"
     id: str  # "stage1.planet2.ring"
     stage: str
     central: str  # member id
@@ -107,6 +135,9 @@ class MeshSpec:
 
 @dataclass(frozen=True)
 class Coupling:
+    """Central members of two stages joined in torsion and, with a radial stiffness, in both translations."""
+
+    element: ClassVar[str] = "coupling"
     name: str
     kind: str
     a: str
@@ -146,6 +177,8 @@ class CycloidStage:
     eccentrics and mesh with the pin wheel's pins (Yang, Chen & Wang 2018; geometry in
     :mod:`gearcheck.train.cycloid`)."""
 
+    element: ClassVar[str] = "cycloid"
+    stage: str  # the planetary stage whose carrier it rides on
     geometry: CycloidGeometry
     phases: tuple[float, ...]  # rad: each disc's eccentric from the cranks' first eccentric
     cranks: tuple[str, ...]  # member ids, crank k at planet k's place
@@ -210,6 +243,12 @@ class TrainSpec:
     def stage_of(self, member_id: str) -> Stage:
         name = self.members[member_id].stage
         return next(s for s in self.stages if s.name == name)
+
+    @property
+    def parts(self) -> tuple:
+        """Every part that joins the members, in the order both models build them
+        (:func:`~gearcheck.train.parts.train_parts`)."""
+        return train_parts(self)
 
     def with_operating(self, **changes) -> "TrainSpec":
         """A copy with operating-point fields replaced (e.g. ``input_speed``)."""
@@ -659,6 +698,8 @@ def _build_stage(st: dict, path: str, fail):
         _check_helical(st, centrals, meshes, path, fail)
     if helical and rv:
         raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
+    if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
+        members = {mid: replace(m, axial=True) for mid, m in members.items()}
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in central_keys),
                   tuple(planet_ids), carrier_id, helical, cycloid)
     return members, stage, meshes
@@ -703,7 +744,7 @@ def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path:
     spline = crank["spline"]
     contact = cyc["contact"]
     return CycloidStage(
-        geometry, phases, tuple(cranks), tuple(discs), wheel,
+        name, geometry, phases, tuple(cranks), tuple(discs), wheel,
         Support(spline["radial_stiffness"], spline["radial_damping"], spline["torsional_stiffness"],
                 spline["torsional_damping"]),
         Support(cyc["bearing"]["radial_stiffness"], cyc["bearing"]["radial_damping"]),

@@ -68,24 +68,23 @@ RGBA = {
 MARKER_RGBA = "0.1 0.1 0.1 1"
 VISUALS = True  # gear meshes, markers and camera; off, the bodies carry no geoms (same dynamics)
 VISUAL = 'contype="0" conaffinity="0" group="1"'  # visual geoms: no contact (no mass: explicit inertials)
-CENTRAL_AXES = ("x", "y")
-PLANET_AXES = ("radial", "tangential")
-DISC_AXES = ("orbit", "radial")  # a cycloid disc: a hinge about the stage axis, a slide along its eccentric
-AXIAL = "z"
+# The joints that realise a member's two translations (:attr:`gearcheck.train.spec.Member.dofs`), by the frame that
+# carries it: world-frame slides on the stage axis, slides along the carrier's radial and tangential axes on a pin,
+# and on an eccentric polar joints about the stage axis (a hinge, and a slide along the eccentric)
+AXES = {"axis": ("x", "y"), "pin": ("radial", "tangential"), "eccentric": ("orbit", "radial")}
+ROTATION = "rz"  # the hinge of the member's rotation theta
+AXIAL = "z"  # the slide along the stage axis
 PIN_BAND = 1.0  # m: a pin tendon's dead band reaches this far below contact (compression only)
 
 
-def axial(spec: TrainSpec, member) -> bool:
-    """Whether ``member`` slides along its stage's axis (every member of a helical stage does)."""
-    return spec.stage_of(member.id).helical
-
-
 def member_axes(member) -> tuple[str, str]:
-    """The names of a member's first two joints (its rotation is ``rz``): a central member's world-frame
-    slides, an orbiting member's slides along its carrier's radial and tangential axes, a disc's polar pair."""
-    if member.kind == "disc":
-        return DISC_AXES
-    return PLANET_AXES if member.orbits else CENTRAL_AXES
+    """The names of a member's first two joints (:data:`AXES`; its rotation is ``rz``)."""
+    return AXES[member.frame]
+
+
+def member_joints(member) -> tuple[str, ...]:
+    """The suffixes of all of a member's joints, one per degree of freedom in the order of its ``dofs``."""
+    return member_axes(member) + (ROTATION,) + ((AXIAL,) if member.axial else ())
 
 
 def num(x) -> str:
@@ -195,7 +194,7 @@ def _assets(spec: TrainSpec) -> list[str]:
 
 def _joints(spec, member, support, joints, indent: str) -> list[str]:
     """The body's joints, (suffix, type, axis, stiffness, damping) each, and its axial slide in a helical stage."""
-    if axial(spec, member):
+    if member.axial:
         joints = joints + [(AXIAL, "slide", (0, 0, 1), support.axial_stiffness, support.axial_damping)]
     return [f"{indent}  {_joint(f'{member.label}_{name}', kind, axis, k, c)}" for name, kind, axis, k, c in joints]
 
@@ -421,7 +420,7 @@ def coupling_tendons(spec: TrainSpec) -> list[str]:
         lines += _fixed(f"coupling_{c.name}_torsion", [(a + "_rz", 1.0), (b + "_rz", -1.0)],
                         c.torsional_stiffness, c.torsional_damping)
         if c.radial_stiffness or c.radial_damping:
-            for axis in CENTRAL_AXES:
+            for axis in member_axes(spec.members[c.a]):
                 lines += _fixed(f"coupling_{c.name}_{axis}", [(f"{a}_{axis}", 1.0), (f"{b}_{axis}", -1.0)],
                                 c.radial_stiffness, c.radial_damping)
     return lines
@@ -433,8 +432,7 @@ def mesh_joints(spec: TrainSpec, mesh) -> list[str]:
     joints = []
     for mid in (mesh.central, spec.stage_of(mesh.planet).carrier, mesh.planet):
         member = spec.members[mid]
-        axes = (PLANET_AXES if member.is_planet else CENTRAL_AXES) + ("rz",) + ((AXIAL,) if axial(spec, member) else ())
-        joints += [f"{member.label}_{a}" for a in axes]
+        joints += [f"{member.label}_{a}" for a in member_joints(member)]
     return joints
 
 
@@ -472,8 +470,8 @@ def pin_list(spec: TrainSpec) -> list[tuple]:
 def pin_joints(spec: TrainSpec, disc) -> list[str]:
     """The joints that move a pin contact: the disc's and the pin wheel's (when it is a body)."""
     wheel = spec.stage_of(disc.id).cycloid.pin_wheel
-    joints = [f"{disc.label}_{a}" for a in DISC_AXES + ("rz",)]
-    return joints + ([f"{spec.members[wheel].label}_{a}" for a in CENTRAL_AXES + ("rz",)] if wheel else [])
+    joints = [f"{disc.label}_{a}" for a in member_joints(disc)]
+    return joints + ([f"{spec.members[wheel].label}_{a}" for a in member_joints(spec.members[wheel])] if wheel else [])
 
 
 def pin_tendons(spec: TrainSpec, coefficients, springlengths) -> list[str]:
@@ -551,7 +549,7 @@ def _sensors(spec: TrainSpec) -> list[str]:
         lines.append(f'    <tendonvel name="{mesh.label}_rate" tendon="{mesh.label}"/>')
     for mid, member in spec.members.items():
         if member.orbits:
-            for axis in PLANET_AXES:
+            for axis in member_axes(member):
                 lines.append(f'    <jointpos name="{member.label}_{axis}_pos" joint="{member.label}_{axis}"/>')
                 lines.append(f'    <jointvel name="{member.label}_{axis}_vel" joint="{member.label}_{axis}"/>')
     for _, crank, disc, _, _ in needle_list(spec):

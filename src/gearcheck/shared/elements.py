@@ -20,11 +20,12 @@ class Registry:
         self._kinds: dict[str, object] = {}
 
     def register(self, kind: str):
-        """Decorator: ``@ELEMENTS.register("support")`` over the implementation of that kind of part."""
+        """Decorator: ``@ELEMENTS.register("support")`` over the implementation of that kind of part (a function, or
+        a class whose one instance is registered)."""
         def add(implementation):
             if kind in self._kinds:
                 raise ValueError(f"{self.side}: element kind {kind!r} registered twice")
-            self._kinds[kind] = implementation
+            self._kinds[kind] = implementation() if isinstance(implementation, type) else implementation
             return implementation
         return add
 

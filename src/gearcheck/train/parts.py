@@ -1,9 +1,9 @@
 """The parts that join a train's members, each a kind of element that both models build
 (:class:`gearcheck.shared.elements.Registry`).
 
-:func:`train_parts` lists them in the one order both models build them: supports of the members on the
-housing, bearings of the members on carrier pins, splines, interstage couplings, the input shaft, the meshes and
-the cycloid-pin stages.  The meshes (:class:`~gearcheck.train.spec.MeshSpec`), couplings
+:func:`train_parts` lists them in the one order both models build them: the meshes, supports of the members
+on the housing, bearings of the members on carrier pins, interstage couplings, splines, the drive and the
+cycloid-pin stages.  The meshes (:class:`~gearcheck.train.spec.MeshSpec`), couplings
 (:class:`~gearcheck.train.spec.Coupling`) and cycloid-pin stages (:class:`~gearcheck.train.spec.CycloidStage`)
 are parts as the train file describes them; the others are written here from the members that carry them.
 """
@@ -46,12 +46,14 @@ class SplinePart:
 
 
 @dataclass(frozen=True)
-class ShaftPart:
-    """The input shaft: a torsional spring-damper between the input member and the drive's reference angle."""
+class DrivePart:
+    """The drive: torques on the input and output members and, when the input is driven by angle, the input
+    shaft, a torsional spring-damper between the input member and the drive's reference angle."""
 
-    element: ClassVar[str] = "shaft"
-    member: str
-    stiffness: float
+    element: ClassVar[str] = "drive"
+    member: str  # the input
+    output: str
+    stiffness: float | None  # the input shaft's; None: the input is driven by torque
     damping: float
 
 
@@ -64,7 +66,6 @@ def train_parts(spec) -> tuple:
     splines = [SplinePart(planet, crank, stage.cycloid.spline) for stage in spec.stages if stage.cycloid
                for planet, crank in zip(stage.planets, stage.cycloid.cranks)]
     op = spec.operating
-    shaft = [ShaftPart(spec.input, op.input_shaft_stiffness, op.input_shaft_damping)] \
-        if op.input_shaft_stiffness is not None else []
+    drive = DrivePart(spec.input, spec.output, op.input_shaft_stiffness, op.input_shaft_damping)
     cycloids = [stage.cycloid for stage in spec.stages if stage.cycloid]
-    return (*supports, *bearings, *splines, *spec.couplings, *shaft, *spec.meshes, *cycloids)
+    return (*spec.meshes, *supports, *bearings, *spec.couplings, *splines, drive, *cycloids)

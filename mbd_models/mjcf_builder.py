@@ -53,9 +53,12 @@ def _hook(spec: TrainSpec, name: str, *args) -> list:
 
 
 def _springs(spec: TrainSpec) -> dict:
+    """{(member id, joint suffix): (stiffness, damping)}: what every part puts on the members' joints, added."""
     springs = {}
     for part in spec.parts:
-        springs.update(ELEMENTS[part.element].joint_springs(part, spec))
+        for key, (k, c) in ELEMENTS[part.element].joint_springs(part, spec).items():
+            k0, c0 = springs.get(key, (0.0, 0.0))
+            springs[key] = (k0 + k, c0 + c)
     return springs
 
 

@@ -8,6 +8,8 @@ them as one line and exit with status 2, never a traceback.
 
 from __future__ import annotations
 
+import difflib
+
 
 class GearcheckError(ValueError):
     """Base class of every error gearcheck raises on bad input or an impossible request."""
@@ -34,3 +36,14 @@ class DivergenceError(SolverError):
     def __init__(self, time: float, message: str):
         self.time = time
         super().__init__(f"diverged at t = {time:.6g} s: {message}")
+
+
+def did_you_mean(name: str, choices, listing: str = "", *, n: int = 1, cutoff: float = 0.6) -> str:
+    """The hint that follows an unknown ``name``: `` (did you mean 'x'?)`` with the entry of ``choices``
+    closest to it (up to ``n`` of them, as near as ``cutoff``: :func:`difflib.get_close_matches`); with
+    none close, `` (LISTING: a, b, ...)`` naming every choice when ``listing`` is given, else ``""``."""
+    choices = list(choices)
+    close = difflib.get_close_matches(name, choices, n=n, cutoff=cutoff)
+    if close:
+        return f" (did you mean {', '.join(map(repr, close))}?)"
+    return f" ({listing}: {', '.join(choices)})" if listing else ""

@@ -11,12 +11,12 @@ from __future__ import annotations
 import html
 
 STYLE = """
-body { font-family: system-ui, sans-serif; margin: 24px; color: #222; max-width: 1240px; }
+body { font-family: sans-serif; margin: 24px; color: #222; max-width: 1240px; }
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.6em; } h3 { font-size: 1em; margin: 0.2em 0; }
-table { border-collapse: collapse; margin: 0.5em 0 1em; font-size: 0.9em; }
-th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: left; vertical-align: top; }
+table { border-collapse: collapse; margin: 0.5em 0 1em; font-size: 0.85em; }
+th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; vertical-align: top; }
 th { background: #f2f2f2; } td.num, .numbers td, .numbers th { text-align: right; font-variant-numeric: tabular-nums; }
-.numbers td:first-child { text-align: left; }
+.numbers td:first-child, .numbers th:first-child { text-align: left; }
 tr.pass, tr.PASS { background: #dfd; } tr.fail, tr.FAIL { background: #fdd; }
 tr.unresolved, tr.INCONCLUSIVE { background: #ffd; } tr.negligible { color: #777; }
 code { font-size: 0.95em; } .muted { color: #777; } .nowrap { white-space: nowrap; }
@@ -32,7 +32,7 @@ figure { margin: 0 0 1em; } figcaption { font-size: 0.9em; font-weight: 600; } i
 tr.change-point td:first-child { border-left: 4px solid #c51b7d; }
 summary { cursor: pointer; margin: 0.3em 0; } summary code { color: #c51b7d; font-weight: 600; }
 details.section > summary { font-size: 1.2em; font-weight: 600; margin: 0.8em 0; }
-svg { display: block; } svg text { font-family: system-ui, sans-serif; }
+svg { display: block; } svg text { font-family: sans-serif; }
 """
 
 

@@ -26,13 +26,13 @@ code { font-size: 0.95em; } .muted { color: #777; } .nowrap { white-space: nowra
 .banner.PASS { background: #2e7d32; } .banner.FAIL { background: #c62828; }
 .banner.INCONCLUSIVE { background: #e08a00; }
 .grid { display: grid; grid-template-columns: repeat(auto-fill, minmax(520px, 1fr)); gap: 10px 18px; }
-.grid svg { max-width: 100%; height: auto; }
-figure { margin: 0 0 1em; } figcaption { font-size: 0.9em; font-weight: 600; } img { max-width: 100%; }
+.grid figure { margin: 0; } .grid svg { max-width: 100%; height: auto; }
+figcaption { font-size: 0.9em; font-weight: 600; } img { max-width: 100%; }
 .card { border: 1px solid #ddd; border-radius: 4px; padding: 8px; margin: 10px 0; }
 tr.change-point td:first-child { border-left: 4px solid #c51b7d; }
 summary { cursor: pointer; margin: 0.3em 0; } summary code { color: #c51b7d; font-weight: 600; }
 details.section > summary { font-size: 1.2em; font-weight: 600; margin: 0.8em 0; }
-svg { display: block; } svg text { font-family: sans-serif; }
+svg { display: block; } svg text { font-family: system-ui, sans-serif; }
 """
 
 

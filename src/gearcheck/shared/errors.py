@@ -3,7 +3,8 @@
 Every error a user can provoke with a train file or a command-line option is a
 ``GearcheckError``.  Messages name the file and the field path
 (``demo.toml: stages[0].sun.teeth: ...``) so the command-line interface can print
-them as one line and exit with status 2, never a traceback.
+them as one line and exit with status 2, never a traceback; a name that is not known ends
+with :func:`did_you_mean`'s hint.
 """
 
 from __future__ import annotations

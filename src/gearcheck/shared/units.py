@@ -2,7 +2,8 @@
 everything inside gearcheck is SI (m, kg, s, N, rad).
 
 ``SUFFIXES`` maps a train-file key suffix to its unit label and the factor that takes the value
-to SI; the schema converts with it once, at loading.
+to SI; the schema converts with it once, at loading.  :func:`checked_rpm` is the one check of a
+speed given in rpm outside a train file.
 """
 
 from __future__ import annotations

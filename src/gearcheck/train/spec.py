@@ -9,7 +9,6 @@ with an error that names the file and the field.
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import math
 from dataclasses import dataclass, field, replace
@@ -25,7 +24,7 @@ from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geom
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import train_parts
 from gearcheck.train.schema import Context, parse_measurements
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
 
 MIN_TEETH = 6
 MAX_BACKLASH = 0.5  # modules: beyond, the backlash is more than the tooth space leaves
@@ -276,12 +275,12 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     train = data["train"]
     for key in ("input", "output"):
         if train[key] not in members:
-            raise fail(f"train.{key}", f"no member {train[key]!r}{_known(train[key], members)}")
+            raise fail(f"train.{key}", f"no member {train[key]!r}{did_you_mean(train[key], members, 'members')}")
     for j, ref in enumerate(train["held"]):
         if ref in train["held"][:j]:
             raise fail(f"train.held[{j}]", f"{ref} is held twice")
         if ref not in members:
-            raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
+            raise fail(f"train.held[{j}]", f"no member {ref!r}{did_you_mean(ref, members, 'members')}")
         if members[ref].kind not in HOLDABLE:
             raise fail(f"train.held[{j}]", f"{ref} is a {members[ref].kind}; only a sun, ring, carrier or pin wheel "
                                            "can be held")
@@ -297,7 +296,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     for j, c in enumerate(data["couplings"]):
         for key in ("from", "to"):
             if c[key] not in members:
-                raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{_known(c[key], members)}")
+                raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{did_you_mean(c[key], members, 'members')}")
             if members[c[key]].kind not in HOLDABLE:
                 raise fail(f"couplings[{j}].{key}", f"{c[key]} is a {members[c[key]].kind}; a coupling joins "
                                                     "central members (sun, ring, carrier, pin wheel)")
@@ -357,11 +356,6 @@ def flat_tolerances(table: dict, fail) -> dict[str, float]:
 
     walk(table, "")
     return flat
-
-
-def _known(ref: str, members) -> str:
-    close = difflib.get_close_matches(ref, list(members), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
 
 
 def beside(source: str, name: str):
@@ -786,9 +780,7 @@ def _check_stiffness(params: dict, path: str, fail):
     """Check a ``stiffness`` table against its model's parameter table; store SI values in place."""
     name = params["model"]
     if name not in MODELS:
-        close = difflib.get_close_matches(name, list(MODELS), n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{hint}")
+        raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{did_you_mean(name, MODELS)}")
     values = {k: v for k, v in params.items() if k != "model"}
     checked = MODELS[name].parameters.parse(values, path, Context(fail("", "").source))
     params.clear()

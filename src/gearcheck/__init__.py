@@ -7,6 +7,9 @@
 
 The front door:
 
+* :class:`Train` -- a session: one train, its lumped model and MuJoCo twin built once, every study below a
+  method (``modes``, ``simulate``, ``crosscheck``, ``campbell``, ``mac``, ``ste``, ``sweep``, ``animate``,
+  ``mjcf``); every result draws itself with ``plot()`` (a matplotlib Figure, no pyplot);
 * :func:`load` -- a train (preset name, train file, or TrainSpec), validated;
 * :func:`modes` -- natural frequencies and mode types, either solver;
 * :func:`simulate` -- a time run, either solver: a :class:`TimeResult` with named signals;
@@ -48,6 +51,7 @@ from gearcheck.api import (  # noqa: E402
 )
 from gearcheck.compare.engine.comparison import CrosscheckResult
 from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
+from gearcheck.session import Train
 from gearcheck.train.spec import TrainSpec
 from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
 from gearcheck.shared.modal import ModalResult
@@ -56,7 +60,7 @@ from gearcheck.shared.results import TimeResult
 __version__ = metadata.version("gearcheck")
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "LinearModel", "Mesh", "ModalResult",
-           "Periodic", "SolverError", "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell",
+           "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec", "__version__", "campbell",
            "crosscheck",
            "export_model", "harmonic_response", "load", "mjcf", "mode_pairing", "modes", "presets", "sensitivity",
            "simulate", "sweep", "write_report"]

@@ -17,8 +17,9 @@ from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
 from gearcheck.compare.engine.user_model import user_side
 from gearcheck.compare.studies.campbell import CampbellResult, campbell
+from gearcheck.lumped import time_solver
 from gearcheck.lumped.side import LumpedSide
-from gearcheck.lumped.transmission_error import static_transmission_error
+from gearcheck.lumped.transmission_error import relief_sweep, static_transmission_error
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
@@ -80,10 +81,17 @@ class Train:
         return side.modes() if speed is None else side.modes_at_speed(rpm_to_rad_s(rpm(speed)))
 
     def simulate(self, solver: str = "lumped", duration: float = 0.2, *, dt: float | None = None,
-                 output_dt: float | None = None, settle: float | None = None, method: str = "rk4",
+                 output_dt: float | None = None, settle: float | None = None, method: str = "rk4", y0=None,
                  progress=None) -> TimeResult:
-        """A time run at the session's operating point.  See :func:`gearcheck.simulate`."""
-        return self.side(solver, method).run(RunSettings(duration, dt, output_dt, settle), progress)
+        """A time run at the session's operating point.  See :func:`gearcheck.simulate`; ``y0``: the lumped
+        model's start (q, q_dot) over its coordinates (``lumped.model.dofs.labels()``) instead of the static
+        one, e.g. the end of another run (a sweep that follows one branch of a nonlinear response)."""
+        settings = RunSettings(duration, dt, output_dt, settle)
+        if y0 is None:
+            return self.side(solver, method).run(settings, progress)
+        if solver != "lumped":
+            raise GearcheckError(f"y0 applies to the lumped solver only, not {solver!r}")
+        return time_solver.simulate(self.lumped.model, settings, method=method, y0=y0, progress=progress)
 
     def crosscheck(self, **options) -> CrosscheckResult:
         """Both solvers compared; ``options`` those of :func:`gearcheck.crosscheck`.  The engine builds its own
@@ -111,6 +119,11 @@ class Train:
         (:func:`gearcheck.lumped.transmission_error.static_transmission_error`; ``slices``: face-width slices
         of a helical mesh)."""
         return static_transmission_error(self.spec, slices=slices)
+
+    def relief_sweep(self, amounts, slices: int | None = None) -> dict:
+        """The loaded static transmission error's peak-to-peak of the first planet's relieved meshes at each tip
+        relief amount of ``amounts`` (m) (:func:`gearcheck.lumped.transmission_error.relief_sweep`)."""
+        return relief_sweep(self.spec, amounts, slices=slices)
 
     def sweep(self, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
               solver: str = "both", duration: float = 0.5, harmonics: int = 3, integration_check: bool = True,

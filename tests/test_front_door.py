@@ -208,3 +208,15 @@ def test_dataframes_carry_units(demo):
 def test_a_bad_plot_selection_names_the_parameter(demo, call, message):
     with pytest.raises(gearcheck.GearcheckError, match=re.escape(message)):
         call(demo)
+
+
+def test_a_lumped_run_starts_where_another_ended(demo):
+    """Train.simulate's y0: one branch of a nonlinear response followed from speed to speed (backlash_jump.ipynb)."""
+    first = demo.simulate("lumped", 0.005)
+    labels = demo.lumped.model.dofs.labels()
+    y0 = (np.array([first.raw[c][-1] for c in labels]), np.array([first.raw[f"{c}_dot"][-1] for c in labels]))
+    second = demo.simulate("lumped", 0.005, y0=y0)
+    np.testing.assert_array_equal([second.raw[c][0] for c in labels], y0[0])
+    assert not np.array_equal(second.values, first.values)
+    with pytest.raises(gearcheck.GearcheckError, match="y0 applies to the lumped solver only"):
+        demo.simulate("mujoco", 0.005, y0=y0)

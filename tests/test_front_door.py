@@ -220,3 +220,15 @@ def test_a_lumped_run_starts_where_another_ended(demo):
     assert not np.array_equal(second.values, first.values)
     with pytest.raises(gearcheck.GearcheckError, match="y0 applies to the lumped solver only"):
         demo.simulate("mujoco", 0.005, y0=y0)
+
+
+def test_the_harmonic_response_of_a_session_is_the_front_doors(demo):
+    from gearcheck.lumped.assembly import build_model
+    from gearcheck.lumped.forced_response import parametric_problem
+    from gearcheck.lumped.fourier_response import harmonic_balance_response
+
+    direct = harmonic_balance_response(parametric_problem(build_model(gearcheck.load("demo-3p"))), (3,))
+    for result in (demo.harmonic_response(orders=[3]), gearcheck.harmonic_response("demo-3p", orders=[3])):
+        np.testing.assert_array_equal(result.amplitudes, direct.amplitudes)
+    with pytest.raises(gearcheck.GearcheckError, match="method 'fourier': one of harmonic balance, Fourier series"):
+        demo.harmonic_response("fourier")

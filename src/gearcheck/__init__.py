@@ -8,8 +8,9 @@
 The front door:
 
 * :class:`Train` -- a session: one train, its lumped model and MuJoCo twin built once, every study below a
-  method (``modes``, ``simulate``, ``crosscheck``, ``campbell``, ``mac``, ``ste``, ``sweep``, ``animate``,
-  ``mjcf``); every result draws itself with ``plot()`` (a matplotlib Figure, no pyplot);
+  method (``modes``, ``simulate``, ``crosscheck``, ``campbell``, ``mac``, ``harmonic_response``, ``ste``,
+  ``relief_sweep``, ``sweep``, ``animate``, ``mjcf``); every result draws itself with ``plot()`` (a matplotlib
+  Figure, no pyplot) and a DataFrame carries its columns' units in ``attrs["units"]``;
 * :func:`load` -- a train (preset name, train file, or TrainSpec), validated; :func:`load_text` one from TOML text,
   :func:`preset_text` a preset's text, :func:`edited` a preset with its text edited (pattern, replacement);
 * :func:`kinematics`, :class:`Excitation` -- a train's nominal speeds and mesh frequencies, and its excitation

@@ -4,7 +4,8 @@ Every function takes a train as a preset name (``"hub-drive"``), the path of a t
 loaded :class:`~gearcheck.train.spec.TrainSpec`.  Bad input raises a
 :class:`~gearcheck.shared.errors.GearcheckError` whose message names the file, field or argument.
 The studies of one train are methods of a :class:`~gearcheck.session.Train` session, which keeps its two models;
-each function here is that method on a new session.
+``modes``, ``simulate``, ``campbell``, ``mode_pairing`` (``Train.mac``), ``harmonic_response``, ``sweep`` and
+``mjcf`` here are those methods on a new session.
 """
 
 from __future__ import annotations
@@ -15,11 +16,8 @@ from gearcheck.compare.studies.campbell import CampbellResult
 from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing
 from gearcheck.compare.presentation.report import write_report
-from gearcheck.compare.studies.sensitivity import field_sensitivity, lattice
-from gearcheck.lumped.assembly import build_model
+from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
-from gearcheck.lumped.forced_response import parametric_problem
-from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
 from gearcheck.session import SOLVERS, Train
 from gearcheck.train.loader import load_train, preset_names, read_train_text
 from gearcheck.train.spec import TrainSpec
@@ -228,11 +226,7 @@ def harmonic_response(train, method: str = "harmonic balance", orders=None, spee
     model's coordinates
     (``.at(t)``, ``.harmonic(h)``).  Trains with backlash, tip relief, transmission error or a varying torque
     are refused (time marching holds them)."""
-    methods = {"harmonic balance": harmonic_balance_response, "Fourier series": fourier_series_response}
-    if method not in methods:
-        raise GearcheckError(f"method {method!r}: one of {', '.join(methods)}")
-    problem = parametric_problem(build_model(load(train, speed)))
-    return methods[method](problem, lattice(problem, orders))
+    return Train(train, speed).harmonic_response(method, orders)
 
 
 def sensitivity(train, parameter: str, method: str = "Fourier series", orders=None, speed: float | None = None):

@@ -17,7 +17,10 @@ from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
 from gearcheck.compare.engine.user_model import user_side
 from gearcheck.compare.studies.campbell import CampbellResult, campbell
+from gearcheck.compare.studies.sensitivity import lattice
 from gearcheck.lumped import time_solver
+from gearcheck.lumped.forced_response import parametric_problem
+from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.lumped.transmission_error import relief_sweep, static_transmission_error
 from gearcheck.mbd_models.side import MujocoSide
@@ -113,6 +116,15 @@ class Train:
         if model is None:
             return pair_modes(self.spec.name, self.lumped, self.mujoco)
         return pair_modes(self.spec.name, self.side(against), user_side(model, self.spec))
+
+    def harmonic_response(self, method: str = "harmonic balance", orders=None):
+        """The steady forced response of the lumped model by harmonic balance or the Fourier-series method of
+        Yang, Chen & Wang (2018).  See :func:`gearcheck.harmonic_response`."""
+        methods = {"harmonic balance": harmonic_balance_response, "Fourier series": fourier_series_response}
+        if method not in methods:
+            raise GearcheckError(f"method {method!r}: one of {', '.join(methods)}")
+        problem = parametric_problem(self.lumped.model)
+        return methods[method](problem, lattice(problem, orders))
 
     def ste(self, slices: int | None = None) -> list:
         """The static transmission error of every mesh over one mesh cycle, unloaded and under the train's load

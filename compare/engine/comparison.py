@@ -46,7 +46,7 @@ from gearcheck.compare.engine.metrics import modal_metrics, spectral_metrics, wa
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError
-from gearcheck.shared.figures import chosen
+from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.side import display_name

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gearcheck.shared.figures import chosen
+from gearcheck.shared.selection import chosen
 from gearcheck.train.kinematics import kinematics
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.units import rpm_to_rad_s

@@ -73,7 +73,7 @@ from gearcheck.train.spec import TrainSpec, beside
 from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
-from gearcheck.shared.figures import chosen
+from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory, check_place
 from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
@@ -668,8 +668,8 @@ class SweepResult:
         """The table as a DataFrame, its columns' units in ``attrs["units"]`` (``"unit"``: the row's ``unit``
         column; ``"file"``: the train file's own unit of a swept field)."""
         frame = self.table.to_pandas()
-        frame.attrs["units"] = {name: unit for name, (unit, _) in COLUMNS.items()} | dict.fromkeys(self.plan.fields,
-                                                                                                  "file")
+        units = {name: unit for name, (unit, _) in COLUMNS.items()}
+        frame.attrs["units"] = units | dict.fromkeys(self.plan.fields, "file")
         return frame
 
     def plot(self, quantity: str | None = None):

@@ -1,4 +1,4 @@
-"""Figures of the floor's results (a time run, a set of modes) and the check of what a ``plot()`` is asked to show.
+"""Figures of the floor's results: a time run, a set of modes.
 
 Drawn on :class:`matplotlib.figure.Figure` objects without pyplot, so drawing never touches the user's matplotlib
 backend (the compare-level results draw with :mod:`gearcheck.compare.presentation.plots` the same way).
@@ -6,26 +6,10 @@ backend (the compare-level results draw with :mod:`gearcheck.compare.presentatio
 
 from __future__ import annotations
 
-import difflib
-
 import numpy as np
 from matplotlib.figure import Figure
 
-from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import GROUPS
-
-
-def chosen(parameter: str, values, known, what: str) -> list:
-    """``values`` (one or several) as a list, each one of ``known``; else a GearcheckError naming ``parameter``,
-    the value and what it should be (``what``), with the nearest known one."""
-    known = list(known)
-    values = [values] if isinstance(values, (str, int)) else list(values)
-    for value in values:
-        if value not in known:
-            close = difflib.get_close_matches(str(value), [str(k) for k in known], n=1)
-            hint = f"did you mean {close[0]!r}?" if close else f"choose from {', '.join(map(str, known[:8]))}"
-            raise GearcheckError(f"{parameter}: {value!r} is not {what} ({hint})")
-    return values
 
 
 def time_figure(result, names) -> Figure:

@@ -26,6 +26,8 @@ import numpy as np
 import pandas as pd
 import scipy.linalg as sla
 
+from gearcheck.shared.selection import chosen
+
 ENERGY_TOLERANCE = 1e-8
 DEGENERACY_TOLERANCE = 1e-7  # relative frequency difference grouped as one multiple frequency
 RIGID_TOLERANCE = 1e-9  # omega^2 below this times the largest one is a rigid-body mode
@@ -77,7 +79,7 @@ class ModalResult:
     def plot(self, types=None):
         """A :class:`matplotlib.figure.Figure` (no pyplot) of the natural frequencies of the modes of ``types`` (a
         mode type or several; default: all), with their kinetic-energy shares."""
-        from gearcheck.shared.figures import chosen, modes_figure
+        from gearcheck.shared.figures import modes_figure
 
         present = list(dict.fromkeys(self.types))
         shown = present if types is None else chosen("types", types, present, f"a mode type of {self.train}")

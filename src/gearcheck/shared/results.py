@@ -30,6 +30,7 @@ import pandas as pd
 
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.outputs import OutputDirectory
+from gearcheck.shared.selection import chosen
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,7 @@ class TimeResult:
     def plot(self, signals=None):
         """A :class:`matplotlib.figure.Figure` (no pyplot) of ``signals`` (a name or several; default: those the
         cross-check gates) against time, one panel per kind of signal."""
-        from gearcheck.shared.figures import chosen, time_figure
+        from gearcheck.shared.figures import time_figure
 
         if signals is None:
             return time_figure(self, self.names(compared=True) or self.names())

@@ -232,3 +232,13 @@ def test_the_harmonic_response_of_a_session_is_the_front_doors(demo):
         np.testing.assert_array_equal(result.amplitudes, direct.amplitudes)
     with pytest.raises(gearcheck.GearcheckError, match="method 'fourier': one of harmonic balance, Fourier series"):
         demo.harmonic_response("fourier")
+
+
+def test_the_teaching_notebooks_use_the_front_door_only():
+    """`import gearcheck` and its public names: no notebook reaches into the packages."""
+    import nbformat
+
+    for path in sorted((README.parent / "examples" / "teaching").glob("*.ipynb")):
+        code = "\n".join(c.source for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code")
+        assert not re.findall(r"(?:from|import)\s+gearcheck\.", code), path.name
+        assert not re.findall(r"gearcheck\.\w+\.\w", code), path.name

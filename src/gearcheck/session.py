@@ -89,12 +89,12 @@ class Train:
         """A time run at the session's operating point.  See :func:`gearcheck.simulate`; ``y0``: the lumped
         model's start (q, q_dot) over its coordinates (``lumped.model.dofs.labels()``) instead of the static
         one, e.g. the end of another run (a sweep that follows one branch of a nonlinear response)."""
-        settings = RunSettings(duration, dt, output_dt, settle)
+        settings, side = RunSettings(duration, dt, output_dt, settle), self.side(solver, method)
         if y0 is None:
-            return self.side(solver, method).run(settings, progress)
+            return side.run(settings, progress)
         if solver != "lumped":
             raise GearcheckError(f"y0 applies to the lumped solver only, not {solver!r}")
-        return time_solver.simulate(self.lumped.model, settings, method=method, y0=y0, progress=progress)
+        return time_solver.simulate(side.model, settings, method=method, y0=y0, progress=progress)
 
     def crosscheck(self, **options) -> CrosscheckResult:
         """Both solvers compared; ``options`` those of :func:`gearcheck.crosscheck`.  The engine builds its own

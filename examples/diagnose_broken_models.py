@@ -41,7 +41,6 @@ import numpy as np  # noqa: E402
 
 import gearcheck  # noqa: E402
 from gearcheck.compare.engine.diagnosis import COEFFICIENT_FLOOR, Evidence, diagnose  # noqa: E402
-from gearcheck.lumped.assembly import build_model  # noqa: E402
 from gearcheck.train.spec import AXIAL  # noqa: E402
 
 PRESETS = ("demo-3p", "demo-4p", "hub-drive", "double-planet", "helical-planetary")
@@ -132,7 +131,7 @@ def mistakes(model, cls: str) -> list[Mistake]:
 def run(task: tuple[str, str, str]) -> dict:
     """Every mistake of one class on one preset, diagnosed from one kind of evidence."""
     evidence, preset, cls = task
-    model = build_model(gearcheck.load(preset))
+    model = gearcheck.Train(preset).lumped.model
     counts = dict(instances=0, no_effect=0, top1=0, top3=0, exact=0, classes=0)
     misses, closest = [], None  # closest: (runner-up score, what)
     start = time.process_time()

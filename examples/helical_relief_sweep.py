@@ -18,7 +18,6 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import gearcheck
-from gearcheck.train.variants import edited
 
 AMOUNTS_UM = (0.0, 2.5, 5.0, 7.5, 10.0, 15.0, 20.0, 30.0)
 DURATION = 0.07
@@ -48,8 +47,9 @@ def statistics(run, mesh: str) -> dict:
 def main(out: Path) -> None:
     results = {}
     for amount in AMOUNTS_UM:
-        spec = edited("helical-planetary", [(r"amount_um = 0.0", f"amount_um = {amount!r}")], f"{amount} um")
-        runs = {solver: gearcheck.simulate(spec, solver=solver, duration=DURATION) for solver in ("lumped", "mujoco")}
+        train = gearcheck.Train(gearcheck.edited("helical-planetary", [(r"amount_um = 0.0", f"amount_um = {amount!r}")],
+                                                 f"{amount} um"))
+        runs = {solver: train.simulate(solver, duration=DURATION) for solver in ("lumped", "mujoco")}
         results[amount] = {solver: {name: statistics(run, mesh) for name, mesh in MESHES.items()}
                            for solver, run in runs.items()}
         print(f"{amount:5.1f} um (lumped; MuJoCo's figures in the files): " + "  ".join(

@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-from gearcheck.compare.presentation.plots import _png
-from gearcheck.compare.studies.uncertainty import NOMINAL, band, drivers, uncertainty_study
-from gearcheck.train.loader import load_text, read_train_text
+import gearcheck
+from gearcheck.compare.studies.uncertainty import NOMINAL, band, drivers, uncertainty_study  # no front door yet
 
 G = 9.8  # m/s^2 per g, as the paper
 FITS = ["stages[0].mesh.ste[0].amplitude_um=0.2:20", "operating.output_torque=20:20000"]
@@ -84,8 +84,8 @@ def g(x):
 
 
 def run(args) -> pd.DataFrame:
-    text, source = read_train_text("hub-drive")
-    entries = list(load_text(text, source).measurements)
+    text, source = gearcheck.preset_text("hub-drive"), "preset:hub-drive"
+    entries = list(gearcheck.load_text(text, source).measurements)
     laws = {path: law for path, (law, _) in DISTRIBUTIONS.items()}
     args.cache.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -169,9 +169,7 @@ def _plain(axis):
     axis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}" if f"{v:.1e}"[0] in "235" else ""))
 
 
-def band_figure(frame: pd.DataFrame) -> bytes:
-    from matplotlib.figure import Figure
-
+def band_figure(frame: pd.DataFrame) -> Figure:
     ok = frame[(frame["sample"] != NOMINAL) & (frame["error"] == "")]
     nominal = frame[frame["sample"] == NOMINAL].iloc[0]
     fit_ok = (ok["fit_error:" + RING].abs() < FIT_OK) & (ok["fit_error:" + CARRIER].abs() < FIT_OK)
@@ -228,12 +226,10 @@ def band_figure(frame: pd.DataFrame) -> bytes:
     ax.legend(fontsize=7, loc="best")
     fig.suptitle("hub-drive (Li et al. 2026, Table 1): Monte Carlo of calibrate-at-606-then-predict-1823 over the "
                  "unpublished parameters' plausible ranges", fontsize=10)
-    return _png(fig)
+    return fig
 
 
-def drivers_figure(frame: pd.DataFrame) -> bytes:
-    from matplotlib.figure import Figure
-
+def drivers_figure(frame: pd.DataFrame) -> Figure:
     ok = frame[(frame["sample"] != NOMINAL) & (frame["error"] == "")]
     outputs = [("predicted:" + RING, "ring I at 1823 rpm"), ("predicted:" + CARRIER, "carrier II at 1823 rpm"),
                ("fit_cost", "fit cost at 606 rpm")]
@@ -264,7 +260,7 @@ def drivers_figure(frame: pd.DataFrame) -> bytes:
     axes[0].legend(fontsize=7.5, loc="lower left")
     fig.suptitle(f"What drives the spread: {len(ok)} samples, each calibrated at 606 rpm (shaded rows: the fit's "
                  "results, Spearman only; the others: drawn numbers)", fontsize=10)
-    return _png(fig)
+    return fig
 
 
 def main():
@@ -289,8 +285,8 @@ def main():
         frame.to_csv(csv, index=False, float_format="%.10g")
     summary = summarise(frame)
     (args.out / "summary.json").write_text(json.dumps(summary, indent=1, sort_keys=True) + "\n")
-    (args.out / "band.png").write_bytes(band_figure(frame))
-    (args.out / "drivers.png").write_bytes(drivers_figure(frame))
+    for name, draw in (("band.png", band_figure), ("drivers.png", drivers_figure)):
+        draw(frame).savefig(args.out / name, dpi=110, metadata={"Software": None})
     for q in (RING, CARRIER):
         o = summary["outputs"][q]
         b = o["band_g"]

@@ -12,18 +12,17 @@ from dataclasses import fields, replace
 
 import numpy as np
 
+import gearcheck
 from gearcheck.lumped import time_solver
-from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.elements.cycloid import CycloidRows
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import harmonic_balance_response
-from gearcheck.train.loader import load_train
 from gearcheck.shared.settings import RunSettings
 
 DURATION, WINDOW, GRID = 0.16, 0.04, 2048
 COORDINATES = ("rv.sun.theta", "rv.carrier.theta", "rv.crank1.theta", "rv.planet1.tangential", "rv.disc1.x")
 
-model = build_model(load_train("rv-reducer"))
+model = gearcheck.Train("rv-reducer").lumped.model
 contacts: dict = {}
 balance = harmonic_balance_response(parametric_problem(model, eccentric_grid=GRID, contacts=contacts), (30, 4))
 stage = next(e for e in model.turning if isinstance(e, CycloidRows))

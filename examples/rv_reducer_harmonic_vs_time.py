@@ -10,20 +10,18 @@ Yang, Chen & Wang (2018) Eqs. 5-6.
 
 import numpy as np
 
-from gearcheck.lumped import time_solver
-from gearcheck.lumped.assembly import build_model
+import gearcheck
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
-from gearcheck.train.loader import load_train
-from gearcheck.shared.settings import RunSettings
 
 DURATION, WINDOW = 0.16, 0.04
 COORDINATES = ("rv.sun.theta", "rv.carrier.theta", "rv.crank1.theta", "rv.planet1.tangential", "rv.disc1.x",
                "rv.disc1.theta")
 
-model = build_model(load_train("rv-reducer"))
+train = gearcheck.Train("rv-reducer")
+model = train.lumped.model
 problem = parametric_problem(model)
-run = time_solver.simulate(model, RunSettings(duration=DURATION))
+run = train.simulate("lumped", DURATION)
 labels = model.dofs.labels()
 window = run.t > DURATION - WINDOW
 print(f"{'lattice':>24} {'method':>16}  " + "  ".join(f"{c:>22}" for c in COORDINATES))

@@ -17,9 +17,7 @@ derived here.  Run it:
 
 import numpy as np
 
-from gearcheck import LinearModel, Mesh, Periodic
-from gearcheck.train.excitation import Excitation
-from gearcheck.train.kinematics import kinematics
+from gearcheck import Excitation, LinearModel, Mesh, Periodic, kinematics
 
 SAMPLES = 4096  # of each mesh's stiffness over its cycle
 

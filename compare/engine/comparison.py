@@ -46,6 +46,7 @@ from gearcheck.compare.engine.metrics import modal_metrics, spectral_metrics, wa
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError
+from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.side import display_name
@@ -135,6 +136,15 @@ class CrosscheckResult:
             if q.name == name:
                 return q
         raise KeyError(f"no compared quantity {name!r}")
+
+    def plot(self, quantities=None):
+        """Both sides' steady time histories of ``quantities`` (a name or several; default: the report's headline
+        ones) as a :class:`matplotlib.figure.Figure` (no pyplot)."""
+        from gearcheck.compare.presentation.plots import time_histories_figure
+
+        names = None if quantities is None else chosen("quantities", quantities, [q.name for q in self.quantities],
+                                                        f"a compared quantity of {self.spec.name}")
+        return time_histories_figure(self, names)
 
     def write(self, directory) -> dict:
         """Write report.json, report.md, report.html and the figures as the folder ``directory``, whole or

@@ -38,6 +38,12 @@ class ModePairing:
     paired: np.ndarray  # per reference mode: its share in its own frequency group's test modes
     findings: list[str] = field(default_factory=list)
 
+    def plot(self):
+        """The MAC matrix as a :class:`matplotlib.figure.Figure` (no pyplot)."""
+        from gearcheck.compare.presentation.plots import mac_figure
+
+        return mac_figure(self)
+
     def to_dict(self) -> dict:
         return {"train": self.train, "reference": self.reference, "test": self.test,
                 "frequencies_reference_hz": self.frequencies_reference.tolist(),

@@ -72,8 +72,10 @@ def _title(result, what: str) -> str:
             f"dt={s['mujoco'].get('dt_s', float('nan')):.3g} s")
 
 
-def time_histories(result, path, cycles: int = 4):
-    names = headline_quantities(result)
+def time_histories_figure(result, names=None, cycles: int = 4) -> Figure:
+    """Both sides of the quantities ``names`` (default: :func:`headline_quantities`) over the last ``cycles``
+    steady cycles, one panel each."""
+    names = headline_quantities(result) if names is None else names
     units = {q.name: q.unit for q in result.quantities}
     f_cycle = 1.0 / result.settings["steady_cycle_s"]
     t = result.grid
@@ -91,7 +93,11 @@ def time_histories(result, path, cycles: int = 4):
     axes[0, 0].legend(loc="upper right", fontsize=8)
     axes[-1, 0].set_xlabel("time [ms]")
     fig.suptitle(_title(result, f"steady-state time histories, last {cycles} mesh cycles"), fontsize=9)
-    _save(fig, path)
+    return fig
+
+
+def time_histories(result, path, cycles: int = 4):
+    _save(time_histories_figure(result, cycles=cycles), path)
 
 
 LOG_SPAN = 20.0  # a spectrum spanning more than this ratio of frequencies gets a logarithmic frequency axis
@@ -327,20 +333,21 @@ def mesh_stiffness(spec, cycles: int = 2) -> bytes:
     return _png(fig)
 
 
-def campbell_diagram(result) -> bytes:
-    """PNG of a :class:`~gearcheck.compare.studies.campbell.CampbellResult`: lumped curves, MuJoCo markers, mesh
-    lines, their crossings with the curves, instability zones shaded."""
+def campbell_figure(result, solvers=None) -> Figure:
+    """A :class:`~gearcheck.compare.studies.campbell.CampbellResult` drawn: lumped curves, MuJoCo markers, mesh
+    lines, their crossings with the curves, instability zones shaded; ``solvers``: those drawn (default: all)."""
     fig, ax = _figure(figsize=(9, 6))
     speeds = result.speeds_rpm
+    shown = list(result.results) if solvers is None else list(solvers)
     for solver, style in (("lumped", {"color": "tab:blue", "lw": 1.0}),
                           ("mujoco", {"color": "tab:orange", "ls": "none", "marker": ".", "ms": 3})):
-        if solver not in result.results:
+        if solver not in shown:
             continue
         f = result.frequencies(solver)
         for mode in range(f.shape[1]):
             ax.plot(speeds, f[:, mode], **style, label=("lumped" if solver == "lumped" else "MuJoCo")
                     if mode == 0 else None)
-    top = max(float(np.max(result.frequencies(s))) for s in result.results) * 1.05
+    top = max(float(np.max(result.frequencies(s))) for s in shown) * 1.05
     for line in result.mesh_lines:
         ax.plot(speeds, line["hz_per_rpm"] * speeds, color="gray", lw=0.7, ls=":" if line["harmonic"] > 1 else "-")
         end = min(speeds[-1], top / line["hz_per_rpm"]) if line["hz_per_rpm"] > 0 else speeds[-1]
@@ -361,7 +368,12 @@ def campbell_diagram(result) -> bytes:
                  + (f"; solvers agree to {agreement:.1e}" if agreement is not None else ""), fontsize=9)
     ax.legend(loc="upper left", fontsize=7)
     ax.grid(alpha=0.3)
-    return _png(fig)
+    return fig
+
+
+def campbell_diagram(result) -> bytes:
+    """PNG of :func:`campbell_figure`."""
+    return _png(campbell_figure(result))
 
 
 def static_transmission_error(curves, train: str) -> bytes:
@@ -401,8 +413,8 @@ def relief_sweep(sweep: dict, train: str) -> bytes:
     return _png(fig)
 
 
-def mac_heatmap(pairing) -> bytes:
-    """PNG of a :class:`~gearcheck.compare.engine.mode_pairing.ModePairing`: the MAC matrix, reference modes down, test
+def mac_figure(pairing) -> Figure:
+    """A :class:`~gearcheck.compare.engine.mode_pairing.ModePairing` drawn: the MAC matrix, reference modes down, test
     modes across, with the frequencies on the axes."""
     fig, ax = _figure(figsize=(7.5, 6.5))
     image = ax.imshow(pairing.mac, vmin=0.0, vmax=1.0, cmap="viridis", origin="upper", aspect="auto")
@@ -415,7 +427,12 @@ def mac_heatmap(pairing) -> bytes:
     ax.set_xlabel(f"{pairing.test} modes [Hz]")
     ax.set_title(f"{pairing.train}: modal assurance criterion, worst paired {pairing.paired.min():.9f}"
                  + (f"; {len(pairing.findings)} findings" if pairing.findings else ""), fontsize=9)
-    return _png(fig)
+    return fig
+
+
+def mac_heatmap(pairing) -> bytes:
+    """PNG of :func:`mac_figure`."""
+    return _png(mac_figure(pairing))
 
 
 

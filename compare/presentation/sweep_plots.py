@@ -67,6 +67,11 @@ def crossings(speeds, mode_hz, line_hz) -> list[tuple[float, int]]:
 
 
 def order_plot(frame, train: str, quantity: str) -> bytes:
+    return _png(order_figure(frame, train, quantity))
+
+
+def order_figure(frame, train: str, quantity: str) -> Figure:
+    """The order plot of ``quantity`` (see the module's docstring)."""
     rows = frame[(frame["quantity"] == quantity) & (frame["metric"] == "harmonic")]
     solvers = list(dict.fromkeys(rows["solver"]))
     unit = rows["unit"].iloc[0]
@@ -126,7 +131,7 @@ def order_plot(frame, train: str, quantity: str) -> bytes:
         + (f", {unsteady} speeds without a steady state" if unsteady else ""), fontsize=9)
     bottom.grid(True, which="major", alpha=0.3)
     bottom.legend(fontsize=7, ncol=max(1, len(solvers)), loc="best")
-    return _png(fig)
+    return fig
 
 
 def dominant_line(rows) -> tuple[str, int]:
@@ -136,6 +141,11 @@ def dominant_line(rows) -> tuple[str, int]:
 
 
 def study_plot(frame, plan, quantities) -> bytes:
+    return _png(study_figure(frame, plan, quantities))
+
+
+def study_figure(frame, plan, quantities) -> Figure:
+    """The study plot of ``quantities`` (see the module's docstring)."""
     monte_carlo = bool(plan.settings.get("distributions"))
     speeds = np.unique(frame["speed_rpm"].to_numpy())
     n = len(quantities)
@@ -195,4 +205,4 @@ def study_plot(frame, plan, quantities) -> bytes:
     band = "" if lines else " (median, band 5-95 %)" if monte_carlo else " (median, band min-max)"
     title = f"{plan.train}: {what}" + (band if speeds.size >= 2 else f" at {speeds[0]:g} rpm")
     fig.suptitle(textwrap.fill(title, width=60 * cols), fontsize=10)
-    return _png(fig)
+    return fig

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from gearcheck.shared.selection import chosen
 from gearcheck.train.kinematics import kinematics
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.units import rpm_to_rad_s
@@ -40,6 +41,13 @@ class CampbellResult:
         a, b = (self.frequencies(s) for s in self.results)
         elastic = a > 0
         return float(np.max(np.abs(a - b)[elastic] / a[elastic]))
+
+    def plot(self, solvers=None):
+        """The diagram as a :class:`matplotlib.figure.Figure` (no pyplot), of ``solvers`` (default: all)."""
+        from gearcheck.compare.presentation.plots import campbell_figure
+
+        shown = None if solvers is None else chosen("solvers", solvers, self.results, "a solver of this diagram")
+        return campbell_figure(self, shown)
 
     def to_dict(self) -> dict:
         return {

@@ -73,6 +73,7 @@ from gearcheck.train.spec import TrainSpec, beside
 from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
+from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory, check_place
 from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
@@ -659,7 +660,29 @@ class SweepResult:
         return self.plan.settings
 
     def to_pandas(self):
-        return self.table.to_pandas()
+        """The table as a DataFrame, its columns' units in ``attrs["units"]`` (``"unit"``: the row's ``unit``
+        column; ``"file"``: the train file's own unit of a swept field)."""
+        frame = self.table.to_pandas()
+        units = {name: unit for name, (unit, _) in COLUMNS.items()}
+        frame.attrs["units"] = units | dict.fromkeys(self.plan.fields, "file")
+        return frame
+
+    def plot(self, quantity: str | None = None):
+        """The figure of one gated quantity (default: the first headline one) as a :class:`matplotlib.figure.Figure`
+        (no pyplot): its order plot over a speed sweep, its study plot over a parameter study or a Monte Carlo."""
+        from gearcheck.compare.presentation import sweep_plots
+
+        frame = self.to_pandas()
+        plotted = set(frame.loc[frame["metric"] == "harmonic", "quantity"])
+        if quantity is None:
+            quantity = self.headline()[0]
+        else:
+            [quantity] = chosen("quantity", quantity, sorted(plotted), f"a quantity of the sweep of {self.train}")
+        if self.plan.fields:
+            return sweep_plots.study_figure(frame, self.plan, [quantity])
+        if frame["speed_rpm"].nunique() < 2:
+            raise GearcheckError(f"the sweep of {self.train} has one speed and no swept field: nothing to plot")
+        return sweep_plots.order_figure(frame, self.plan.train, quantity)
 
     def parquet(self) -> bytes:
         """The table as Parquet bytes: the same inputs give the same bytes."""

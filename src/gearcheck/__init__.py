@@ -7,7 +7,14 @@
 
 The front door:
 
-* :func:`load` -- a train (preset name, train file, or TrainSpec), validated;
+* :class:`Train` -- a session: one train, its lumped model and MuJoCo twin built once, every study below a
+  method (``modes``, ``simulate``, ``crosscheck``, ``campbell``, ``mac``, ``harmonic_response``, ``ste``,
+  ``relief_sweep``, ``sweep``, ``animate``, ``mjcf``); every result draws itself with ``plot()`` (a matplotlib
+  Figure, no pyplot) and a DataFrame carries its columns' units in ``attrs["units"]``;
+* :func:`load` -- a train (preset name, train file, or TrainSpec), validated; :func:`load_text` one from TOML text,
+  :func:`preset_text` a preset's text, :func:`edited` a preset with its text edited (pattern, replacement);
+* :func:`kinematics`, :class:`Excitation` -- a train's nominal speeds and mesh frequencies, and its excitation
+  (mesh stiffness and transmission error over time): the pieces of a user's own model;
 * :func:`modes` -- natural frequencies and mode types, either solver;
 * :func:`simulate` -- a time run, either solver: a :class:`TimeResult` with named signals;
 * :func:`mjcf` -- the MuJoCo model of a train;
@@ -48,15 +55,20 @@ from gearcheck.api import (  # noqa: E402
 )
 from gearcheck.compare.engine.comparison import CrosscheckResult
 from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
+from gearcheck.session import Train
+from gearcheck.train.excitation import Excitation
+from gearcheck.train.kinematics import kinematics
+from gearcheck.train.loader import load_text, preset_text
 from gearcheck.train.spec import TrainSpec
+from gearcheck.train.variants import edited
 from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 
 __version__ = metadata.version("gearcheck")
 
-__all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "GearcheckError", "LinearModel", "Mesh", "ModalResult",
-           "Periodic", "SolverError", "TimeResult", "TrainFileError", "TrainSpec", "__version__", "campbell",
-           "crosscheck",
-           "export_model", "harmonic_response", "load", "mjcf", "mode_pairing", "modes", "presets", "sensitivity",
-           "simulate", "sweep", "write_report"]
+__all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "GearcheckError", "LinearModel", "Mesh",
+           "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",
+           "__version__", "campbell", "crosscheck", "edited", "export_model", "harmonic_response", "kinematics",
+           "load", "load_text", "mjcf", "mode_pairing", "modes", "preset_text", "presets", "sensitivity", "simulate",
+           "sweep", "write_report"]

@@ -3,6 +3,9 @@
 Every function takes a train as a preset name (``"hub-drive"``), the path of a train file, or a
 loaded :class:`~gearcheck.train.spec.TrainSpec`.  Bad input raises a
 :class:`~gearcheck.shared.errors.GearcheckError` whose message names the file, field or argument.
+The studies of one train are methods of a :class:`~gearcheck.session.Train` session, which keeps its two models;
+``modes``, ``simulate``, ``campbell``, ``mode_pairing`` (``Train.mac``), ``harmonic_response``, ``sweep`` and
+``mjcf`` here are those methods on a new session.
 """
 
 from __future__ import annotations
@@ -10,31 +13,20 @@ from __future__ import annotations
 from pathlib import Path
 
 from gearcheck.compare.studies.campbell import CampbellResult
-from gearcheck.compare.studies.campbell import campbell as campbell_diagram
 from gearcheck.compare.engine.crosscheck import crosscheck
-from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
+from gearcheck.compare.engine.mode_pairing import ModePairing
 from gearcheck.compare.presentation.report import write_report
-from gearcheck.compare.studies.sensitivity import field_sensitivity, lattice
-from gearcheck.compare.engine.user_model import user_side
-from gearcheck.lumped.assembly import build_model
+from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
-from gearcheck.lumped.forced_response import parametric_problem
-from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
+from gearcheck.session import SOLVERS, Train
 from gearcheck.train.loader import load_train, preset_names, read_train_text
-from gearcheck.lumped.side import LumpedSide
 from gearcheck.train.spec import TrainSpec
-from gearcheck.mbd_models.side import MujocoSide
-from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
-from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
 
 __all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "harmonic_response", "load", "mjcf", "mode_pairing",
            "modes", "presets", "sensitivity", "simulate", "sweep", "write_report"]
-
-SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
 
 
 def presets() -> list[str]:
@@ -60,16 +52,6 @@ def load(train: str | Path | TrainSpec, speed: float | None = None) -> TrainSpec
     return load_train(train, speed)
 
 
-def _side(solver: str, spec: TrainSpec, method: str = "rk4"):
-    if solver not in SOLVERS:
-        raise GearcheckError(f"unknown solver {solver!r}; choose one of {', '.join(SOLVERS)}")
-    if solver == "lumped":
-        return LumpedSide(spec, method)
-    if method != "rk4":
-        raise GearcheckError(f"method {method!r} applies to the lumped solver only")
-    return MujocoSide(spec)
-
-
 def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalResult:
     """Natural frequencies, mode shapes, Lin & Parker mode types and energy shares at mean mesh stiffness.
 
@@ -89,12 +71,9 @@ def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalRes
     ModalResult
         ``frequencies`` (Hz), ``shapes``, ``types``, ``multiplicity``, ``fractions`` (kinetic energy in
         central translation, central rotation, planets); at a speed also ``growth`` (1/s), ``stability``
-        and ``stable``; ``to_dataframe()``, ``to_dict()``.
+        and ``stable``; ``to_dataframe()``, ``to_dict()``, ``plot()``.
     """
-    side = _side(solver, load(train))
-    if speed is None:
-        return side.modes()
-    return side.modes_at_speed(rpm_to_rad_s(checked_rpm(speed, zero=True)))
+    return Train(train).modes(solver, speed)
 
 
 def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> CampbellResult:
@@ -114,16 +93,9 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
     -------
     CampbellResult
         ``frequencies(solver)`` (speeds x modes, Hz), ``crossings`` of mesh harmonics with modes,
-        instability ``zones``, ``agreement`` of the two solvers; ``to_dict()``; the figure from
-        :func:`gearcheck.compare.presentation.plots.campbell_diagram`.
+        instability ``zones``, ``agreement`` of the two solvers; ``to_dict()``; ``plot()``.
     """
-    spec = load(train)
-    solvers = tuple(SOLVERS) if solver == "both" else (solver,)
-    sides = {s: _side(s, spec) for s in solvers}
-    speeds = [checked_rpm(v, zero=True) for v in speeds]
-    if len(speeds) < 2 or any(b <= a for a, b in zip(speeds, speeds[1:])):
-        raise GearcheckError(f"speeds: give at least two speeds in ascending order, got {list(speeds)}")
-    return campbell_diagram(spec, speeds, lambda s, w: sides[s].modes_at_speed(w), solvers, harmonics)
+    return Train(train).campbell(speeds, solver, harmonics)
 
 
 def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
@@ -134,13 +106,9 @@ def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
     -------
     ModePairing
         ``mac`` (reference modes x twin modes), ``paired`` (each mode's share in its frequency group's twin
-        modes: 1 is the same shape), ``findings`` (swapped, missing, spurious modes), ``to_dict()``; the
-        figure from :func:`gearcheck.compare.presentation.plots.mac_heatmap`.
+        modes: 1 is the same shape), ``findings`` (swapped, missing, spurious modes), ``to_dict()``; ``plot()``.
     """
-    spec = load(train)
-    if model is None:
-        return pair_modes(spec.name, _side("lumped", spec), _side("mujoco", spec))
-    return pair_modes(spec.name, _side(against, spec), user_side(model, spec))
+    return Train(train).mac(model, against)
 
 
 def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: float | None = None,
@@ -174,10 +142,11 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
     Returns
     -------
     TimeResult
-        Named signals, ``result["stage1.ring.ay.world"]``; ``to_dataframe()``, ``summary()``,
+        Named signals, ``result["stage1.ring.ay.world"]``; ``to_dataframe()``, ``plot()``, ``summary()``,
         ``write(directory)``.
     """
-    return _side(solver, load(train, speed), method).run(RunSettings(duration, dt, output_dt, settle), progress)
+    return Train(train, speed).simulate(solver, duration, dt=dt, output_dt=output_dt, settle=settle, method=method,
+                                        progress=progress)
 
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
@@ -234,15 +203,13 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
     Returns
     -------
     SweepResult
-        ``table`` (pyarrow), ``to_pandas()``, ``summary()``, ``write(directory)`` (``sweep.parquet``,
+        ``table`` (pyarrow), ``to_pandas()``, ``plot()``, ``summary()``, ``write(directory)`` (``sweep.parquet``,
         ``sweep.json``, order plots or a study plot), ``computed``/``cached`` point counts, ``wall_s``.
     """
-    from gearcheck.compare.studies.sweep import sweep as run_sweep
-
-    return run_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples, seed=seed,
-                     solvers=solver, duration=duration, harmonics=harmonics, integration_check=integration_check,
-                     refine=refine, workers=workers, scheduler=scheduler, executor=executor, cache=cache,
-                     progress=progress)
+    return Train(train).sweep(speeds=speeds, fields=fields, distributions=distributions, samples=samples, seed=seed,
+                              solver=solver, duration=duration, harmonics=harmonics,
+                              integration_check=integration_check, refine=refine, workers=workers,
+                              scheduler=scheduler, executor=executor, cache=cache, progress=progress)
 
 
 def export_model(train, path) -> None:
@@ -259,11 +226,7 @@ def harmonic_response(train, method: str = "harmonic balance", orders=None, spee
     model's coordinates
     (``.at(t)``, ``.harmonic(h)``).  Trains with backlash, tip relief, transmission error or a varying torque
     are refused (time marching holds them)."""
-    methods = {"harmonic balance": harmonic_balance_response, "Fourier series": fourier_series_response}
-    if method not in methods:
-        raise GearcheckError(f"method {method!r}: one of {', '.join(methods)}")
-    problem = parametric_problem(build_model(load(train, speed)))
-    return methods[method](problem, lattice(problem, orders))
+    return Train(train, speed).harmonic_response(method, orders)
 
 
 def sensitivity(train, parameter: str, method: str = "Fourier series", orders=None, speed: float | None = None):
@@ -279,4 +242,4 @@ def sensitivity(train, parameter: str, method: str = "Fourier series", orders=No
 
 def mjcf(train, speed: float | None = None) -> str:
     """The MuJoCo model (MJCF text) of the train, deterministic, loadable in MuJoCo's viewer."""
-    return compile_train(load(train, speed)).xml
+    return Train(train, speed).mjcf()

@@ -470,17 +470,17 @@ def cmd_mac(args) -> int:
 
 def cmd_ste(args) -> int:
     from gearcheck.compare.presentation import plots
-    from gearcheck.lumped.transmission_error import relief_sweep, static_transmission_error
 
     if args.slices is not None and not 1 <= args.slices <= 1000:
         raise GearcheckError(f"--slices {args.slices}: must be between 1 and 1000")
-    spec = gearcheck.load(args.train)
+    train = gearcheck.Train(args.train)
+    spec = train.spec
     with OutputDirectory(args.out) as place:
-        curves = static_transmission_error(spec, slices=args.slices)
+        curves = train.ste(args.slices)
         report = {"train": spec.name, "meshes": [c.to_dict() for c in curves]}
         write_file(place.path / "ste.png", plots.static_transmission_error(curves, spec.name))
         if args.relief_sweep:
-            report["relief_sweep"] = relief_sweep(spec, [a * 1e-6 for a in args.relief_sweep], slices=args.slices)
+            report["relief_sweep"] = train.relief_sweep([a * 1e-6 for a in args.relief_sweep], args.slices)
             write_file(place.path / "relief_sweep.png", plots.relief_sweep(report["relief_sweep"], spec.name))
         write_file(place.path / "ste.json", json.dumps(report, indent=2) + "\n")
     for c in curves:
@@ -605,7 +605,7 @@ def cmd_stiffness(args) -> int:
 
 
 def cmd_animate(args) -> int:
-    from gearcheck.compare.presentation.animate import animate, animate_mode, check_output
+    from gearcheck.compare.presentation.animate import check_output
 
     for name in ("fps", "slow_motion", "magnify"):
         value = getattr(args, name)
@@ -615,16 +615,14 @@ def cmd_animate(args) -> int:
         raise GearcheckError(f"--size {args.size[0]} {args.size[1]}: between 16 and 4096 pixels")
     check_output(args.output)
     check_place(args.output, "-o", folder=False)
-    spec = gearcheck.load(args.train)
-    bar = ProgressBar(f"animate {spec.name}")
+    train = gearcheck.Train(args.train)
+    bar = ProgressBar(f"animate {train.spec.name}")
     width, height = args.size
+    options = {"duration": args.duration, "fps": args.fps, "width": width, "height": height, "progress": bar}
     if args.mode is None:
-        animate(spec, args.output, duration=args.duration, fps=args.fps, magnify=args.magnify,
-                slow_motion=args.slow_motion, width=width, height=height, progress=bar)
+        train.animate(args.output, magnify=args.magnify, slow_motion=args.slow_motion, **options)
     else:
-        modal = gearcheck.modes(spec, "lumped") if args.solver == "lumped" else None
-        animate_mode(spec, args.output, args.mode, solver=args.solver, modal=modal, duration=args.duration,
-                     fps=args.fps, width=width, height=height, progress=bar)
+        train.animate(args.output, args.mode, args.solver, **options)
     bar.close()
     print(f"wrote {args.output}")
     return 0

@@ -26,6 +26,8 @@ import numpy as np
 import pandas as pd
 import scipy.linalg as sla
 
+from gearcheck.shared.selection import chosen
+
 ENERGY_TOLERANCE = 1e-8
 DEGENERACY_TOLERANCE = 1e-7  # relative frequency difference grouped as one multiple frequency
 RIGID_TOLERANCE = 1e-9  # omega^2 below this times the largest one is a rigid-body mode
@@ -33,6 +35,7 @@ RIGID_TOLERANCE = 1e-9  # omega^2 below this times the largest one is a rigid-bo
 
 STABILITY_TOLERANCE = 1e-8  # a growth rate below this times the largest |s| counts as none (round-off)
 GROUPS = ("central_translation", "central_rotation", "planets")
+UNITS = {"mode": "", "frequency_hz": "Hz", "type": "", "multiplicity": "", "growth_rate_1_s": "1/s", "stability": ""}
 
 
 @dataclass
@@ -69,7 +72,18 @@ class ModalResult:
             columns.update(growth_rate_1_s=self.growth, stability=self.stability)
         if self.fractions is not None:
             columns.update({f"energy_{g}": self.fractions[:, j] for j, g in enumerate(GROUPS)})
-        return pd.DataFrame(columns)
+        frame = pd.DataFrame(columns)
+        frame.attrs["units"] = {name: UNITS.get(name, "1") for name in frame.columns}
+        return frame
+
+    def plot(self, types=None):
+        """A :class:`matplotlib.figure.Figure` (no pyplot) of the natural frequencies of the modes of ``types`` (a
+        mode type or several; default: all), with their kinetic-energy shares."""
+        from gearcheck.shared.figures import modes_figure
+
+        present = list(dict.fromkeys(self.types))
+        shown = present if types is None else chosen("types", types, present, f"a mode type of {self.train}")
+        return modes_figure(self, shown)
 
     def to_dict(self) -> dict:
         modes = []

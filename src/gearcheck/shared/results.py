@@ -30,6 +30,7 @@ import pandas as pd
 
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.outputs import OutputDirectory
+from gearcheck.shared.selection import chosen
 
 
 @dataclass(frozen=True)
@@ -84,8 +85,20 @@ class TimeResult:
         return self.t >= self.settle_time
 
     def to_dataframe(self, names=None) -> pd.DataFrame:
+        """Time and the signals ``names`` (default: all) as columns, their units in ``attrs["units"]``."""
         names = [s.name for s in self.signals] if names is None else list(names)
-        return pd.DataFrame({"t": self.t, **{n: self[n] for n in names}})
+        frame = pd.DataFrame({"t": self.t, **{n: self[n] for n in names}})
+        frame.attrs["units"] = {"t": "s"} | {n: self.signal(n).unit for n in names}
+        return frame
+
+    def plot(self, signals=None):
+        """A :class:`matplotlib.figure.Figure` (no pyplot) of ``signals`` (a name or several; default: those the
+        cross-check gates) against time, one panel per kind of signal."""
+        from gearcheck.shared.figures import time_figure
+
+        if signals is None:
+            return time_figure(self, self.names(compared=True) or self.names())
+        return time_figure(self, chosen("signals", signals, self._index, f"a signal of {self.solver} {self.train}"))
 
     def summary(self) -> dict:
         """Steady-state mean, RMS, peak-to-peak and largest magnitude of every signal (JSON-ready, SI)."""

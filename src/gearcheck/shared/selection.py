@@ -1,0 +1,21 @@
+"""The check of a selection argument (``plot(signals=...)``, ``plot(types=...)``): each value one of the known ones,
+else a GearcheckError that names the parameter, the value and the nearest known one."""
+
+from __future__ import annotations
+
+import difflib
+
+from gearcheck.shared.errors import GearcheckError
+
+
+def chosen(parameter: str, values, known, what: str) -> list:
+    """``values`` (one or several) as a list, each one of ``known``; else a GearcheckError naming ``parameter``,
+    the value and what it should be (``what``), with the nearest known one."""
+    known = list(known)
+    values = [values] if isinstance(values, (str, int)) else list(values)
+    for value in values:
+        if value not in known:
+            close = difflib.get_close_matches(str(value), [str(k) for k in known], n=1)
+            hint = f"did you mean {close[0]!r}?" if close else f"choose from {', '.join(map(str, known[:8]))}"
+            raise GearcheckError(f"{parameter}: {value!r} is not {what} ({hint})")
+    return values

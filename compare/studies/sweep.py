@@ -59,7 +59,7 @@ import tomli_w
 from threadpoolctl import threadpool_limits
 
 from gearcheck.compare.studies import point_backends as backends
-from gearcheck.compare.engine.align import STEADY_THRESHOLD, steady_state
+from gearcheck.compare.engine.align import steady_state
 from gearcheck.compare.studies.calibrate import FitParameter
 from gearcheck.compare.studies.distributions import Distribution, draw_samples
 from gearcheck.compare.engine.comparison import check_step
@@ -67,10 +67,8 @@ from gearcheck.compare.engine.line_projection import harmonics
 from gearcheck.compare.engine.plan import TrainPlan
 from gearcheck.compare.studies.sweep_lines import counted, measured
 from gearcheck.train.loader import load_text, load_train, read_train_text
-from gearcheck.lumped.modal import settling_time
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.train.spec import TrainSpec, beside
-from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.outputs import OutputDirectory, check_place
@@ -419,8 +417,7 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
     spec = load_train(load_text(point.text, point.source), point.speed_rpm)
     lumped = LumpedSide(spec)
     model = lumped.model
-    plan = TrainPlan.of(spec, model.kin, step_limits(model).omega_max, point.duration,
-                        settling_time(model, STEADY_THRESHOLD))
+    plan = TrainPlan.of(spec, lumped, point.duration)
     rows = _Rows()
     modal = lumped.modes_at_speed(spec.operating.input_speed)
     for k, (f, kind) in enumerate(zip(modal.frequencies, modal.types), start=1):

@@ -13,9 +13,9 @@ from gearcheck.compare.studies.campbell import CampbellResult
 from gearcheck.compare.studies.campbell import campbell as campbell_diagram
 from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
+from gearcheck.compare.engine.model_pair import resolve_model
 from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.studies.sensitivity import field_sensitivity, lattice
-from gearcheck.compare.engine.user_model import user_side
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.forced_response import parametric_problem
@@ -128,7 +128,7 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
 
 def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
     """The lumped model's and the MuJoCo twin's mode shapes paired by the modal assurance criterion; with
-    ``model`` (a user's model, as :func:`crosscheck` takes it), that model's against ``against``.
+    ``model`` (as :func:`crosscheck` takes it), that model's against ``against``.
 
     Returns
     -------
@@ -138,9 +138,8 @@ def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
         figure from :func:`gearcheck.compare.presentation.plots.mac_heatmap`.
     """
     spec = load(train)
-    if model is None:
-        return pair_modes(spec.name, _side("lumped", spec), _side("mujoco", spec))
-    return pair_modes(spec.name, _side(against, spec), user_side(model, spec))
+    pair = resolve_model(spec, "general" if model is None else model, against)
+    return pair_modes(spec.name, pair.reference, pair.test)
 
 
 def _speed(value) -> float:

@@ -34,3 +34,7 @@ class DivergenceError(SolverError):
     def __init__(self, time: float, message: str):
         self.time = time
         super().__init__(f"diverged at t = {time:.6g} s: {message}")
+
+
+class UnsupportedError(SolverError):
+    """A side asked for a capability it does not have (modes at speed, mode shapes, ...)."""

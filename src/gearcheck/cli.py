@@ -56,6 +56,17 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
+FLAGS = {"model": "--model", "results": "--results", "columns": "--columns", "speed": "--speed",
+         "duration": "--duration"}  # a library error's Python parameter -> this command line's flag
+_PARAMETER = re.compile(rf"\b({'|'.join(FLAGS)})=('([^']*)'|(?=[^\s,.;:)]))?")
+
+
+def as_flags(message: str) -> str:
+    """A library error as the command line says it: ``model='x': ...`` as ``--model x: ...``, ``duration=`` as
+    ``--duration``."""
+    return _PARAMETER.sub(lambda m: FLAGS[m[1]] if m[2] is None else f"{FLAGS[m[1]]} {m[3] or ''}", message)
+
+
 def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `gearcheck show | head`: end quietly, like other tools
     previous = signal.signal(signal.SIGTERM, _terminate)
@@ -63,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
         args = _parser().parse_args(argv)
         return args.func(args)
     except GearcheckError as exc:
-        print(f"gearcheck: error: {exc}", file=sys.stderr)
+        print(f"gearcheck: error: {as_flags(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("gearcheck: interrupted", file=sys.stderr)

@@ -19,8 +19,7 @@ from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, sim
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed, settling_time
 from gearcheck.lumped.published import four_dof_model, linear_model
-from gearcheck.lumped.time_solver import default_step, simulate, stable_step
-from gearcheck.lumped.time_solver import step_limits as model_step_limits
+from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
@@ -132,5 +131,6 @@ class PublishedSide(LinearSide):
     def operating(self) -> dict:
         """The paper's operating point, the chosen model and its load case."""
         p = self.model.params
-        return {"input_speed_rpm": rad_s_to_rpm(p.input_speed), "output_torque_nm": p.output_torque if self.load else 0.0,
-                "model": self.name, "load": self.load, "planet_sets": self.planet_sets}
+        return {"input_speed_rpm": rad_s_to_rpm(p.input_speed),
+                "output_torque_nm": p.output_torque if self.load else 0.0, "model": self.name, "load": self.load,
+                "planet_sets": self.planet_sets}

@@ -49,7 +49,8 @@ def test_a_side_without_an_optional_capability_gets_its_default():
         TrainPlan.of(SPEC, side, 0.05)  # it cannot be the reference of a train's plan
     assert side.unmapped() == [] and side.settling_time(0.01) is None and side.linear is None
     assert side.rerunnable and side.has_modes and side.references == ()
-    assert side.operating() == {"input_speed_rpm": pytest.approx(1500.0), "output_torque_nm": SPEC.operating.output_torque}
+    assert side.operating() == {"input_speed_rpm": pytest.approx(1500.0),
+                                "output_torque_nm": SPEC.operating.output_torque}
 
 
 def test_a_side_without_mode_shapes_is_refused_by_name_where_shapes_are_needed():

@@ -73,8 +73,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     Returns
     -------
     CrosscheckResult
-        ``.verdict`` ("PASS", "FAIL" or "INCONCLUSIVE"), ``.failures``, ``.unresolved``, ``.quantities`` (``result[name]``),
-        ``.measurements``, ``.moved`` (metrics moved from the baseline), ``.write(directory)``.
+        ``.verdict`` ("PASS", "FAIL" or "INCONCLUSIVE"), ``.failures``, ``.unresolved``, ``.quantities``
+        (``result[name]``), ``.measurements``, ``.moved`` (metrics moved from the baseline), ``.write(directory)``.
     """
     spec = load_train(train, speed)
     pair = resolve_model(spec, model, against, results, columns, modes)

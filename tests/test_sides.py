@@ -101,14 +101,17 @@ def test_the_plan_comes_from_the_reference_side_when_mujoco_is_the_reference():
 
 
 @pytest.mark.parametrize("call, message", [
-    (lambda: gearcheck.crosscheck("demo-3p", model="model.txt"), "model='model.txt': a model file is .mat or .npz"),
+    (lambda: gearcheck.crosscheck("demo-3p", model="model.txt"), "model=model.txt: a model file is .mat or .npz"),
     (lambda: gearcheck.crosscheck("demo-3p", model="as-published", results="x.csv"),
      "results= gives the model checked: leave model= out"),
     (lambda: gearcheck.crosscheck("demo-3p", results="x.csv"), "results= needs columns="),
-    (lambda: gearcheck.crosscheck("demo-3p", against="abaqus"), "against='abaqus': choose 'lumped' or 'mujoco'"),
-    (lambda: gearcheck.crosscheck("demo-3p", model="user"), "model='user': demo-3p registers no user_model"),
+    (lambda: gearcheck.crosscheck("demo-3p", against="abaqus"), "against='abaqus': choose lumped or mujoco"),
+    (lambda: gearcheck.crosscheck("demo-3p", model="user"), "model=user: demo-3p registers no user_model"),
     (lambda: gearcheck.crosscheck("demo-3p", model="no_such_module_xyz:f"),
-     "model='no_such_module_xyz:f': importing no_such_module_xyz failed"),
+     "model=no_such_module_xyz:f: importing no_such_module_xyz failed"),
+    (lambda: gearcheck.sweep("demo-3p", solver="euler"), "solver=euler: choose lumped, mujoco or both"),
+    (lambda: gearcheck.sweep("demo-3p", harmonics=0), "harmonics=0: needs an integer from 1 to 20"),
+    (lambda: gearcheck.sensitivity("demo-3p", "stages[0].sun.mass", method="euler"), "method='euler': one of"),
 ])
 def test_library_errors_name_the_python_parameter(call, message):
     with pytest.raises(gearcheck.GearcheckError) as caught:
@@ -117,11 +120,13 @@ def test_library_errors_name_the_python_parameter(call, message):
 
 
 def test_the_command_line_names_its_flags(tmp_path, capsys):
-    assert as_flags("model='a b.npz': x; leave model= out (duration=)") == \
-        "--model a b.npz: x; leave --model out (--duration)"
+    assert as_flags("model=a.npz: x; leave model= out (duration=)") == \
+        "--model a.npz: x; leave --model out (--duration)"
     assert as_flags("duration=-1: must be > 0") == "--duration -1: must be > 0"
     assert as_flags("input_speed=3") == "input_speed=3"  # only whole parameter names
     assert all(flag == "--" + name.replace("_", "-") for name, flag in FLAGS.items())
+    assert as_flags("workers= counts local processes: a Dask cluster (scheduler=) has its own workers") == \
+        "--workers counts local processes: a Dask cluster (--scheduler) has its own workers"
     assert main(["crosscheck", "demo-3p", "--results", str(tmp_path / "x.csv"), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err == "gearcheck: error: --results needs --columns, the map of its columns to gearcheck's signals\n"

@@ -117,7 +117,7 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     is checked against, ``"lumped"`` or ``"mujoco"``; ``results``, ``columns``, ``modes``: another solver's
     results as the user's model (:class:`~gearcheck.compare.engine.recorded.RecordedSide`)."""
     if against not in AGAINST:
-        raise GearcheckError(f"against={against!r}: choose {' or '.join(map(repr, AGAINST))}")
+        raise GearcheckError(f"against={against!r}: choose {' or '.join(AGAINST)}")
     reference = (LumpedSide if against == "lumped" else MujocoSide)(spec)
     named = model if isinstance(model, str) else None
     if results is not None:
@@ -132,11 +132,11 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
         return PublishedPair(PublishedSide(spec, named), PublishedTwinSide(spec, named))
     if named == USER:
         if spec.user_model is None:
-            raise GearcheckError(f"model='user': {spec.name} registers no user_model (train.user_model in its file)")
+            raise GearcheckError(f"model=user: {spec.name} registers no user_model (train.user_model in its file)")
         return UserPair(reference, user_side(spec.user_model, spec))
     if named is not None and ":" not in named and Path(named).suffix not in SUFFIXES:
         if Path(named).suffix:
-            raise GearcheckError(f"model={named!r}: a model file is {' or '.join(SUFFIXES)}, "
+            raise GearcheckError(f"model={named}: a model file is {' or '.join(SUFFIXES)}, "
                                  f"not {Path(named).suffix!r}")
         raise GearcheckError(f"unknown model {named!r}: choose one of {', '.join(MODELS)}, or give your own: a model "
                              f"file ({' or '.join(SUFFIXES)}), module:factory or file.py:factory")

@@ -40,13 +40,13 @@ def user_side(model, spec) -> Side:
     except GearcheckError:
         raise
     except Exception as exc:  # the user's code, failing in its own way
-        raise GearcheckError(f"model={text!r}: building the model failed: {type(exc).__name__}: {exc}") from None
+        raise GearcheckError(f"model={text}: building the model failed: {type(exc).__name__}: {exc}") from None
     if isinstance(built, LinearModel):
         built.source = built.source or text
         return LinearSide(built, spec)
     if _is_side(built):
         return _as_side(built, spec, text)
-    raise GearcheckError(f"model={text!r}: returned {type(built).__name__}, neither a LinearModel nor a side "
+    raise GearcheckError(f"model={text}: returned {type(built).__name__}, neither a LinearModel nor a side "
                          f"(an object with {', '.join(SIDE_METHODS)})")
 
 
@@ -56,7 +56,7 @@ def _is_side(obj) -> bool:
 
 def _as_side(obj, spec, given) -> Side:
     if not getattr(obj, "solver", None):
-        raise GearcheckError(f"model={str(given)!r}: the side it gives needs a 'solver' name")
+        raise GearcheckError(f"model={given}: the side it gives needs a 'solver' name")
     return obj if isinstance(obj, Side) else AdoptedSide(obj, spec)
 
 
@@ -92,7 +92,7 @@ def load_factory(text: str):
         if where.endswith(".py"):
             path = Path(where)
             if not path.is_file():
-                raise GearcheckError(f"model={text!r}: no such file {where}")
+                raise GearcheckError(f"model={text}: no such file {where}")
             spec = importlib.util.spec_from_file_location(path.stem, path)
             module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(module)
@@ -101,9 +101,9 @@ def load_factory(text: str):
     except GearcheckError:
         raise
     except Exception as exc:  # the user's code may fail in any way while it loads
-        raise GearcheckError(f"model={text!r}: importing {where} failed: {type(exc).__name__}: "
+        raise GearcheckError(f"model={text}: importing {where} failed: {type(exc).__name__}: "
                              f"{str(exc).splitlines()[0] if str(exc) else ''}") from None
     factory = getattr(module, name, None)
     if not callable(factory):
-        raise GearcheckError(f"model={text!r}: {where} has no callable {name!r}")
+        raise GearcheckError(f"model={text}: {where} has no callable {name!r}")
     return factory

@@ -56,15 +56,18 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
-FLAGS = {"model": "--model", "results": "--results", "columns": "--columns", "speed": "--speed",
-         "duration": "--duration"}  # a library error's Python parameter -> this command line's flag
-_PARAMETER = re.compile(rf"\b({'|'.join(FLAGS)})=('([^']*)'|(?=[^\s,.;:)]))?")
+FLAGS = {  # a library error's Python parameter -> this command line's flag
+    "model": "--model", "results": "--results", "columns": "--columns", "speed": "--speed", "duration": "--duration",
+    "measurements": "--measurements", "solver": "--solver", "method": "--method", "coordinate": "--coordinate",
+    "samples": "--samples", "seed": "--seed", "harmonics": "--harmonics", "refine": "--refine", "workers": "--workers",
+    "scheduler": "--scheduler"}
+_PARAMETER = re.compile(rf"\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
 
 
 def as_flags(message: str) -> str:
-    """A library error as the command line says it: ``model='x': ...`` as ``--model x: ...``, ``duration=`` as
-    ``--duration``."""
-    return _PARAMETER.sub(lambda m: FLAGS[m[1]] if m[2] is None else f"{FLAGS[m[1]]} {m[3] or ''}", message)
+    """A library error as the command line says it: ``model=x: ...`` as ``--model x: ...``, ``(duration=)`` as
+    ``(--duration)``."""
+    return _PARAMETER.sub(lambda m: FLAGS[m[1]] + (" " if m[2] else ""), message)
 
 
 def main(argv: list[str] | None = None) -> int:

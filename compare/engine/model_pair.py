@@ -33,7 +33,7 @@ from gearcheck.train.published_parameters import LABELS
 from gearcheck.train.published_parameters import MODELS as PUBLISHED_MODELS
 
 MODELS = ("general",) + PUBLISHED_MODELS
-AGAINST = ("lumped", "mujoco")
+AGAINST = {"lumped": LumpedSide, "mujoco": MujocoSide}  # what a user's model is checked against
 USER = "user"  # the model the train file registers (train.user_model)
 GENERAL_DURATION = 0.1  # s, default simulated time of a train
 PUBLISHED_DURATION = 0.02  # s, of the 4-DOF models' start-stop transient
@@ -118,14 +118,14 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     results as the user's model (:class:`~gearcheck.compare.engine.recorded.RecordedSide`)."""
     if against not in AGAINST:
         raise GearcheckError(f"against={against!r}: choose {' or '.join(AGAINST)}")
-    reference = (LumpedSide if against == "lumped" else MujocoSide)(spec)
+    reference = AGAINST[against]
     named = model if isinstance(model, str) else None
     if results is not None:
         if named != "general":
             raise GearcheckError("results= gives the model checked: leave model= out")
         if columns is None:
             raise GearcheckError("results= needs columns=, the map of its columns to gearcheck's signals")
-        return RecordedPair(reference, RecordedSide(spec, results, columns, modes))
+        return RecordedPair(reference(spec), RecordedSide(spec, results, columns, modes))
     if named == "general":
         return ModelPair(LumpedSide(spec), MujocoSide(spec))
     if named in PUBLISHED_MODELS:
@@ -133,11 +133,11 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     if named == USER:
         if spec.user_model is None:
             raise GearcheckError(f"model=user: {spec.name} registers no user_model (train.user_model in its file)")
-        return UserPair(reference, user_side(spec.user_model, spec))
+        return UserPair(reference(spec), user_side(spec.user_model, spec))
     if named is not None and ":" not in named and Path(named).suffix not in SUFFIXES:
         if Path(named).suffix:
             raise GearcheckError(f"model={named}: a model file is {' or '.join(SUFFIXES)}, "
                                  f"not {Path(named).suffix!r}")
         raise GearcheckError(f"unknown model {named!r}: choose one of {', '.join(MODELS)}, or give your own: a model "
                              f"file ({' or '.join(SUFFIXES)}), module:factory or file.py:factory")
-    return UserPair(reference, user_side(model, spec))
+    return UserPair(reference(spec), user_side(model, spec))

@@ -144,7 +144,7 @@ def pin_loads(model, times=None, *, span: str = "pitch", samples: int = 16, stag
     element = cycloid_element(model, stage)
     if times is None:
         if samples < 1:
-            raise GearcheckError(f"--samples {samples}: need at least one frozen time")
+            raise GearcheckError(f"samples={samples}: need at least one frozen time")
         times = np.arange(samples) * span_period(element, span) / samples
     times = np.atleast_1d(np.asarray(times, dtype=float))
     g = element.geometry

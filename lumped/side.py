@@ -17,16 +17,18 @@ from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, simulate_linear, step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
-from gearcheck.lumped.modal import modes, modes_at_speed
+from gearcheck.lumped.modal import modes, modes_at_speed, settling_time
 from gearcheck.lumped.published import four_dof_model, linear_model
-from gearcheck.lumped.time_solver import default_step, simulate, stable_step
+from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.side import Side
+from gearcheck.shared.units import rad_s_to_rpm
 
 
-class LumpedSide:
+class LumpedSide(Side):
     """The reference lumped model of a train; ``method`` is the time integrator (see
     :func:`gearcheck.lumped.time_solver.simulate`)."""
 
@@ -65,8 +67,14 @@ class LumpedSide:
     def default_step(self) -> float:
         return default_step(self.model)
 
+    def omega_max(self) -> float:
+        return model_step_limits(self.model).omega_max
 
-class LinearSide:
+    def settling_time(self, fraction: float) -> float:
+        return settling_time(self.model, fraction)
+
+
+class LinearSide(Side):
     """A model given as matrices (:class:`~gearcheck.lumped.linear_model.LinearModel`: a user's, or a
     published one) for the train ``spec``; validated against the train's coordinates when built."""
 
@@ -117,5 +125,12 @@ class PublishedSide(LinearSide):
 
     def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1):
         self.model = four_dof_model(spec, name, planet_sets)
-        self.load, self.planet_sets = load, planet_sets
+        self.name, self.load, self.planet_sets = name, load, planet_sets
         super().__init__(linear_model(self.model, load), spec, ("matejic2021",))
+
+    def operating(self) -> dict:
+        """The paper's operating point, the chosen model and its load case."""
+        p = self.model.params
+        return {"input_speed_rpm": rad_s_to_rpm(p.input_speed),
+                "output_torque_nm": p.output_torque if self.load else 0.0, "model": self.name, "load": self.load,
+                "planet_sets": self.planet_sets}

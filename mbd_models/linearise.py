@@ -38,6 +38,7 @@ import numpy as np
 from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
+from gearcheck.shared.modal import settling_time as shared_settling_time
 from gearcheck.shared.units import rad_s_to_rpm
 
 FD_STEP = 1e-6  # m or rad; the spring forces are linear in qpos, so the step only sets rounding
@@ -142,6 +143,15 @@ def step_limits(mb) -> stepping.StepLimits:
     RV reducer touching), damping included."""
     return stepping.StepLimits.of(mass_matrix(mb), stiffness_matrix(mb, mb.excitation.max_stiffness, every_pin=True),
                                   damping_matrix(mb, every_pin=True))
+
+
+def settling_time(mb, fraction: float) -> float:
+    """How long the free vibration of the twin at rest, every mesh at its mean stiffness, takes to fall to
+    ``fraction`` (:func:`gearcheck.shared.modal.settling_time` of MuJoCo's own matrices, in the axes of
+    :func:`modes`)."""
+    S = _disc_axes(mb)[0]
+    return shared_settling_time(S.T @ mass_matrix(mb) @ S, S.T @ damping_matrix(mb) @ S,
+                                S.T @ stiffness_matrix(mb, mb.excitation.mean_stiffness) @ S, fraction)
 
 
 def joint_labels(mb) -> list[str]:

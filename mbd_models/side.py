@@ -20,9 +20,10 @@ from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.side import Side
 
 
-class MujocoSide:
+class MujocoSide(Side):
     """The MuJoCo twin of a train (``stiffness_clock``: see
     :func:`gearcheck.mbd_models.runner.simulate_mujoco`)."""
 
@@ -59,8 +60,14 @@ class MujocoSide:
     def default_step(self) -> float:
         return self.model.default_step
 
+    def omega_max(self) -> float:
+        return self.model.omega_max
 
-class PublishedTwinSide:
+    def settling_time(self, fraction: float) -> float:
+        return linearise.settling_time(self.model, fraction)
+
+
+class PublishedTwinSide(Side):
     """The MuJoCo twin of the 4-DOF model ``name`` of Matejic et al. (2021); ``y1`` and ``carrier_mass``
     override the kinematics that model claims (:data:`~gearcheck.train.published_parameters.KINEMATICS`).
     A run needs its step: the 4-DOF models and their twin are compared on one time grid."""

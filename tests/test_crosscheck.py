@@ -15,7 +15,6 @@ from gearcheck.compare.engine.plan import TrainPlan
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.train.loader import load_train, preset_names
 from gearcheck.lumped.side import LumpedSide
-from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.settings import RunSettings
 
@@ -41,7 +40,7 @@ def test_a_twin_with_a_wrong_planet_inertia_fails_by_name():
     members = {k: dataclasses.replace(m, inertia=1.3 * m.inertia) if m.is_planet else m
                for k, m in spec.members.items()}
     reference = LumpedSide(spec)
-    plan = TrainPlan.of(spec, reference.model.kin, step_limits(reference.model).omega_max, 0.05)
+    plan = TrainPlan.of(spec, reference, 0.05)
     result = compare(spec, reference, MujocoSide(dataclasses.replace(spec, members=members)), plan,
                      (RunSettings(0.05),) * 2, Tolerances())
     assert not result.passed

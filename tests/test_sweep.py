@@ -274,7 +274,7 @@ def test_bad_sweep_input_is_one_line_and_nothing_written(tmp_path, capsys, monke
 def test_the_api_refuses_what_it_cannot_sweep():
     with pytest.raises(GearcheckError, match="not a loaded TrainSpec"):
         gearcheck.sweep(gearcheck.load("demo-3p"))
-    with pytest.raises(GearcheckError, match="--solver euler"):
+    with pytest.raises(GearcheckError, match="solver=euler: choose"):
         gearcheck.sweep("demo-3p", solver="euler")
     with pytest.raises(GearcheckError, match="operating.input_speed_rpm is swept by --speeds"):
         gearcheck.sweep("demo-3p", speeds=[1000], fields={"operating.input_speed_rpm": [1000, 2000]})

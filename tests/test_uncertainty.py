@@ -115,7 +115,7 @@ def test_bad_speeds_and_workers_are_refused(entries):
         study(entries, fit_speed=-606)
     with pytest.raises(GearcheckError, match=r"workers 0"):
         study(entries, workers=0)
-    with pytest.raises(GearcheckError, match=r"--samples 0"):
+    with pytest.raises(GearcheckError, match=r"samples=0: needs an integer"):
         study(entries, samples=0)
 
 

@@ -15,10 +15,12 @@ import scipy.io
 
 import gearcheck
 from gearcheck.cli import main
+from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.matrix_file import read_matrix_file
 from gearcheck.lumped.side import LinearSide, LumpedSide
+from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.settings import RunSettings
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -117,6 +119,7 @@ def test_recorded_results_from_another_solver(tmp_path):
     assert sorted(q.name for q in result.quantities) == sorted(names)
     assert all(q.metrics["integration_error"]["test"] is None for q in result.quantities)
     assert result.modal == []
+    assert result.settle_s == MujocoSide(spec).settling_time(STEADY_THRESHOLD)  # the plan of the reference, the twin
     result.write(tmp_path / "report")
     report = (tmp_path / "report" / "report.md").read_text()
     assert "Test (other)" in report and "none: a recording" in report and "Natural frequencies" not in report

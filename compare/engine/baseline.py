@@ -84,12 +84,19 @@ def _moved_rel(new, old, tol) -> bool:
     return abs(new - old) > tol * max(abs(old), 1e-300)
 
 
+def baseline_path(baseline, name: str) -> Path | None:
+    """Where the baseline ``baseline`` of the train ``name`` lies: None, "shipped" (the preset's own) or a path."""
+    if baseline is None:
+        return None
+    return BASELINE_DIR / f"{name}.json" if str(baseline) == "shipped" else Path(baseline)
+
+
 def check_settings(baseline: dict, duration: float, input_speed_rpm: float) -> None:
     """Refuse to compare runs made at another speed or over another duration than the baseline."""
     if abs(duration - baseline["duration_s"]) > 1e-12 or \
             abs(input_speed_rpm - baseline["input_speed_rpm"]) > 1e-9 * baseline["input_speed_rpm"]:
         raise GearcheckError(f"baseline of {baseline['train']} was taken at {baseline['input_speed_rpm']:.6g} rpm over "
-                             f"{baseline['duration_s']:.6g} s; run with --speed and --duration to match")
+                             f"{baseline['duration_s']:.6g} s; run with speed= and duration= to match")
 
 
 def compare_to_baseline(result, baseline: dict) -> list[str]:

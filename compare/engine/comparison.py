@@ -45,7 +45,7 @@ from gearcheck.compare.engine.align import (
 from gearcheck.compare.engine.metrics import modal_metrics, spectral_metrics, waveform_metrics
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.tolerances import Tolerances
-from gearcheck.shared.errors import SolverError
+from gearcheck.shared.errors import SolverError, UnsupportedError
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
@@ -169,7 +169,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     modes_a = reference.modes()
     wall["lumped_modes_s"] = time.perf_counter() - started
     started = time.perf_counter()
-    modes_b = test.modes() if getattr(test, "has_modes", True) else None
+    modes_b = test.modes() if test.has_modes else None
     wall["mujoco_modes_s"] = time.perf_counter() - started
     modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
 
@@ -181,7 +181,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
         attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress)
         needed = plan.needed_duration() if plan.detect_steady else None
-        rerunnable = all(getattr(side, "rerunnable", True) for side in (reference, test))
+        rerunnable = reference.rerunnable and test.rerunnable
         reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked and rerunnable
         if attempt.how is None and not extended and reachable:
             notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
@@ -219,7 +219,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         "sensor_band_hz": list(sensor_band) if sensor_band else None,
         "tolerances": dict(sorted(tolerances.values.items())),
     }
-    references = list(getattr(spec, "references", ())) + list(reference.references) + list(test.references)
+    references = list(spec.references) + list(reference.references) + list(test.references)
     return CrosscheckResult(spec, run_settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
                             comparisons, t0, how in ("detected", "decayed", "transient"), (a, b), (modes_a, modes_b),
                             grid, series, wall, notes=notes, references=list(dict.fromkeys(references)),
@@ -268,10 +268,11 @@ def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
     if len(modes_a) == len(modes_b):
         return modal_metrics(modes_a.frequencies, modes_b.frequencies, modes_a.types, modes_b.types,
                              modes_a.multiplicity)
-    if not (hasattr(reference, "physical_modes") and hasattr(test, "physical_modes")):
+    try:
+        partner = pair_modes(spec.name, reference, test, (modes_a, modes_b)).mac.argmax(axis=0)
+    except UnsupportedError as exc:
         raise SolverError(f"the models have different numbers of modes ({len(modes_a)} {reference.solver}, "
-                          f"{len(modes_b)} {test.solver}) and no mode shapes to pair them by")
-    partner = pair_modes(spec.name, reference, test, (modes_a, modes_b)).mac.argmax(axis=0)
+                          f"{len(modes_b)} {test.solver}) and no mode shapes to pair them by: {exc}") from None
     return modal_metrics(modes_a.frequencies[partner], modes_b.frequencies, [modes_a.types[i] for i in partner],
                          modes_b.types, [modes_a.multiplicity[i] for i in partner])
 
@@ -287,7 +288,7 @@ def _run_pairs(sides, settings, wall, progress):
         started = time.perf_counter()
         run = side.run(run_settings, report)
         wall[f"{label}_run_s"] = time.perf_counter() - started
-        if not getattr(side, "rerunnable", True):
+        if not side.rerunnable:
             pairs.append((run, None))
             continue
         check_dt = check_step(side, run.info["dt_s"])

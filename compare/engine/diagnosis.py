@@ -41,7 +41,7 @@ import scipy.linalg as sla
 from gearcheck.lumped.assembly import DofMap, LumpedModel
 from gearcheck.train.spec import AXIAL
 from gearcheck.lumped.modal import modes, modes_at_speed
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, UnsupportedError
 from gearcheck.shared.modal import DEGENERACY_TOLERANCE, RIGID_TOLERANCE, STABILITY_TOLERANCE
 
 KINDS = ("no mistake", "held coordinates", "dropped coupling", "sign error", "stiffness", "inertia", "gyroscopic",
@@ -532,16 +532,18 @@ def diagnose(model: LumpedModel, evidence: Evidence, top: int = 3) -> Diagnosis:
 
 
 def diagnose_side(model: LumpedModel, side, modal=None, top: int = 3) -> Diagnosis:
-    """The diagnosis of a user's model as the cross-check holds it (a side with ``modes()``,
-    ``physical_modes()`` and, where it turns, ``modes_at_speed()``) against the reference ``model``: its
-    frequencies, its shapes where it has them, its frequencies at the operating speed.  A model given as
+    """The diagnosis of a user's model as the cross-check holds it (a :class:`~gearcheck.shared.side.Side`)
+    against the reference ``model``: its frequencies, its shapes and its frequencies at the operating speed where
+    it has them.  A model given as
     matrices over the train's members is compared with the reference reduced to its coordinates
     (:func:`constrained`), so a torsional model is held to the reference with its translations tied as its
     map ties them.  ``modal``: the side's modes when already computed."""
     modal = side.modes() if modal is None else modal
-    at_speed = (side.modes_at_speed(model.spec.operating.input_speed).frequencies
-                if hasattr(side, "modes_at_speed") else None)
-    linear = getattr(side, "linear", None)
+    try:
+        at_speed = side.modes_at_speed(model.spec.operating.input_speed).frequencies
+    except UnsupportedError:
+        at_speed = None
+    linear = side.linear
     if linear is not None and all("." in c and c.rsplit(".", 1)[0] in model.spec.members for c in linear.coordinates):
         T, _ = linear.to_physical(model.dofs.labels())
         reduced = constrained(model, linear.coordinates, T)
@@ -552,6 +554,6 @@ def diagnose_side(model: LumpedModel, side, modal=None, top: int = 3) -> Diagnos
         return diagnosis
     try:
         labels, mass, shapes = side.physical_modes(modal)
-    except GearcheckError:  # a recording without mode shapes
+    except UnsupportedError:  # a recording without mode shapes
         labels, mass, shapes = model.dofs.labels(), None, None
     return diagnose(model, Evidence(labels, modal.frequencies, shapes, mass, at_speed), top)

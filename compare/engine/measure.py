@@ -41,7 +41,7 @@ def steady_window(grid: np.ndarray, forces: np.ndarray, cycle: float, settle: fl
     if how is None:
         need = "" if settle is None else f"; its start's free vibration decays in {settle:.4g} s, so give at least " \
             f"{settle + STEADY_WINDOW_CYCLES * cycle:.4g} s"
-        raise GearcheckError(f"a run of {grid[-1]:.4g} s reaches no steady state to measure{need} (--duration)")
+        raise GearcheckError(f"a run of {grid[-1]:.4g} s reaches no steady state to measure{need} (duration=)")
     return grid >= start
 
 

@@ -6,9 +6,12 @@ cycle; how far to search for a lag and which spectral lines to measure in each s
 negligibility scale of each kind; below which floor a solver cannot resolve a kind; and which
 operating-point settings the report states.
 
+Each plan is built from the reference side, the one whose runs it reads (:meth:`TrainPlan.of`,
+:meth:`TransientPlan.of`):
+
 * :class:`TrainPlan` -- a gear train in steady operation: resampled onto the lower of the two
   output rates, steady window from each stage's mesh forces over its own mesh cycle or from the
-  decay of the reference model's free vibration (:func:`gearcheck.compare.engine.align.steady_state`),
+  decay of the reference's free vibration (:func:`gearcheck.compare.engine.align.steady_state`),
   lags within half a mesh period, mesh harmonics and carrier sidebands, translational scale also from r alpha of every
   central member, and MuJoCo's round-off floor of absolute angles (:func:`round_off_floor`);
 * :class:`TransientPlan` -- a start-stop transient on one shared step grid (the 4-DOF models of
@@ -24,9 +27,10 @@ from fractions import Fraction
 
 import numpy as np
 
-from gearcheck.compare.engine.align import STEADY_WINDOW_CYCLES
+from gearcheck.compare.engine.align import STEADY_THRESHOLD, STEADY_WINDOW_CYCLES
 from gearcheck.compare.engine.metrics import spectral_lines
-from gearcheck.shared.units import rad_s_to_rpm
+from gearcheck.shared.stepping import transient_step
+from gearcheck.train.kinematics import kinematics
 
 
 @dataclass(frozen=True)
@@ -36,18 +40,21 @@ class TrainPlan:
     stage_frequencies: dict[str, tuple[float, float]]  # stage -> (slowest mesh frequency, carrier frequency) Hz
     floors: dict[str, float]  # kind -> the smallest amplitude a solver resolves
     settle: float | None = None  # s: the reference's free vibration decays to the steady threshold
+    operating: dict = field(default_factory=dict)  # the operating point the report states
     resample: bool = True
     detect_steady: bool = True
 
     @classmethod
-    def of(cls, spec, kin, omega_max: float, duration: float, settle: float | None = None) -> "TrainPlan":
-        """The plan of ``spec`` (kinematics ``kin``) for runs of ``duration`` s; ``omega_max`` the
-        reference model's highest natural angular frequency, ``settle`` its free vibration's decay time."""
+    def of(cls, spec, reference, duration: float) -> "TrainPlan":
+        """The plan of ``spec`` for runs of ``duration`` s of the side ``reference``: its highest natural
+        frequency sets the round-off floor, the decay of its free vibration the earliest steady state."""
+        kin = kinematics(spec)
         stages = {}
         for stage in spec.stages:
             f_mesh = min(kin.mesh_frequency[m.id] for m in spec.meshes if m.stage == stage.name)
             stages[stage.name] = (f_mesh, abs(kin.speeds[stage.carrier]) / (2 * math.pi))
-        return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, omega_max, duration), settle)
+        return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, reference.omega_max(), duration),
+                   reference.settling_time(STEADY_THRESHOLD), reference.operating())
 
     def steady_groups(self, names) -> list[tuple[list[str], float]]:
         """The mesh-force signals among ``names`` with the cycle over which they repeat in steady state: all
@@ -76,11 +83,6 @@ class TrainPlan:
         """The period of the slowest mesh: the cycle of the steady-state test and of the plots."""
         return 1.0 / min(f for f, _ in self.stage_frequencies.values())
 
-    @property
-    def operating(self) -> dict:
-        return {"input_speed_rpm": rad_s_to_rpm(self.spec.operating.input_speed),
-                "output_torque_nm": self.spec.operating.output_torque}
-
     def _frequencies(self, name: str) -> tuple[float, float]:
         f_mesh, f_carrier = self.stage_frequencies.get(name.split(".")[0], next(iter(self.stage_frequencies.values())))
         mesh = name.rsplit(".", 1)[0]
@@ -108,6 +110,16 @@ class TransientPlan:
     floors: dict = field(default_factory=dict)
     resample: bool = False
     detect_steady: bool = False
+
+    @classmethod
+    def of(cls, reference, test) -> "TransientPlan":
+        """The plan of a start-stop transient of ``reference`` and ``test`` from rest: the reference's natural
+        frequencies, one step that resolves both sides' highest (:func:`gearcheck.shared.stepping.transient_step`),
+        the reference's operating point and both sides' counts of rigid modes."""
+        modes = reference.modes(), test.modes()
+        dt = transient_step(np.concatenate([m.frequencies for m in modes]))
+        rigid = {name: m.types.count("rigid") for name, m in zip(("lumped", "mujoco"), modes)}
+        return cls(modes[0].frequencies, dt, {**reference.operating(), "rigid_modes": rigid})
 
     @property
     def cycle(self) -> float:

@@ -48,10 +48,11 @@ from scipy.io.matlab import MatReadError
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.files import read_toml
 from gearcheck.lumped.modal import central_coordinates
-from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
+from gearcheck.shared.errors import GearcheckError, TrainFileError, UnsupportedError, did_you_mean
 from gearcheck.shared.modal import ModalResult, energy_fractions, mode_types, multiplicities, rigid_or_elastic
 from gearcheck.shared.results import TimeResult, train_signals
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.side import Side
 
 UNITS = {  # a signal's SI unit -> the units a column may hold it in, with the factor to SI
     "m/s^2": {"m/s^2": 1.0, "mm/s^2": 1e-3, "g": 9.80665},
@@ -405,12 +406,11 @@ def _one_line(exc: BaseException) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
-class RecordedSide:
+class RecordedSide(Side):
     """Another solver's results as a :class:`~gearcheck.shared.side.Side`: the recorded time series (read and
     checked at construction) and, with ``modes_path``, its modes.  Nothing is re-run: ``rerunnable`` is False,
     :meth:`run` returns the recording whatever its settings ask (the engine compares the overlap)."""
 
-    references: tuple[str, ...] = ()
     rerunnable = False
 
     def __init__(self, spec, series_path: str | Path, columns: ColumnMap | Mapping | str | Path,
@@ -431,14 +431,14 @@ class RecordedSide:
 
     def modes(self) -> ModalResult:
         if self._modes is None:
-            raise GearcheckError(f"{self.solver}: no modes file was given, so there are no natural frequencies")
+            raise UnsupportedError(f"{self.solver}: no modes file was given, so there are no natural frequencies")
         return self._modes[0]
 
     def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray | None, np.ndarray]:
         """(coordinate labels, the file's mass matrix or None, the shapes of ``modal``), rows in the reference
         model's coordinate order; pair with the reference's mass when None."""
         if self._modes is None or not self._modes[1]:
-            raise GearcheckError(f"{self.solver}: the modes file gives no mode shapes")
+            raise UnsupportedError(f"{self.solver}: the modes file gives no mode shapes")
         return self._modes[1], self._modes[2], modal.shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:

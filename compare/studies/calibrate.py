@@ -149,7 +149,7 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
     """Fit ``fits`` of the train file ``text`` to the measurement ``entries`` (lumped solver)."""
     document = tomllib.loads(text)
     if not entries:
-        raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or --measurements")
+        raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or measurements=")
     base_spec = load_text(text, source)
     base_rpm = rad_s_to_rpm(base_spec.operating.input_speed)
     rpm = _speeds(entries, base_rpm)

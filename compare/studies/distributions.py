@@ -76,9 +76,9 @@ def sample_generator(seed: int, index: int) -> np.random.Generator:
 def draw_samples(distributions: dict, samples: int, seed: int) -> list[dict[str, float]]:
     """``samples`` draws of every field of ``distributions`` (field path -> :class:`Distribution`), in order."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise GearcheckError(f"--seed {seed!r}: needs an integer >= 0")
+        raise GearcheckError(f"seed={seed!r}: needs an integer >= 0")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not 1 <= samples <= 1_000_000:
-        raise GearcheckError(f"--samples {samples!r}: needs an integer from 1 to 1000000")
+        raise GearcheckError(f"samples={samples!r}: needs an integer from 1 to 1000000")
     out = []
     for i in range(samples):
         rng = sample_generator(int(seed), i)

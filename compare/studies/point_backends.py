@@ -121,18 +121,18 @@ def connect(scheduler):
     try:
         import distributed
     except ImportError:
-        raise GearcheckError(f"--scheduler {scheduler}: needs dask.distributed (pip install 'gearcheck[cluster]')"
+        raise GearcheckError(f"scheduler={scheduler}: needs dask.distributed (pip install 'gearcheck[cluster]')"
                              ) from None
     if isinstance(scheduler, distributed.Client):
         return scheduler, False
     if not isinstance(scheduler, str) or not re.fullmatch(r"[a-z+]+://\S+|\S+:\d+", scheduler):
-        raise GearcheckError(f"--scheduler {scheduler!r}: give the scheduler's address, "
+        raise GearcheckError(f"scheduler={scheduler!r}: give the scheduler's address, "
                              "e.g. tcp://scheduler.example.org:8786")
     try:
         return distributed.Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False), True
     except Exception as exc:  # OSError, TimeoutError, ValueError: whatever stops the connection
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise GearcheckError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({reason})") from None
+        raise GearcheckError(f"scheduler={scheduler}: cannot reach the Dask scheduler ({reason})") from None
 
 
 def run_dask(run, pending, scheduler, finished) -> None:

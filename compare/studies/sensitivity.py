@@ -114,7 +114,7 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=None, metho
 
 def _check(method: str) -> None:
     if method not in METHODS:
-        raise GearcheckError(f"--method {method!r}: one of {', '.join(METHODS)}")
+        raise GearcheckError(f"method={method!r}: one of {', '.join(METHODS)}")
 
 
 def _closed_form(base: ParametricProblem, derivative: ParametricProblem, orders, method: str):
@@ -182,7 +182,7 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
         model = _model(text, source, None, None, rpm)
         labels = model.dofs.labels()
         if coordinate not in labels:
-            raise GearcheckError(f"--coordinate {coordinate!r}: not a coordinate of {model.spec.name}"
+            raise GearcheckError(f"coordinate={coordinate!r}: not a coordinate of {model.spec.name}"
                                  + did_you_mean(coordinate, labels, n=3, cutoff=0))
         index = labels.index(coordinate)
         base = parametric_problem(model, contacts=contacts, **grids)

@@ -59,7 +59,7 @@ import tomli_w
 from threadpoolctl import threadpool_limits
 
 from gearcheck.compare.studies import point_backends as backends
-from gearcheck.compare.engine.align import STEADY_THRESHOLD, steady_state
+from gearcheck.compare.engine.align import steady_state
 from gearcheck.compare.studies.calibrate import FitParameter
 from gearcheck.compare.studies.distributions import Distribution, draw_samples
 from gearcheck.compare.engine.comparison import check_step
@@ -67,10 +67,8 @@ from gearcheck.compare.engine.line_projection import harmonics
 from gearcheck.compare.engine.plan import TrainPlan
 from gearcheck.compare.studies.sweep_lines import counted, measured
 from gearcheck.train.loader import load_text, load_train, read_train_text
-from gearcheck.lumped.modal import settling_time
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.train.spec import TrainSpec, beside
-from gearcheck.lumped.time_solver import step_limits
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.selection import chosen
@@ -255,13 +253,13 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
                              "it edits the file's numbers and hashes its text")
     solvers = _solvers(solvers)
     if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
-        raise GearcheckError(f"--duration {duration!r}: needs a positive number of seconds")
+        raise GearcheckError(f"duration={duration!r}: needs a positive number of seconds")
     if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
-        raise GearcheckError(f"--harmonics {harmonics!r}: needs an integer from 1 to 20")
+        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to 20")
     if not isinstance(integration_check, bool):
         raise GearcheckError(f"integration_check {integration_check!r}: needs True or False")
     if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:
-        raise GearcheckError(f"--refine {refine!r}: needs an integer from 1 to {MAX_REFINE}")
+        raise GearcheckError(f"refine={refine!r}: needs an integer from 1 to {MAX_REFINE}")
     text, source = read_train_text(train)
     base = load_text(text, source)
     document = tomllib.loads(text)
@@ -346,7 +344,7 @@ def _solvers(solvers) -> tuple[str, ...]:
     solvers = tuple(solvers)
     bad = [s for s in solvers if s not in SOLVERS]
     if bad or not solvers or len(set(solvers)) != len(solvers):
-        raise GearcheckError(f"--solver {', '.join(map(str, solvers)) or '(none)'}: choose lumped, mujoco or both")
+        raise GearcheckError(f"solver={', '.join(map(str, solvers)) or '(none)'}: choose lumped, mujoco or both")
     return solvers
 
 
@@ -415,8 +413,7 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
     spec = load_train(load_text(point.text, point.source), point.speed_rpm)
     lumped = LumpedSide(spec)
     model = lumped.model
-    plan = TrainPlan.of(spec, model.kin, step_limits(model).omega_max, point.duration,
-                        settling_time(model, STEADY_THRESHOLD))
+    plan = TrainPlan.of(spec, lumped, point.duration)
     rows = _Rows()
     modal = lumped.modes_at_speed(spec.operating.input_speed)
     for k, (f, kind) in enumerate(zip(modal.frequencies, modal.types), start=1):
@@ -562,7 +559,7 @@ def _workers(workers) -> int:
     if workers is None:
         return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 4096:
-        raise GearcheckError(f"--workers {workers!r}: needs an integer from 1 to 4096")
+        raise GearcheckError(f"workers={workers!r}: needs an integer from 1 to 4096")
     return workers
 
 
@@ -770,9 +767,9 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
     if cache is not None:
         check_place(Path(cache), "--cache")
     if scheduler is not None and executor is not None:
-        raise GearcheckError("--scheduler runs on a Dask cluster: give it or an executor, not both")
+        raise GearcheckError("scheduler= runs on a Dask cluster: give it or an executor, not both")
     if scheduler is not None and workers is not None:
-        raise GearcheckError("--workers counts local processes: a Dask cluster (--scheduler) has its own workers")
+        raise GearcheckError("workers= counts local processes: a Dask cluster (scheduler=) has its own workers")
     run = execute(plan.points, workers=workers, scheduler=scheduler, executor=executor, cache=cache,
                   progress=progress)
     table = assemble(plan, run.tables)

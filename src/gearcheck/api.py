@@ -100,7 +100,7 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
 
 def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
     """The lumped model's and the MuJoCo twin's mode shapes paired by the modal assurance criterion; with
-    ``model`` (a user's model, as :func:`crosscheck` takes it), that model's against ``against``.
+    ``model`` (as :func:`crosscheck` takes it), that model's against ``against``.
 
     Returns
     -------

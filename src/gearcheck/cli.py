@@ -57,6 +57,20 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
+FLAGS = {  # a library error's Python parameter -> this command line's flag
+    "model": "--model", "results": "--results", "columns": "--columns", "speed": "--speed", "duration": "--duration",
+    "measurements": "--measurements", "solver": "--solver", "method": "--method", "coordinate": "--coordinate",
+    "samples": "--samples", "seed": "--seed", "harmonics": "--harmonics", "refine": "--refine", "workers": "--workers",
+    "scheduler": "--scheduler"}
+_PARAMETER = re.compile(rf"\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
+
+
+def as_flags(message: str) -> str:
+    """A library error as the command line says it: ``model=x: ...`` as ``--model x: ...``, ``(duration=)`` as
+    ``(--duration)``."""
+    return _PARAMETER.sub(lambda m: FLAGS[m[1]] + (" " if m[2] else ""), message)
+
+
 def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `gearcheck show | head`: end quietly, like other tools
     previous = signal.signal(signal.SIGTERM, _terminate)
@@ -64,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
         args = _parser().parse_args(argv)
         return args.func(args)
     except GearcheckError as exc:
-        print(f"gearcheck: error: {exc}", file=sys.stderr)
+        print(f"gearcheck: error: {as_flags(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("gearcheck: interrupted", file=sys.stderr)

@@ -15,7 +15,7 @@ from pathlib import Path
 from gearcheck.compare.engine.comparison import CrosscheckResult
 from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
-from gearcheck.compare.engine.user_model import user_side
+from gearcheck.compare.engine.model_pair import resolve_model
 from gearcheck.compare.studies.campbell import CampbellResult, campbell
 from gearcheck.compare.studies.sensitivity import lattice
 from gearcheck.lumped import time_solver
@@ -108,7 +108,8 @@ class Train:
         ``model`` (a user's), that model's against ``against``.  See :func:`gearcheck.mode_pairing`."""
         if model is None:
             return pair_modes(self.spec.name, self.lumped, self.mujoco)
-        return pair_modes(self.spec.name, self.side(against), user_side(model, self.spec))
+        pair = resolve_model(self.spec, model, against)
+        return pair_modes(self.spec.name, pair.reference, pair.test)
 
     def harmonic_response(self, method: str = "harmonic balance", orders=None):
         """The steady forced response of the lumped model by harmonic balance or the Fourier-series method of

@@ -48,3 +48,7 @@ def did_you_mean(name: str, choices, listing: str = "", *, n: int = 1, cutoff: f
     if close:
         return f" (did you mean {', '.join(map(repr, close))}?)"
     return f" ({listing}: {', '.join(choices)})" if listing else ""
+
+
+class UnsupportedError(SolverError):
+    """A side asked for a capability it does not have (modes at speed, mode shapes, ...)."""

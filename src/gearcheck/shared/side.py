@@ -1,16 +1,20 @@
-"""What the cross-check asks of a model: its modes and a time run, both as named results.
+"""What the cross-check asks of a model: a :class:`Side`.
 
-The reference lumped model, the MuJoCo twin and the published 4-DOF models of Matejic et al.
-(2021) and their twin all implement this; the cross-check engine knows nothing else about them.
+Every side has modes and time runs, both as named results; a few capabilities are optional, each with its
+default here, and a side overrides the ones it has.  The reference lumped model, the MuJoCo twin, the
+published 4-DOF models of Matejic et al. (2021) and their twin, a user's model and another solver's recording
+all derive from it; the cross-check engine knows nothing else about them.
 """
 
 from __future__ import annotations
 
-from typing import Protocol
+from abc import ABC, abstractmethod
 
+from gearcheck.shared.errors import UnsupportedError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.units import rad_s_to_rpm
 
 DISPLAY = {"lumped": "lumped", "mujoco": "MuJoCo"}  # how reports write the built-in solvers' names
 
@@ -20,15 +24,52 @@ def display_name(solver: str) -> str:
     return DISPLAY.get(solver, solver)
 
 
-class Side(Protocol):
-    solver: str  # how reports name it: "lumped", "mujoco", "as-published", ...
-    references: tuple[str, ...]  # keys of gearcheck.shared.citations.REFERENCES its equations come from
+class Side(ABC):
+    """A model of the train ``spec`` as the cross-check sees it."""
 
+    solver: str  # how reports name it: "lumped", "mujoco", "as-published", ...
+    spec: object  # the TrainSpec it models
+    references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES its equations come from
+    rerunnable: bool = True  # run() integrates anew at the settings asked (False: a recording, as it is)
+    has_modes: bool = True  # modes() gives natural frequencies (False: a recording without a modes file)
+    linear = None  # its matrices (a LinearModel) when it is a model given as matrices
+
+    @abstractmethod
     def modes(self) -> ModalResult:
         """Natural frequencies, mode shapes and types of the linear(ised) model."""
 
+    @abstractmethod
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         """A time run; ``progress`` is called with the fraction done."""
 
+    @abstractmethod
     def stable_step(self) -> float:
         """The largest fixed step its runs accept (s)."""
+
+    def modes_at_speed(self, input_speed: float) -> ModalResult:
+        """The gyroscopic modes of the train turning at ``input_speed`` (rad/s).  Default: unsupported."""
+        raise UnsupportedError(f"{self.solver} has no modes at speed (modes_at_speed)")
+
+    def physical_modes(self, modal: ModalResult) -> tuple[list[str], object, object]:
+        """(coordinate labels, mass matrix or None, the shapes of ``modal``) in the train's physical coordinates,
+        by which modes are paired.  Default: unsupported."""
+        raise UnsupportedError(f"{self.solver} gives no mode shapes in the train's coordinates (physical_modes)")
+
+    def unmapped(self) -> list[str]:
+        """The train's gated signals its runs do not report.  Default: none."""
+        return []
+
+    def omega_max(self) -> float:
+        """Its highest natural angular frequency (rad/s), every mesh at its stiffest: what sets the round-off
+        floor of a plan that reads its runs.  Default: unsupported."""
+        raise UnsupportedError(f"{self.solver} does not state its highest natural frequency (omega_max)")
+
+    def settling_time(self, fraction: float) -> float | None:
+        """How long its free vibration takes to fall to ``fraction`` of its start (s).  Default None: not known
+        (no run is extended to reach its steady state)."""
+        return None
+
+    def operating(self) -> dict:
+        """The operating point a report of its runs states.  Default: the train's input speed and output torque."""
+        return {"input_speed_rpm": rad_s_to_rpm(self.spec.operating.input_speed),
+                "output_torque_nm": self.spec.operating.output_torque}

@@ -11,6 +11,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import mujoco
@@ -78,6 +79,19 @@ def test_a_twin_compiles_once(monkeypatch):
     assert len(compiles) == 1
     assert mb.model.opt.timestep == mb.default_step and f'timestep="{mb.default_step!r}"' in mb.xml
     assert mb.default_step <= 0.9 * 2 * 2**0.5 / mb.omega_max  # inside RK4's stability limit
+
+
+def test_every_package_of_the_checkout_is_installed():
+    """pyproject.toml lists the packages (the design card's folders are mapped, not found): a folder left out of
+    the list would import from a checkout and fail from site-packages."""
+    root = PYPROJECT.parent
+    mapping = tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))["tool"]["setuptools"]
+    found = set()
+    for package, folder in mapping["package-dir"].items():
+        for init in (root / folder).rglob("__init__.py"):
+            parts = init.parent.relative_to(root / folder).parts
+            found.add(".".join((package, *parts)))
+    assert found == set(mapping["packages"])
 
 
 def test_only_gearcheck_goes_into_site_packages():

@@ -3,9 +3,7 @@ else a GearcheckError that names the parameter, the value and the nearest known 
 
 from __future__ import annotations
 
-import difflib
-
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, did_you_mean
 
 
 def chosen(parameter: str, values, known, what: str) -> list:
@@ -15,7 +13,6 @@ def chosen(parameter: str, values, known, what: str) -> list:
     values = [values] if isinstance(values, (str, int)) else list(values)
     for value in values:
         if value not in known:
-            close = difflib.get_close_matches(str(value), [str(k) for k in known], n=1)
-            hint = f"did you mean {close[0]!r}?" if close else f"choose from {', '.join(map(str, known[:8]))}"
-            raise GearcheckError(f"{parameter}: {value!r} is not {what} ({hint})")
+            hint = did_you_mean(str(value), map(str, known)) or f" (choose from {', '.join(map(str, known[:8]))})"
+            raise GearcheckError(f"{parameter}: {value!r} is not {what}{hint}")
     return values

@@ -242,3 +242,30 @@ def test_the_teaching_notebooks_use_the_front_door_only():
         code = "\n".join(c.source for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code")
         assert not re.findall(r"(?:from|import)\s+gearcheck\.", code), path.name
         assert not re.findall(r"gearcheck\.\w+\.\w", code), path.name
+
+
+def test_every_command_of_the_command_line_is_in_the_front_door():
+    """Each command is a function of ``import gearcheck`` or a method of a Train session, which it calls."""
+    from gearcheck.cli import _parser
+
+    subparsers = next(a for a in _parser()._actions if a.dest == "command")
+    front = {"presets": gearcheck.presets, "show": gearcheck.describe, "modes": gearcheck.modes,
+             "campbell": gearcheck.campbell, "mac": gearcheck.mode_pairing, "ste": gearcheck.Train.ste,
+             "run": gearcheck.simulate, "crosscheck": gearcheck.crosscheck, "calibrate": gearcheck.calibrate,
+             "sweep": gearcheck.sweep, "sensitivity": gearcheck.sensitivity, "pins": gearcheck.pin_loads,
+             "stiffness": gearcheck.Train.stiffness, "animate": gearcheck.Train.animate, "view": gearcheck.Train.view,
+             "dashboard": gearcheck.dashboard, "export": gearcheck.export_model, "mjcf": gearcheck.mjcf}
+    assert set(subparsers.choices) == set(front)
+    assert all(callable(f) and f.__doc__ for f in front.values())
+
+
+def test_describe_and_stiffness_from_the_front_door():
+    info = gearcheck.describe("demo-3p")
+    assert info["train"] == "demo-3p" and len(info["meshes"]) == 6
+    train = gearcheck.Train("demo-3p")
+    fig = train.stiffness(cycles=2)
+    first = [m for m in train.spec.meshes if m.planet_index == 0]
+    assert len(fig.axes) == len(first)
+    x, k = fig.axes[0].lines[0].get_data()
+    assert x[-1] == 2.0 and np.isclose(np.mean(k[:-1]), train.lumped.model.excitation.mean_stiffness[0] / 1e9,
+                                       rtol=1e-3)

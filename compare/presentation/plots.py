@@ -313,9 +313,9 @@ FIGURES = {  # failing.png only when a quantity fails
 }
 
 
-def mesh_stiffness(spec, cycles: int = 2) -> bytes:
-    """PNG of k over ``cycles`` mesh cycles for the first planet's mesh with every central gear of every
-    stage (the model the train file names), with the number of tooth pairs in contact."""
+def mesh_stiffness_figure(spec, cycles: int = 2) -> Figure:
+    """k over ``cycles`` mesh cycles for the first planet's mesh with every central gear of every stage (the model
+    the train file names), beside its mean."""
     first = [m for m in spec.meshes if m.planet_index == 0]
     fig, axes = _figure(len(first), 1, figsize=(9, 2.0 * len(first)), sharex=True, squeeze=False)
     xi = np.linspace(0.0, cycles, 2000 * cycles + 1)
@@ -330,7 +330,12 @@ def mesh_stiffness(spec, cycles: int = 2) -> bytes:
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
     fig.suptitle(f"{spec.name}: time-varying mesh stiffness", fontsize=9)
-    return _png(fig)
+    return fig
+
+
+def mesh_stiffness(spec, cycles: int = 2) -> bytes:
+    """PNG of :func:`mesh_stiffness_figure`."""
+    return _png(mesh_stiffness_figure(spec, cycles))
 
 
 def campbell_figure(result, solvers=None) -> Figure:

@@ -9,7 +9,7 @@ The front door:
 
 * :class:`Train` -- a session: one train, its lumped model and MuJoCo twin built once, every study below a
   method (``modes``, ``simulate``, ``crosscheck``, ``campbell``, ``mac``, ``harmonic_response``, ``ste``,
-  ``relief_sweep``, ``sweep``, ``animate``, ``mjcf``); every result draws itself with ``plot()`` (a matplotlib
+  ``relief_sweep``, ``sweep``, ``animate``, ``view``, ``mjcf``, ``describe``, ``pin_loads``, ``stiffness``); every result draws itself with ``plot()`` (a matplotlib
   Figure, no pyplot) and a DataFrame carries its columns' units in ``attrs["units"]``;
 * :func:`load` -- a train (preset name, train file, or TrainSpec), validated; :func:`load_text` one from TOML text,
   :func:`preset_text` a preset's text, :func:`edited` a preset with its text edited (pattern, replacement);
@@ -22,11 +22,16 @@ The front door:
 * :func:`harmonic_response`, :func:`sensitivity` -- the steady forced response by harmonic methods and its
   derivatives to the numbers of a train file;
 * :func:`sweep` -- speed sweeps, parameter studies and Monte Carlo, cached, on local processes or Dask;
-* :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check.
+* :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check;
+* :func:`describe`, :func:`pin_loads`, :func:`calibrate`, :func:`dashboard` -- what a train derives from its file,
+  an RV reducer's static pin loads, a least-squares calibration to measurements, the regression dashboard.
 
-Packages: :mod:`gearcheck.lumped` (train description and reference solver),
-:mod:`gearcheck.mbd_models` (the MuJoCo twin), :mod:`gearcheck.compare` (the cross-check),
-:mod:`gearcheck.shared` (what both solvers share).
+Every command of the command line is one of these (``ste``, ``animate``, ``view`` and ``stiffness`` are
+:class:`Train` methods).
+
+Packages: :mod:`gearcheck.train` (the train description), :mod:`gearcheck.lumped` (the reference solver),
+:mod:`gearcheck.mbd_models` (the MuJoCo twin), :mod:`gearcheck.compare` (the cross-check, its studies and their
+presentation), :mod:`gearcheck.shared` (what every package shares).
 """
 
 import os
@@ -39,14 +44,18 @@ if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.enviro
 
 from gearcheck.api import (  # noqa: E402
                            SOLVERS,
+                           calibrate,
                            campbell,
                            crosscheck,
+                           dashboard,
+                           describe,
                            export_model,
                            harmonic_response,
                            load,
                            mjcf,
                            mode_pairing,
                            modes,
+                           pin_loads,
                            presets,
                            sensitivity,
                            simulate,
@@ -69,6 +78,6 @@ __version__ = metadata.version("gearcheck")
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "GearcheckError", "LinearModel", "Mesh",
            "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",
-           "__version__", "campbell", "crosscheck", "edited", "export_model", "harmonic_response", "kinematics",
-           "load", "load_text", "mjcf", "mode_pairing", "modes", "preset_text", "presets", "sensitivity", "simulate",
-           "sweep", "write_report"]
+           "__version__", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "edited", "export_model",
+           "harmonic_response", "kinematics", "load", "load_text", "mjcf", "mode_pairing", "modes", "pin_loads",
+           "preset_text", "presets", "sensitivity", "simulate", "sweep", "write_report"]

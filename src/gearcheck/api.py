@@ -15,7 +15,11 @@ from pathlib import Path
 from gearcheck.compare.studies.campbell import CampbellResult
 from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing
+from gearcheck.compare.engine.measurements import load_measurements
+from gearcheck.compare.presentation.dashboard import render
 from gearcheck.compare.presentation.report import write_report
+from gearcheck.compare.studies.calibrate import Calibration, FitParameter
+from gearcheck.compare.studies.calibrate import calibrate as fit_train
 from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.session import SOLVERS, Train
@@ -25,7 +29,8 @@ from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 
-__all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "harmonic_response", "load", "mjcf", "mode_pairing",
+__all__ = ["SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model", "harmonic_response",
+           "load", "mjcf", "mode_pairing", "pin_loads",
            "modes", "presets", "sensitivity", "simulate", "sweep", "write_report"]
 
 
@@ -243,3 +248,49 @@ def sensitivity(train, parameter: str, method: str = "Fourier series", orders=No
 def mjcf(train, speed: float | None = None) -> str:
     """The MuJoCo model (MJCF text) of the train, deterministic, loadable in MuJoCo's viewer."""
     return Train(train, speed).mjcf()
+
+
+def describe(train) -> dict:
+    """What a train derives from its file (``gearcheck show``): speeds, ratio, gear radii, every mesh's contact
+    ratio, frequency, phase, stiffness and damping, an RV reducer's cycloid-pin stage; JSON-ready."""
+    return Train(train).describe()
+
+
+def pin_loads(train, times=None, *, span: str = "pitch", samples: int = 16, stage: str | None = None):
+    """An RV reducer's static pin forces (``gearcheck pins``): a
+    :class:`~gearcheck.lumped.pin_loads.PinLoads` of every disc and pin over one pin pitch or eccentric turn."""
+    return Train(train).pin_loads(times, span=span, samples=samples, stage=stage)
+
+
+def calibrate(train, fit, *, measurements=None, duration: float = 0.6, fit_speed=None, progress=None) -> Calibration:
+    """Least-squares fit of train-file numbers to measured amplitudes (``gearcheck calibrate``).
+
+    Parameters
+    ----------
+    train : str or path
+        A preset name or the path of a train file (the calibrated file is this text with the fitted values).
+    fit : list of str
+        Train-file fields in their own units with optional bounds, ``"stages[0].mesh.ste[0].amplitude_um=0.05:20"``.
+    measurements : path, optional
+        A TOML file of ``[[measurements]]``; default the train file's own.
+    duration : float
+        Simulated time per run, s.
+    fit_speed : list of float, optional
+        Fit only the measurements at these speeds (rpm); the others are predicted.
+    progress : callable, optional
+        Called with the number of runs done.
+
+    Returns
+    -------
+    Calibration
+        The fitted values, their uncertainty, the measured against predicted amplitudes, the calibrated text.
+    """
+    text, source = read_train_text(train)
+    entries = load_measurements(measurements) if measurements else list(load(train).measurements)
+    return fit_train(text, source, entries, [FitParameter.parse(f) for f in fit], duration, fit_speed, progress)
+
+
+def dashboard(store, out) -> Path:
+    """The regression dashboard (``gearcheck dashboard``): a static site of the history store ``store`` written
+    into the folder ``out``; returns its path."""
+    return render(store, out)

@@ -22,13 +22,12 @@ from pathlib import Path
 import numpy as np
 
 import gearcheck
-from gearcheck.compare.presentation import dashboard, history
+from gearcheck.compare.presentation import history
 from gearcheck.compare.engine.crosscheck import MODELS
 from gearcheck.compare.presentation.junit import write_junit
 from gearcheck.compare.presentation.progress import ProgressBar
 from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.presentation.summary import summary_row, write_summary
-from gearcheck.lumped.describe import describe
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError, did_you_mean
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
@@ -377,7 +376,7 @@ def cmd_presets(args) -> int:
 
 
 def cmd_show(args) -> int:
-    info = describe(gearcheck.load(args.train))
+    info = gearcheck.describe(args.train)
     if args.json:
         print(json.dumps(info, indent=2))
         return 0
@@ -589,13 +588,11 @@ def _coordinate(spec, name: str) -> int:
 
 def cmd_pins(args) -> int:
     from gearcheck.compare.presentation.plots import pin_loads as figure
-    from gearcheck.lumped.assembly import build_model
-    from gearcheck.lumped.pin_loads import pin_loads
 
     spec = gearcheck.load(args.train)
     path = args.output or Path("out") / f"{spec.name}-pins.png"
     check_place(path, "-o", folder=False)
-    loads = pin_loads(build_model(spec), span=args.span, samples=args.samples)
+    loads = gearcheck.pin_loads(spec, span=args.span, samples=args.samples)
     s = loads.summary()
     write_file(path, figure(loads, title=f"{spec.name}: static pin loads at {abs(loads.output_torque):.6g} N·m over "
                                          f"one {'pin pitch' if args.span == 'pitch' else 'eccentric turn'}"))
@@ -643,14 +640,12 @@ def cmd_animate(args) -> int:
 
 
 def cmd_view(args) -> int:
-    from gearcheck.compare.presentation.live_view import live_view
-
-    live_view(gearcheck.load(args.train), slow_motion=args.slow_motion, magnify=args.magnify)
+    gearcheck.Train(args.train).view(slow_motion=args.slow_motion, magnify=args.magnify)
     return 0
 
 
 def cmd_dashboard(args) -> int:
-    site = dashboard.render(args.store, args.output)
+    site = gearcheck.dashboard(args.store, args.output)
     print(f"wrote {site / 'index.html'}")
     return 0
 
@@ -701,22 +696,17 @@ def cmd_mjcf(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
-    from gearcheck.compare.studies.calibrate import FitParameter, calibrate
     from gearcheck.compare.presentation.calibrate_report import write_calibration
-    from gearcheck.compare.engine.measurements import load_measurements
-    from gearcheck.train.loader import read_train_text
 
-    text, source = read_train_text(args.train)
     spec = gearcheck.load(args.train)
-    entries = load_measurements(args.measurements) if args.measurements else list(spec.measurements)
-    fits = [FitParameter.parse(f) for f in args.fit]
 
     def progress(runs):
         if sys.stderr.isatty():
             print(f"\rcalibrate {spec.name}: {runs} runs", end="", file=sys.stderr, flush=True)
 
     with OutputDirectory(args.out) as place:
-        result = calibrate(text, source, entries, fits, args.duration, args.fit_speed, progress)
+        result = gearcheck.calibrate(args.train, args.fit, measurements=args.measurements, duration=args.duration,
+                                     fit_speed=args.fit_speed, progress=progress)
         if sys.stderr.isatty():
             print(file=sys.stderr)
         lines = write_calibration(result, spec.name, place.path, args.out)

@@ -19,8 +19,10 @@ from gearcheck.compare.engine.model_pair import resolve_model
 from gearcheck.compare.studies.campbell import CampbellResult, campbell
 from gearcheck.compare.studies.sensitivity import lattice
 from gearcheck.lumped import time_solver
+from gearcheck.lumped.describe import describe
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
+from gearcheck.lumped.pin_loads import PinLoads, pin_loads
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.lumped.transmission_error import relief_sweep, static_transmission_error
 from gearcheck.mbd_models.side import MujocoSide
@@ -159,3 +161,27 @@ class Train:
     def mjcf(self) -> str:
         """The MuJoCo model (MJCF text) of the twin, deterministic, loadable in MuJoCo's viewer."""
         return self.mujoco.model.xml
+
+    def describe(self) -> dict:
+        """What the train derives from its file, JSON-ready: speeds and ratio, every gear's radii, every mesh's
+        contact ratio, frequency, phase, stiffness and damping, an RV reducer's cycloid-pin stage."""
+        return describe(self.spec)
+
+    def pin_loads(self, times=None, *, span: str = "pitch", samples: int = 16, stage: str | None = None) -> PinLoads:
+        """An RV reducer's static pin forces, every disc and pin, at ``times`` (s) or ``samples`` frozen times over
+        one ``span`` ("pitch" or "turn"; Yang, Chen & Wang 2018).  See :func:`gearcheck.lumped.pin_loads.pin_loads`."""
+        return pin_loads(self.lumped.model, times, span=span, samples=samples, stage=stage)
+
+    def stiffness(self, cycles: int = 2):
+        """A Figure of every central gear's mesh stiffness with its first planet over ``cycles`` mesh cycles, beside
+        its mean (the model the train file names)."""
+        from gearcheck.compare.presentation.plots import mesh_stiffness_figure
+
+        return mesh_stiffness_figure(self.spec, cycles)
+
+    def view(self, slow_motion: float = 100.0, magnify: float = 1000.0) -> None:
+        """MuJoCo's viewer on the twin, running ``slow_motion`` times slower than real time with its deflection
+        magnified ``magnify`` times, until the window closes (needs a display)."""
+        from gearcheck.compare.presentation.live_view import live_view
+
+        live_view(self.mujoco.model, slow_motion=slow_motion, magnify=magnify)

@@ -39,6 +39,7 @@ from gearcheck.shared import divergence, stepping
 from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.results import TimeResult, bearing_names, train_result
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
@@ -184,15 +185,18 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
 
     started = clock.perf_counter()
     if method in ("rk4", "rk4-stages"):
-        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway, method == "rk4-stages", drive)
-        evaluations = 4 * n_steps
+        t_out, q_out, v_out, sub_steps = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway,
+                                              method == "rk4-stages", drive)
+        engine, stages, calls = "numba-rk4" if method == "rk4" else "python-rk4", 4, 4 * sub_steps
     else:
-        t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
+        t_out, q_out, v_out, calls = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
         runaway(t_out, q_out)
+        engine, stages = f"scipy-{method}", None
     wall = clock.perf_counter() - started
-    info = {"method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
-            "rhs_evaluations": evaluations, "wall_time_s": wall,
-            "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms}
+    info = RunInfo(engine, n_steps, stages, calls, wall, {
+        "method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
+        "rhs_evaluations": calls if stages is None else 4 * n_steps, "wall_time_s": wall,  # as reports state them
+        "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms})
     return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
@@ -244,7 +248,8 @@ def _chunk_steps(sys) -> int:
 def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, drive="steps"):
     """Fixed-step RK4 over n_steps, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
     samples and its last state for divergence.  The compiled steps (:func:`~gearcheck.lumped.compiled_steps.
-    rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python."""
+    rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python.  Returns the
+    samples' (t, q, v) and the sub-steps taken (steps split at stiffness jumps count each of theirs)."""
     n = q.size
     n_out = n_steps // every + 1
     t_out = np.empty(n_out)
@@ -252,11 +257,12 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
     v_out = np.empty((n_out, n))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     q, v = q.copy(), v.copy()
-    j = 1
+    j, sub_steps = 1, 0
     chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
         lengths, ends, times, inputs = _chunk(sys, h, start, stop, drive)
+        sub_steps += lengths.size
         if stage_by_stage:
             written = _python_steps(sys, q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
         else:
@@ -266,7 +272,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
         j += written
         if progress is not None:
             progress(stop / n_steps)
-    return t_out[:j], q_out[:j], v_out[:j]
+    return t_out[:j], q_out[:j], v_out[:j], sub_steps
 
 
 def stepper(model, dt: float, n_steps: int, drive: str = "steps"):

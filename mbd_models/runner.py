@@ -73,6 +73,7 @@ from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.results import Signal, TimeResult, train_result
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
@@ -393,8 +394,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     the static start.  record_energy: enable ``mjENBL_ENERGY`` and return MuJoCo's kinetic and
     potential energy in ``raw``.  engine: "compiled" (the step loop in C,
     :mod:`gearcheck.mbd_models.compiled`; the same steps, equal to round-off), "python" (the loop in Python),
-    or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); ``info["engine"]`` says which
-    ran.
+    or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); the result's ``info``
+    (:class:`~gearcheck.shared.run_info.RunInfo`) says which ran.
     """
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
@@ -429,6 +430,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     kind = _CompiledStepper if use_compiled else _LeanStepper if lean else _Stepper
     stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
+    sub_steps = n_steps
     try:
         started = clock.perf_counter()
         for start in range(0, n_steps, CHUNK):
@@ -436,6 +438,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
             j0 = stepper.j
             split = ({} if stiffness_clock == "bodies"
                      else stepping.split_steps(dt, start, stop, mb.excitation.switch_times(start * dt, stop * dt)))
+            sub_steps += sum(inner.size for inner in split.values())
             stepper.run(start, stop, every, stepper.drive.steps(dt * np.arange(start, stop), dt), split)
             _check_divergence(stepper, j0, stop * dt, every * dt, scale, what)
             if progress is not None:
@@ -447,11 +450,13 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         m.opt.enableflags, m.opt.timestep, m.opt.integrator = saved[3], saved[4], saved[5]
         m.tendon_damping[:] = saved[6]
     t = dt * every * np.arange(stepper.j)
-    info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
-            "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
-            "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
-            "static_newton_iterations": static.iterations, "static_residual": static.residual,
-            "forward_evaluations": 4 * n_steps, "engine": "compiled" if use_compiled else "python"}
+    loop = "compiled" if use_compiled else "python"
+    info = RunInfo(f"mujoco-{loop}", n_steps, 4, 4 * sub_steps, wall, {  # mj_forward, then mj_RungeKutta's 3
+        "method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
+        "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
+        "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
+        "static_newton_iterations": static.iterations, "static_residual": static.residual,
+        "forward_evaluations": 4 * n_steps, "engine": loop})  # as reports state them
     return _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
 
 

@@ -31,7 +31,7 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearcheck.lumped.compiled_steps import Sparse, Turning, rk4_steps
+from gearcheck.lumped.compiled_steps import Chunk, Matrices, Meshes, Output, Sparse, rk4_steps, turning_groups
 from gearcheck.lumped.cycloid_rows import CycloidRows
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
@@ -86,10 +86,13 @@ class _System:
         self.relieved = self.exc.relieved
         self.relieved_index = np.full(self.c.size, -1, dtype=np.int64)  # mesh -> its place among the relieved
         self.relieved_index[self.relieved] = np.arange(self.relieved.size)
-        self.turning_arrays = Turning.of(self.turning, model.n)  # for the compiled steps
-        self.sparse = Sparse.of(self.Kc), Sparse.of(self.D), Sparse.of(self.A)
         self.F0 = model.F_static
         self.b_in, self.b_out = model.b_input, model.b_output
+        static_load = sum((e.static_load for e in self.turning if isinstance(e, CycloidRows)), np.zeros(model.n))
+        self.kernel = (Matrices(self.Minv, self.F0 - static_load, self.b_in, self.b_out, Sparse.of(self.Kc),
+                                Sparse.of(self.D)),
+                       Meshes(Sparse.of(self.A), self.c, self.b, self.has_backlash, self.relieved_index),
+                       *turning_groups(self.turning))  # the compiled steps' groups
 
     def drive(self, t):
         """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``
@@ -128,16 +131,10 @@ class _System:
             force = force + coupling.forces(t, q, v)
         return force * self.Minv
 
-    def compiled_steps(self, q, v, lengths, ends, times, inputs, first_step, every, q_out, v_out) -> int:
+    def compiled_steps(self, q, v, chunk: Chunk, out: Output) -> int:
         """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` on this system (see :func:`_chunk`)."""
-        k, e, de, tin, tout, pairs = inputs
-        pairs = np.zeros((0, 3, 0, 0, 2)) if pairs is None else np.ascontiguousarray(pairs)
-        K, D, A = self.sparse
-        turning = self.turning_arrays
-        return rk4_steps(q, v, lengths, ends, first_step, every, q_out, v_out,
-                         self.Minv, self.F0 - turning.static_load, self.b_in, self.b_out, K.indptr, K.indices, K.data,
-                         D.indptr, D.indices, D.data, A.indptr, A.indices, A.data, self.c, self.b, self.has_backlash,
-                         self.relieved_index, *turning.arrays(), times, tin, tout, k, e, de, pairs)
+        pairs = np.zeros((0, 3, 0, 0, 2)) if chunk.pairs is None else np.ascontiguousarray(chunk.pairs)
+        return rk4_steps(q, v, *self.kernel, chunk._replace(pairs=pairs), out)
 
 
 def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
@@ -200,13 +197,10 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
-def _chunk(sys, h, start, stop, drive):
-    """The (sub-)steps of steps start..stop-1 and their drive: a step inside which a mesh stiffness jumps is
-    split there (:func:`~gearcheck.shared.stepping.split_steps`).  Returns (lengths, ends, times, inputs):
-    sub-step r spans [times[r, 0], times[r, 0] + lengths[r]], ``ends[r]`` when it ends a whole step, ``times``
-    (sub-steps, 3) its stage times t, t + h/2, t + h (at which the turning elements' rows are placed), and
-    ``inputs`` the drive (k, e, de, T_in, T_out, pairs) at the stage times of :data:`STAGE_OFFSETS`, with
-    time along axes (0, 1), held per step when ``drive == "steps"``."""
+def _chunk(sys, h, start, stop, drive) -> Chunk:
+    """The (sub-)steps of steps start..stop-1 and their drive (:class:`~gearcheck.lumped.compiled_steps.Chunk`): a
+    step inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`); the
+    drive held per step when ``drive == "steps"``."""
     steps = np.arange(start, stop)
     lengths = np.full(steps.size, h)
     sample = (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
@@ -234,7 +228,7 @@ def _chunk(sys, h, start, stop, drive):
         if sys.exc.has_transmission_error:  # else zeros
             e, de = per_step_drive(e), per_step_drive(de)
         pairs = None if pairs is None else per_step_pairs(pairs)
-    return lengths, ends, times, (k, e, de, tin, tout, pairs)
+    return Chunk(lengths, ends, times, k, e, de, tin, tout, pairs)
 
 
 def _chunk_steps(sys) -> int:
@@ -261,12 +255,10 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
     chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
-        lengths, ends, times, inputs = _chunk(sys, h, start, stop, drive)
-        sub_steps += lengths.size
-        if stage_by_stage:
-            written = _python_steps(sys, q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
-        else:
-            written = sys.compiled_steps(q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
+        steps = _chunk(sys, h, start, stop, drive)
+        sub_steps += steps.lengths.size
+        out = Output(start, every, q_out[j:], v_out[j:])
+        written = _python_steps(sys, q, v, steps, out) if stage_by_stage else sys.compiled_steps(q, v, steps, out)
         t_out[j:j + written] = h * (every * (start // every + 1 + np.arange(written)))
         runaway(np.append(t_out[j:j + written], stop * h), np.vstack([q_out[j:j + written], q[None]]))
         j += written
@@ -286,16 +278,17 @@ def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
 
     def run(q, v):
         q, v = np.array(q, dtype=float), np.array(v, dtype=float)
-        for start, (lengths, ends, times, inputs) in chunks:
-            sys.compiled_steps(q, v, lengths, ends, times, inputs, start, n_steps + 1, none, none)
+        for start, steps in chunks:
+            sys.compiled_steps(q, v, steps, Output(start, n_steps + 1, none, none))
         return q, v
 
     return run
 
 
-def _python_steps(sys, q, v, lengths, ends, times, inputs, first_step, every, q_out, v_out) -> int:
+def _python_steps(sys, q, v, chunk: Chunk, out: Output) -> int:
     """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` stage by stage in Python (the reference)."""
-    k, e, de, tin, tout, pairs = inputs
+    lengths, ends, times, k, e, de, tin, tout, pairs = chunk
+    first_step, every, q_out, v_out = out
     step, written = first_step, 0
     for r, h in enumerate(lengths):
         def stage(s, q, v):

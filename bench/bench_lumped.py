@@ -198,9 +198,9 @@ def steady_state_row(label: str, spec, settle: float = 1e-7, max_periods: int = 
     periods = int(settled[0]) if settled.size else None
     march = None if periods is None else run.info.wall_s * periods / (run.t.size - 1)
     marched = "not within the march" if periods is None else \
-        f"{periods:>8} {march:>8.3f} {march / shot.wall_time_s:>7.1f}"
+        f"{periods:>8} {march:>8.3f} {march / shot.info.wall_s:>7.1f}"
     print(f"{label:<22} {shot.period * 1e3:>9.4f} {shot.steps:>6} {shot.method:>6} {shot.residual:>9.1e} "
-          f"{shot.runs:>5} {shot.wall_time_s:>8.3f} {marched}")
+          f"{shot.runs:>5} {shot.info.wall_s:>8.3f} {marched}")
 
 
 def steady_state_table():

@@ -268,9 +268,9 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
 
 
 def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
-    """A function (q, v) -> (q, v) at t = n_steps dt, from (q, v) at t = 0, by the compiled RK4 steps of
-    :func:`simulate` (same drive sampling and splits); the drive is sampled once, for every call (a shooting
-    method's many runs over one period)."""
+    """(a function (q, v) -> (q, v) at t = n_steps dt, from (q, v) at t = 0, by the compiled RK4 steps of
+    :func:`simulate` (same drive sampling and splits), the sub-steps it takes); the drive is sampled once, for every
+    call (a shooting method's many runs over one period)."""
     sys = _System(model)
     chunk = _chunk_steps(sys)
     chunks = [(start, _chunk(sys, dt, start, min(start + chunk, n_steps), drive)) for start in range(0, n_steps, chunk)]
@@ -282,7 +282,7 @@ def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
             sys.compiled_steps(q, v, steps, Output(start, n_steps + 1, none, none))
         return q, v
 
-    return run
+    return run, sum(steps.lengths.size for _, steps in chunks)
 
 
 def _python_steps(sys, q, v, chunk: Chunk, out: Output) -> int:

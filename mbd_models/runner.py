@@ -316,38 +316,40 @@ class _CompiledStepper(_Stepper):
         super().__init__(mb, d, h, n_samples, bodies, energy)
         m, n, tc, reader = self.m, self.n_mesh, mb.turning, self.reader
         self.c = compiled.library()
-        self.pointers = (m._address, d._address, reader.probe._address, reader.joints_only._address)
-        self.model_views = (m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm, compiled.timestep_view(m),
-                            reader.probe.tendon_stiffness[:n], reader.probe.tendon_lengthspring[:n], m.tendon_damping)
-        self.data_views = (d.qpos, d.qvel, d.ctrl, d.qfrc_applied, d.sensordata, d.qfrc_spring, d.qfrc_damper,
-                           d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length, d.ten_velocity)
-        self.cycloid_arrays = compiled.cycloid_arrays(mb.cycloid, m.nv)
-        self.turning_arrays = tuple(np.ascontiguousarray(x) for x in (
-            tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
-            mb.half_backlash))
         c = self.contacts
         none = np.zeros(0, dtype=np.int64)
-        self.contact_arrays = ((none, none, none, np.zeros(1, dtype=np.int64)) if c is None else
-                               tuple(np.ascontiguousarray(x, dtype=np.int64) for x in
-                                     (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps)))))
-        self.work = (mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n))
-        self.reader_arrays = (np.ascontiguousarray(reader.dofs, dtype=np.int64),
-                              np.ascontiguousarray(reader.slides, dtype=np.int64))
-        self.outputs = (self.sensors, self.forces,
-                        np.zeros((0, n)) if self.stiffness is None else self.stiffness,
-                        np.zeros((0, 2)) if self.energy is None else self.energy,
-                        np.zeros((0, 0)) if self.pins is None else self.pins)
-        self.flags = (self.drive.has_te, self.contacts is not None, self.stiffness is not None,
-                      self.energy is not None, self.pins is not None)
+        self.twin = (  # the kernel's groups of this twin, as run_steps takes them after the C functions
+            compiled.Pointers(m._address, d._address, reader.probe._address, reader.joints_only._address),
+            compiled.ModelViews(m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm, compiled.timestep_view(m),
+                                reader.probe.tendon_stiffness[:n], reader.probe.tendon_lengthspring[:n],
+                                m.tendon_damping),
+            compiled.DataViews(d.qpos, d.qvel, d.ctrl, d.qfrc_applied, d.sensordata, d.qfrc_spring, d.qfrc_damper,
+                               d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length, d.ten_velocity),
+            compiled.Turning(*(np.ascontiguousarray(x) for x in (
+                tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
+                mb.half_backlash))),
+            compiled.Contacts(none, none, none, np.zeros(1, dtype=np.int64)) if c is None else compiled.Contacts(
+                *(np.ascontiguousarray(x, dtype=np.int64) for x in
+                  (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps))))),
+            compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n)),
+            compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
+                            np.ascontiguousarray(reader.slides, dtype=np.int64)),
+            compiled.cycloid_arrays(mb.cycloid, m.nv))
+        self.outputs = compiled.Outputs(self.sensors, self.forces,
+                                        np.zeros((0, n)) if self.stiffness is None else self.stiffness,
+                                        np.zeros((0, 2)) if self.energy is None else self.energy,
+                                        np.zeros((0, 0)) if self.pins is None else self.pins)
+        self.flags = compiled.Flags(self.drive.has_te, self.contacts is not None, self.stiffness is not None,
+                                    self.energy is not None, self.pins is not None)
 
-    def _arrays(self, values, rows: int):
-        """(k1, k2, u1, u2, e1, e2, de1, de2, p1, p2) of :meth:`_Drive.steps` as contiguous arrays, the absent
-        ones empty along their last axes."""
+    def _arrays(self, values, rows: int) -> compiled.Drive:
+        """(k, u, e, de, pairs) of :meth:`_Drive.steps` as contiguous arrays, the absent ones empty along their last
+        axes."""
         n = self.n_mesh
         empty = (np.zeros((rows, n)), np.zeros((rows, self.m.nu)), np.zeros((rows, 0)), np.zeros((rows, 0)),
                  np.zeros((rows, 0, 0, 2)))
-        return tuple(np.ascontiguousarray(y) if y is not None else blank
-                     for (first, later), blank in zip(values, empty) for y in (first, later))
+        return compiled.Drive(*(np.ascontiguousarray(y) if y is not None else blank
+                                for (first, later), blank in zip(values, empty) for y in (first, later)))
 
     def run(self, start, stop, every, values, split) -> None:
         rows = stop - start
@@ -361,13 +363,11 @@ class _CompiledStepper(_Stepper):
         lengths = np.array(lengths, dtype=float)
         sub = (self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size
                else [(None, None)] * 5)
-        split_arrays = (first, count, lengths) + self._arrays(sub, lengths.size)
         c = self.c
-        self.j = compiled.run_steps(c.forward, c.runge_kutta, c.passive, c.kinematics, c.com_pos, c.jac,
-                                    self.pointers, self.model_views, self.data_views, self.turning_arrays,
-                                    self.contact_arrays, self.work, self.reader_arrays, self.cycloid_arrays,
-                                    self._arrays(values, rows), split_arrays, self.flags, self.outputs, self.h, start,
-                                    stop, every, self.j)
+        self.j = compiled.run_steps(c.forward, c.runge_kutta, c.passive, c.kinematics, c.com_pos, c.jac, *self.twin,
+                                    self._arrays(values, rows),
+                                    compiled.Split(first, count, lengths, self._arrays(sub, lengths.size)),
+                                    self.flags, self.outputs, self.h, start, stop, every, self.j)
 
 
 def compiled_unsupported(mb: MbdModel, stiffness_clock: str = "nominal") -> str | None:

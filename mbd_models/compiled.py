@@ -300,7 +300,8 @@ def cycloid_arrays(cyc, nv: int) -> Cycloid:
                 np.asarray(cyc.stiffness if cyc is not None else [], dtype=f64),
                 np.asarray(cyc.damping if cyc is not None else [], dtype=f64),
                 np.asarray(cyc.clearance if cyc is not None else [], dtype=f64),
-                np.array([r[0] for r in rows], dtype=i64), np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
+                np.array([r[0] for r in rows], dtype=i64),
+                np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
     columns = list(zip(*discs)) if discs else [[]] * 11
     types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
     disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))

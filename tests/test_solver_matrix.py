@@ -154,8 +154,9 @@ RTOL, ATOL = 1e-8, 1e-20  # atol below every state's scale: the tolerance is rel
 def test_scipy_methods_meet_their_tolerance(problem, method, monkeypatch):
     """scipy's methods over 0.001 s (each of their steps at most 8 default steps): the largest error of q and of
     q', each over RTOL times the largest |q| or |q'|, within a few tolerances (global errors of a local error
-    control; bounds in ``ADAPTIVE``, measured at most 1.3, 2.3, 0.03, 9.3 and 6.6); the run reports scipy's count of right-hand sides, each of which evaluated
-    the model's once (the implicit methods' Jacobian differences evaluate it more)."""
+    control; bounds in ``ADAPTIVE``, measured at most 1.3, 2.3, 0.03, 9.3 and 6.6); the run reports scipy's count
+    of right-hand sides, each of which evaluated the model's once (the implicit methods' Jacobian differences
+    evaluate it more)."""
     spec, model, h = problem
     calls = []
     acceleration = time_solver._System.acceleration

@@ -41,7 +41,8 @@ import numpy as np  # noqa: E402
 
 import gearcheck  # noqa: E402
 from gearcheck.compare.engine.diagnosis import COEFFICIENT_FLOOR, Evidence, diagnose  # noqa: E402
-from gearcheck.lumped.assembly import AXIAL_DOF, build_model  # noqa: E402
+from gearcheck.lumped.assembly import build_model  # noqa: E402
+from gearcheck.train.spec import AXIAL  # noqa: E402
 
 PRESETS = ("demo-3p", "demo-4p", "hub-drive", "double-planet", "helical-planetary")
 CLASSES = ("dropped coupling", "sign error", "wrong inertia", "missing gyroscopic")
@@ -107,7 +108,7 @@ def inertia_mistakes(model) -> list[Mistake]:
     out = []
     for member in model.spec.members:
         dofs = [d for m, d in model.dofs.names if m == member]
-        groups = (("mass", dofs[:2]), ("theta inertia", ["theta"]), ("axial mass", [d for d in dofs if d == AXIAL_DOF]))
+        groups = (("mass", dofs[:2]), ("theta inertia", ["theta"]), ("axial mass", [d for d in dofs if d == AXIAL]))
         for what, group in groups:
             if not group:
                 continue

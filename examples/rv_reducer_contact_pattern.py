@@ -14,7 +14,7 @@ import numpy as np
 
 from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.elements.cycloid import CycloidRows
 from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import harmonic_balance_response
 from gearcheck.train.loader import load_train

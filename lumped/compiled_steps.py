@@ -11,14 +11,14 @@ chunk, and runs RK4 through them in compiled code.  Its right-hand side is that 
 * mesh m: f = k_m g(a_m.q - e_m) + c_m (a_m.v - e_m'), g the backlash dead zone (or the identity), or for a
   relieved mesh sum_j k_j max(0, a_m.q - e_m - e_j) over its tooth pairs;
 * the turning elements, whose rows move with time, at each stage's own time: the radial couplings between
-  frames (:meth:`gearcheck.lumped.assembly.TurningCoupling.forces`) and the cycloid stages' needle bearings,
-  compression-only pin contacts and orbit loads (:meth:`gearcheck.lumped.cycloid_rows.CycloidRows.forces`; the
+  frames (:meth:`gearcheck.lumped.elements.coupling.TurningCoupling.forces`) and the cycloid stages' needle bearings,
+  compression-only pin contacts and orbit loads (:meth:`gearcheck.lumped.elements.cycloid.CycloidRows.forces`; the
   pins' normals and arms from one sine and cosine per disc by the angle-addition formulas, as
   :func:`gearcheck.train.cycloid.pin_contacts` states them).
 
 It takes the model and the chunk in named groups (numba passes named tuples of arrays as structs):
-:class:`Matrices`, :class:`Meshes`, :class:`Couplings` and :class:`Discs` built once per model, :class:`Chunk` per
-chunk of steps, :class:`Output` where the samples go.
+:class:`Matrices`, :class:`Meshes`, :class:`Couplings` and :class:`Discs` built once per model
+(:func:`kernel_groups`), :class:`Chunk` per chunk of steps, :class:`Output` where the samples go.
 
 numba (``@njit(cache=True)``, compiled on the first call and cached on disk) is the one compiled dependency:
 a step is a loop over a few hundred numbers with branches (dead zones, contacts) that numpy cannot vectorise
@@ -32,8 +32,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from gearcheck.lumped.assembly import TurningCoupling
-from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.elements.coupling import TurningCoupling
+from gearcheck.lumped.elements.cycloid import CycloidRows
 
 
 class Sparse(NamedTuple):
@@ -136,13 +136,19 @@ class Discs(NamedTuple):
         return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
 
 
-def turning_groups(turning) -> tuple[Couplings, Discs]:
-    """The model's turning elements as the kernel's groups; TypeError for a kind without a compiled form."""
+def kernel_groups(system) -> tuple[Matrices, Meshes, Couplings, Discs]:
+    """The groups of a model's right-hand side (:class:`gearcheck.lumped.time_solver._System`) that
+    :func:`rk4_steps` takes after q and v; TypeError for a turning element without a compiled form."""
+    turning = system.turning
     unknown = [type(e).__name__ for e in turning if not isinstance(e, (TurningCoupling, CycloidRows))]
     if unknown:
         raise TypeError(f"no compiled form of the turning element(s) {', '.join(unknown)}")
-    return (Couplings.of([e for e in turning if isinstance(e, TurningCoupling)]),
-            Discs.of([e for e in turning if isinstance(e, CycloidRows)]))
+    cycloids = [e for e in turning if isinstance(e, CycloidRows)]
+    static_load = sum((e.static_load for e in cycloids), np.zeros(system.Minv.size))
+    return (Matrices(system.Minv, system.F0 - static_load, system.b_in, system.b_out, Sparse.of(system.Kc),
+                     Sparse.of(system.D)),
+            Meshes(Sparse.of(system.A), system.c, system.b, system.has_backlash, system.relieved_index),
+            Couplings.of([e for e in turning if isinstance(e, TurningCoupling)]), Discs.of(cycloids))
 
 
 class Chunk(NamedTuple):

@@ -22,7 +22,7 @@ from dataclasses import replace
 import numpy as np
 
 from gearcheck.lumped.assembly import LumpedModel, contact_sets, frozen_at
-from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.elements.cycloid import CycloidRows
 from gearcheck.lumped.fourier_response import ParametricProblem
 from gearcheck.lumped.static import mean_load
 from gearcheck.shared.errors import SolverError

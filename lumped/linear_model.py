@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gearcheck.shared.errors import TrainFileError
+from gearcheck.shared.errors import TrainFileError, did_you_mean
 
 SYMMETRY_TOLERANCE = 1e-9  # relative asymmetry of M, K, C accepted as round-off
 MEAN_TOLERANCE = 1e-6  # relative difference accepted between a given mean and the mean of the samples
@@ -273,8 +273,8 @@ class LinearModel:
                 raise self._error("meshes", f"{mesh.id!r} is not a mesh of {spec.name} ({', '.join(sorted(mesh_ids))})")
         for label, combination in self.physical_map().items():
             if label not in known:
-                raise self._error("physical", f"{label!r} is not a coordinate of {spec.name} (e.g. {labels[0]}, "
-                                  f"{labels[-1]})")
+                raise self._error("physical", f"{label!r} is not a coordinate of {spec.name}"
+                                  + did_you_mean(label, labels, n=3, cutoff=0))
             for coordinate, coefficient in combination.items():
                 if coordinate not in self.coordinates:
                     raise self._error(f"physical.{label}", f"{coordinate!r} is not one of the model's coordinates")

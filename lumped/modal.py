@@ -10,7 +10,7 @@
 
 from __future__ import annotations
 
-from gearcheck.lumped.assembly import AXIAL_DOF
+from gearcheck.train.spec import AXIAL, ROTATION
 from gearcheck.shared import modal as shared
 from gearcheck.shared.modal import ModalResult, modal_result
 from gearcheck.shared.units import rad_s_to_rpm
@@ -22,7 +22,7 @@ def central_coordinates(spec, labels) -> tuple[list[int], list[int]]:
     slides count with the rotations); labels of no member of ``spec`` are neither."""
     named = [(i, label.rsplit(".", 1)) for i, label in enumerate(labels) if "." in label]
     central = [(i, dof) for i, (member, dof) in named if member in spec.members and not spec.members[member].orbits]
-    turning = ("theta", AXIAL_DOF)
+    turning = (ROTATION, AXIAL)
     return [i for i, d in central if d not in turning], [i for i, d in central if d in turning]
 
 

@@ -37,8 +37,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.lumped.assembly import TurningCoupling
-from gearcheck.lumped.cycloid_rows import CycloidRows
 from gearcheck.lumped.time_solver import initial_state, step_limits, stepper
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import SolverError
@@ -83,12 +81,7 @@ def drive_frequencies(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
     model's turning couplings and cycloid contacts."""
     drive, meshes, aperiodic = model.excitation.periodic_terms()
     freqs = [drive]
-    for e in model.turning:
-        if isinstance(e, TurningCoupling):
-            freqs.append(np.array([abs(e.omega_b - e.omega_a) / (2 * math.pi)]))
-        elif isinstance(e, CycloidRows):  # eccentric (needles, orbit) and pins passing (identical pins)
-            freqs.append(np.array([abs(e.omega_eccentric), e.geometry.pins * abs(e.omega_pins - e.omega_eccentric)])
-                         / (2 * math.pi))
+    freqs += [e.frequencies() for e in model.turning]
     f = np.concatenate(freqs) if freqs else np.empty(0)
     return f[f > 0], meshes[meshes > 0], aperiodic
 
@@ -120,7 +113,7 @@ def common_period(model, max_mesh_periods: int = MAX_MESH_PERIODS) -> float:
 
 def _is_linear(model) -> bool:
     exc = model.excitation
-    return not (np.any(exc.backlash > 0) or exc.relieved.size or any(isinstance(e, CycloidRows) for e in model.turning))
+    return not (np.any(exc.backlash > 0) or exc.relieved.size or not all(e.smooth for e in model.turning))
 
 
 class _PeriodMap:

@@ -25,7 +25,7 @@ from gearcheck.train.cycloid import (
     pin_contacts,
     rigid_disc_load_share,
 )
-from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.elements.cycloid import CycloidRows
 from gearcheck.lumped.static import static_solution
 from gearcheck.shared.errors import GearcheckError
 

@@ -31,8 +31,7 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearcheck.lumped.compiled_steps import Chunk, Matrices, Meshes, Output, Sparse, rk4_steps, turning_groups
-from gearcheck.lumped.cycloid_rows import CycloidRows
+from gearcheck.lumped.compiled_steps import Chunk, Output, kernel_groups, rk4_steps
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
@@ -88,11 +87,7 @@ class _System:
         self.relieved_index[self.relieved] = np.arange(self.relieved.size)
         self.F0 = model.F_static
         self.b_in, self.b_out = model.b_input, model.b_output
-        static_load = sum((e.static_load for e in self.turning if isinstance(e, CycloidRows)), np.zeros(model.n))
-        self.kernel = (Matrices(self.Minv, self.F0 - static_load, self.b_in, self.b_out, Sparse.of(self.Kc),
-                                Sparse.of(self.D)),
-                       Meshes(Sparse.of(self.A), self.c, self.b, self.has_backlash, self.relieved_index),
-                       *turning_groups(self.turning))  # the compiled steps' groups
+        self.kernel = kernel_groups(self)
 
     def drive(self, t):
         """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``
@@ -347,7 +342,7 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
     static_bearing = [static.row_forces[static.row_names.index(r.name)] for r in bearings]
-    cycloids = [e for e in model.turning if isinstance(e, CycloidRows)]
-    pins = np.concatenate([e.pin_forces(t, q, v) for e in cycloids], axis=1) if cycloids else None
+    contacts = [e for e in model.turning if e.has_contacts]
+    pins = np.concatenate([e.pin_forces(t, q, v) for e in contacts], axis=1) if contacts else None
     return train_result(spec, "lumped", t, acc, angle, delta, force, k, static.mesh_force, static_bearing,
                         bearing_force, settle, info, raw, pins)

@@ -27,7 +27,7 @@ import mujoco
 import numba
 import numpy as np
 
-from gearcheck.mbd_models.mjcf_builder import PIN_BAND
+from gearcheck.mbd_models.elements.cycloid import PIN_BAND
 
 _LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
 _OPTION_DOUBLES_BEFORE_GRAVITY = 7  # mjOption: timestep, impratio, 4 tolerances, sleep_tolerance, then gravity[3]

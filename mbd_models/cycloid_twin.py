@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 
 from gearcheck.train.spec import TrainSpec
-from gearcheck.mbd_models.mjcf_builder import (
+from gearcheck.mbd_models.elements.cycloid import (
     PIN_BAND,
     needle_actuator,
     needle_list,

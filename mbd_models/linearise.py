@@ -35,7 +35,6 @@ from contextlib import contextmanager
 import mujoco
 import numpy as np
 
-from gearcheck.mbd_models.mjcf_builder import CENTRAL_AXES, member_axes
 from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
@@ -205,7 +204,7 @@ def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np
     n = mb.model.nv
     S, dS, ddS = np.eye(n), np.zeros((n, n)), np.zeros((n, n))
     for mid, member in mb.spec.members.items():
-        if member.kind != "disc":
+        if member.frame != "eccentric":
             continue
         stage = mb.spec.stage_of(mid)
         cyc = stage.cycloid
@@ -249,7 +248,7 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
             m.actuator_biasprm[mb.cycloid.needles.ravel(), 2] = 0.0
         P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier
         for mid, member in mb.spec.members.items():
-            if member_axes(member) == CENTRAL_AXES:
+            if member.frame == "axis":
                 ix, iy, _ = mb.dadr[mid]
                 omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
                 P[ix, iy], P[iy, ix] = -omega, omega
@@ -288,7 +287,7 @@ def _disc_curvature(mb, force: np.ndarray) -> np.ndarray:
     orbit atan2(t, e + r) (own hinge: minus that) have the second derivatives 1/e in t^2 and -1/e^2 in r t."""
     K = np.zeros((mb.model.nv, mb.model.nv))
     for mid, member in mb.spec.members.items():
-        if member.kind == "disc":
+        if member.frame == "eccentric":
             cyc = mb.spec.stage_of(mid).cycloid
             e, psi = cyc.geometry.eccentricity, cyc.phases[cyc.discs.index(mid)]
             orbit, radial, own = force[list(mb.dadr[mid])]

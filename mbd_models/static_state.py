@@ -73,7 +73,7 @@ def nominal_speeds(mb) -> np.ndarray:
     for mid, member in spec.members.items():
         ix, _, ir = mb.dadr[mid]
         omega = kin.speeds[f"{member.stage}.carrier"]
-        if member.kind == "disc":
+        if member.frame == "eccentric":
             orbit = kin.speeds[spec.stage_of(mid).cycloid.cranks[0]]
             qvel[ix], qvel[ir] = orbit, kin.speeds[mid] - orbit
         else:
@@ -91,7 +91,7 @@ def _nominal(mb, q: np.ndarray):
     qvel = nominal_speeds(mb)
     target = np.zeros_like(q)
     for mid, member in spec.members.items():
-        if member.orbits or member.kind == "disc":
+        if member.frame != "axis":
             continue
         ix, iy, _ = mb.dadr[mid]
         omega = kin.speeds[f"{member.stage}.carrier"]

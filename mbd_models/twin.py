@@ -36,18 +36,11 @@ from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.cycloid_twin import CycloidTwin
-from gearcheck.mbd_models.mjcf_builder import (
-    coupling_tendons,
-    document,
-    header,
-    member_axes,
-    mesh_joints,
-    mesh_tendons,
-    pin_joints,
-    pin_list,
-    pin_tendons,
-    spline_tendons,
-)
+from gearcheck.mbd_models.elements.base import TendonValues
+from gearcheck.mbd_models.elements.cycloid import pin_joints, pin_list, pin_tendon
+from gearcheck.mbd_models.elements.mesh import mesh_joints
+from gearcheck.mbd_models.mjcf_builder import document, header
+from gearcheck.mbd_models.mjcf_text import member_axes
 from gearcheck.mbd_models.static_state import static_state
 from gearcheck.shared import stepping
 
@@ -207,17 +200,13 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     exc = Excitation(spec, kin)
     k = _stiffness_values(spec, exc, stiffness)
     joints = [mesh_joints(spec, mesh) for mesh in spec.meshes]
-    placeholder = [[(j, 0.0) for j in names] for names in joints]
-    zeros = np.zeros(len(spec.meshes))
-    couplings = coupling_tendons(spec) + spline_tendons(spec)
-    pins = [[(j, 0.0) for j in pin_joints(spec, disc)] for _, disc, _ in pin_list(spec)]
-    tendons = mesh_tendons(spec, placeholder, k, zeros) + couplings + pin_tendons(spec, pins, [(0.0, 0.0)] * len(pins))
-    model = mujoco.MjModel.from_xml_string(document(spec, tendons, PLACEHOLDER_STEP, []))
+    values = TendonValues(stiffness={mesh.label: value for mesh, value in zip(spec.meshes, k)})
+    model = mujoco.MjModel.from_xml_string(document(spec, values, PLACEHOLDER_STEP, []))
 
     # MuJoCo's own coefficients at the reference configuration, into the compiled model
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    coefficients, damping = [], []
+    damping = []
     for t, (mesh, names, k_mean) in enumerate(zip(spec.meshes, joints, exc.mean_stiffness)):
         row = mesh_jacobian_row(spec, kin, model, data, mesh)
         dofs = {name: int(model.jnt_dofadr[_id(model, mujoco.mjtObj.mjOBJ_JOINT, name)]) for name in names}
@@ -226,24 +215,26 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
         for i, (name, value) in enumerate(coefs):
             assert model.wrap_objid[adr + i] == _id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
             model.wrap_prm[adr + i] = value
-        coefficients.append(coefs)
         damping.append(_mesh_damping(spec, mesh, model, row, float(k_mean)))
+        values.coefficients[mesh.label], values.damping[mesh.label] = coefs, damping[-1]
     model.tendon_damping[:len(spec.meshes)] = damping
 
     mb = _indices(spec, kin, exc, model)
+    pins = pin_list(spec)
     if pins:  # the pin contacts of t = 0, as MuJoCo's own Jacobians give them
         mb.cycloid = CycloidTwin(spec, model)
         mb.cycloid.refresh(data)
-        pins = [[(name, float(model.wrap_prm[model.tendon_adr[t] + i])) for i, (name, _) in enumerate(coefs)]
-                for coefs, t in zip(pins, mb.cycloid.tendons)]
+        for (_, disc, i), t in zip(pins, mb.cycloid.tendons):
+            values.coefficients[pin_tendon(disc, i)] = [(name, float(model.wrap_prm[model.tendon_adr[t] + w]))
+                                                        for w, name in enumerate(pin_joints(spec, disc))]
     mb.limits = linearise.step_limits(mb)
     model.opt.timestep = mb.default_step
     if mb.cycloid:
         mb.cycloid.contacts = static_state(mb).contacts
+        for (_, disc, i), t in zip(pins, mb.cycloid.tendons):
+            values.band[pin_tendon(disc, i)] = tuple(model.tendon_lengthspring[t])
     stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
-    bands = [tuple(band) for band in model.tendon_lengthspring[mb.cycloid.tendons]] if mb.cycloid else []
-    mb.xml = document(spec, mesh_tendons(spec, coefficients, k, damping) + couplings + pin_tendons(spec, pins, bands),
-                      model.opt.timestep, header(spec, stiffness_label))
+    mb.xml = document(spec, values, model.opt.timestep, header(spec, stiffness_label))
     return mb
 
 

@@ -286,7 +286,7 @@ OPTIONS = [
     (["run", "demo-3p", "--speed", "0"], "argument --speed: must be a positive number of rpm, got 0"),
     (["run", "demo-3p", "--speed", "-5"], "argument --speed: must be a positive number of rpm, got -5"),
     (["run", "demo-3p", "--speed", "inf"], "argument --speed: must be a positive number of rpm, got inf"),
-    (["run", "demo-3p", "--speed", "1e300"], "demo-3p: speed: must be <= 1e+06 rpm, got 1e+300"),
+    (["run", "demo-3p", "--speed", "1e300"], "speed must be <= 1e+06 rpm, got 1e+300"),
     (["run", "demo-3p", "--speed", "500000"], "speed 500000 rpm for demo-3p: the stage1.sun mesh would run at"),
     (["run", "demo-3p", "--method", "Euler"], "unknown method 'Euler'"),
     (["run", "demo-3p", "--solver", "mujoco", "--method", "RK45"], "method 'RK45' applies to the lumped solver only"),
@@ -324,7 +324,7 @@ OPTIONS = [
     (["sensitivity", "hub-drive", "--parameter", "stages[0].sun.mass"],
      "hub-drive: the harmonic methods solve a linear problem with constant load; this train has backlash"),
     (["sensitivity", "rv-reducer", "--parameter", "stages[0].sun.mass", "--speeds", "0:1000:3"],
-     "--speeds: every speed must be positive, got 0 rpm"),
+     "--speeds: every speed must be a positive number of rpm, got 0"),
     (["pins", "demo-3p"], "demo-3p has no cycloid-pin stage"),
     (["pins", "rv-reducer", "--samples", "0"], "--samples 0: need at least one frozen time"),
 ]

@@ -1,11 +1,13 @@
 """The compiled RK4 steps against the same RK4 stage by stage in Python, and no Python per step."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.compiled_steps import turning_groups
+from gearcheck.lumped.compiled_steps import kernel_groups
 from gearcheck.train.loader import load_train
 from gearcheck.train.variants import chained, edited
 from gearcheck.shared.settings import RunSettings
@@ -85,4 +87,4 @@ def test_chunks_hold_a_bounded_drive():
 
 def test_turning_elements_of_unknown_kind_are_refused():
     with pytest.raises(TypeError, match="no compiled form"):
-        turning_groups([object()])
+        kernel_groups(SimpleNamespace(turning=[object()]))

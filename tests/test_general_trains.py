@@ -62,7 +62,7 @@ def test_two_stages_with_a_spline():
 def test_a_ring_shared_by_two_stages():
     """Two stages' rings joined into one (a coupling of kind "ring", stiff radially and torsionally): the
     carriers turn at different speeds, so in the lumped model the radial coupling is time-periodic
-    (gearcheck.lumped.assembly.TurningCoupling).  At t = 0 every frame coincides and the natural frequencies
+    (gearcheck.lumped.elements.coupling.TurningCoupling).  At t = 0 every frame coincides and the natural frequencies
     agree with MuJoCo's (whose rings' slides are world-fixed, so its coupling is constant); the time
     responses agree too, which they would not if the periodic rows were wrong."""
     from gearcheck.train.loader import load_text

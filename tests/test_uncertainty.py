@@ -111,6 +111,8 @@ def test_bad_input_is_refused_in_one_line(entries, laws, fits, message):
 def test_bad_speeds_and_workers_are_refused(entries):
     with pytest.raises(GearcheckError, match=r"predict_speed 1000 rpm: no measurement"):
         study(entries, predict_speed=1000.0)
+    with pytest.raises(GearcheckError, match=r"^fit_speed must be a positive number of rpm, got -606$"):
+        study(entries, fit_speed=-606)
     with pytest.raises(GearcheckError, match=r"workers 0"):
         study(entries, workers=0)
     with pytest.raises(GearcheckError, match=r"--samples 0"):

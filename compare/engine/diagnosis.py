@@ -38,7 +38,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.linalg as sla
 
-from gearcheck.lumped.assembly import AXIAL_DOF, DofMap, LumpedModel
+from gearcheck.lumped.assembly import DofMap, LumpedModel
+from gearcheck.train.spec import AXIAL
 from gearcheck.lumped.modal import modes, modes_at_speed
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import DEGENERACY_TOLERANCE, RIGID_TOLERANCE, STABILITY_TOLERANCE
@@ -219,7 +220,7 @@ class _Base:
         for member in model.spec.members:
             dofs = [d for m, d in model.dofs.names if m == member]
             for term, group in ((f"{member} mass", dofs[:2]), (f"{member}.theta inertia", ["theta"]),
-                                (f"{member}.{AXIAL_DOF} mass", [d for d in dofs if d == AXIAL_DOF])):
+                                (f"{member}.{AXIAL} mass", [d for d in dofs if d == AXIAL])):
                 coordinates = [f"{member}.{d}" for d in group if f"{member}.{d}" in position]
                 if coordinates:
                     mask = np.zeros(len(self.labels), bool)

@@ -11,14 +11,13 @@ measuring chain and the value the source's own model gave (``published_model``).
 
 from __future__ import annotations
 
-import difflib
 import math
 from pathlib import Path
 
 from gearcheck.compare.engine.measure import chain_statistic
 from gearcheck.train.files import read_toml
 from gearcheck.train.schema import parse_measurements
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, did_you_mean
 
 SPEED_MATCH = 1e-6  # relative
 
@@ -33,9 +32,8 @@ def check_quantities(entries, quantities) -> None:
     known = set(quantities)
     for entry in entries:
         if entry["quantity"] not in known:
-            close = difflib.get_close_matches(entry["quantity"], sorted(known), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise GearcheckError(f"measurement of {entry['quantity']!r}: no such compared quantity{hint}")
+            raise GearcheckError(f"measurement of {entry['quantity']!r}: no such compared quantity"
+                                 + did_you_mean(entry["quantity"], sorted(known)))
 
 
 def attach(result, entries) -> None:

@@ -34,7 +34,6 @@ field or column and the value.
 
 from __future__ import annotations
 
-import difflib
 import math
 import zipfile
 from collections.abc import Mapping
@@ -49,7 +48,7 @@ from scipy.io.matlab import MatReadError
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.files import read_toml
 from gearcheck.lumped.modal import central_coordinates
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
 from gearcheck.shared.modal import ModalResult, energy_fractions, mode_types, multiplicities, rigid_or_elastic
 from gearcheck.shared.results import TimeResult, train_signals
 from gearcheck.shared.settings import RunSettings
@@ -178,8 +177,8 @@ def _factors(cmap: ColumnMap, spec) -> dict[str, float]:
     factors = {}
     for name, col in cmap.signals.items():
         if name not in known:
-            raise TrainFileError(cmap.source, _key(name), f"not a signal of {spec.name} "
-                                 f"(did you mean {', '.join(map(repr, _closest(name, known)))}?)")
+            raise TrainFileError(cmap.source, _key(name), f"not a signal of {spec.name}"
+                                 + _closest(name, known))
         unit = known[name].unit
         allowed = UNITS.get(unit, {unit: 1.0})
         given = unit if col.unit is None else col.unit
@@ -190,11 +189,12 @@ def _factors(cmap: ColumnMap, spec) -> dict[str, float]:
     return factors
 
 
-def _closest(name: str, known) -> list[str]:
-    """A few signal names like ``name``: those of the same last part (``force``, ``alpha`` ...) first."""
+def _closest(name: str, known) -> str:
+    """The did-you-mean of a few signal names like ``name``: those of the same last part (``force``, ``alpha``
+    ...) first."""
     last = name.rsplit(".", 1)[-1]
     pool = [n for n in known if n.rsplit(".", 1)[-1] == last] or list(known)
-    return difflib.get_close_matches(name, pool, n=3, cutoff=0.0)
+    return did_you_mean(name, pool, n=3, cutoff=0)
 
 
 def _uniform_step(t: np.ndarray, source: str, column: str, unit: str) -> float:
@@ -276,9 +276,8 @@ def _labels(raw, source: str, known: list[str]) -> list[str]:
             raise TrainFileError(source, _field(source, "coordinates"), f"holds {_show(item)}, not a coordinate name")
         label = item.strip()
         if label not in known:
-            close = difflib.get_close_matches(label, known, n=3, cutoff=0.0)
-            raise TrainFileError(source, _field(source, "coordinates"), f"{label!r} is not a coordinate of the train "
-                                 f"(did you mean {', '.join(map(repr, close))}?)")
+            raise TrainFileError(source, _field(source, "coordinates"), f"{label!r} is not a coordinate of the train"
+                                 + did_you_mean(label, known, n=3, cutoff=0))
         if label in out:
             raise TrainFileError(source, _field(source, "coordinates"), f"{label!r} appears twice")
         out.append(label)

@@ -16,12 +16,11 @@ table in a TOML file given with ``--tolerances`` (or a dict from Python; these w
 
 from __future__ import annotations
 
-import difflib
 from pathlib import Path
 
 from gearcheck.train.files import read_toml
 from gearcheck.train.spec import flat_tolerances
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
 
 METRICS = ("nrmse", "rel_error")
 DEFAULTS = {
@@ -52,8 +51,7 @@ class Tolerances:
             if metric not in METRICS:
                 raise GearcheckError(f"tolerance {key!r}: the metric must be one of {', '.join(METRICS)}")
             if name not in known:
-                close = difflib.get_close_matches(name, sorted(known), n=1)
-                hint = f" (did you mean {close[0]!r}?)" if close else f" (kinds: {', '.join(sorted(kinds))})"
+                hint = did_you_mean(name, sorted(known)) or f" (kinds: {', '.join(sorted(kinds))})"
                 raise GearcheckError(f"tolerance {key!r}: {name!r} is neither a kind nor a compared quantity{hint}")
 
     @classmethod

@@ -26,6 +26,7 @@ from pathlib import Path
 import pandas as pd
 
 from gearcheck.compare.presentation import history
+from gearcheck.compare.presentation.html_page import page
 from gearcheck.shared.outputs import OutputDirectory
 
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#17becf", "#bcbd22", "#7f7f7f")
@@ -41,23 +42,6 @@ RECENT = 20  # change-point rows on the front page
 MOVED_SHOWN = 15  # moved metrics listed per preset on the front page
 RUNS_SHOWN = 50  # runs listed on a preset page
 SHORT = 7  # characters of a commit id shown
-
-CSS = """
-body { font-family: system-ui, sans-serif; margin: 24px; color: #222; max-width: 1240px; }
-h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.6em; } h3 { font-size: 1em; margin: 0.2em 0; }
-table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
-th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: left; vertical-align: top; }
-th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
-code { font-size: 0.95em; } .muted { color: #777; } .nowrap { white-space: nowrap; }
-.badge { display: inline-block; padding: 1px 7px; border-radius: 3px; color: #fff; font-weight: 600; }
-.grid { display: grid; grid-template-columns: repeat(auto-fill, minmax(520px, 1fr)); gap: 10px 18px; }
-.grid svg { max-width: 100%; height: auto; }
-figure { margin: 0; } figcaption { font-size: 0.9em; font-weight: 600; }
-.card { border: 1px solid #ddd; border-radius: 4px; padding: 8px; margin: 10px 0; }
-tr.change-point td:first-child { border-left: 4px solid #c51b7d; }
-summary { cursor: pointer; margin: 0.3em 0; } summary code { color: #c51b7d; font-weight: 600; }
-svg { display: block; } svg text { font-family: system-ui, sans-serif; }
-"""
 
 
 @dataclass
@@ -180,7 +164,7 @@ def _index(store_name: str, order: list[str], presets: list[Preset]) -> str:
     body.append(".</p>")
     if not presets:
         body.append("<p>No runs recorded yet.</p>")
-        return _html("gearcheck regression dashboard", "".join(body))
+        return page("gearcheck regression dashboard", "".join(body))
     body.append("<h2>Latest verdicts</h2><table><tr><th>preset</th><th>verdict</th><th>commit</th><th>date</th>"
                 "<th>failures</th><th>unresolved</th><th>verdicts over commits (oldest left)</th></tr>")
     for p in presets:
@@ -232,7 +216,7 @@ def _index(store_name: str, order: list[str], presets: list[Preset]) -> str:
                         f"<td class=\"nowrap\"><a href=\"{_e(p.page)}\">{_e(name)}</a></td>"
                         f"<td class=\"num\">{len(these)}</td><td>{examples}</td></tr>")
         body.append("</table>")
-    return _html("gearcheck regression dashboard", "".join(body))
+    return page("gearcheck regression dashboard", "".join(body))
 
 
 def _since_previous(p: Preset) -> tuple[list, list]:
@@ -337,7 +321,7 @@ def _preset_page(p: Preset) -> str:
                      p.relative(item, "lumped.peak_to_peak", "lumped peak-to-peak", PALETTE[1])]
         body.append(_figure("Amplitude, change from the first run (%)", p.chart(amplitude, unit="%")))
         body.append("</div></div>")
-    return _html(f"{p.name}: gearcheck regression dashboard", "".join(body))
+    return page(f"{p.name}: gearcheck regression dashboard", "".join(body))
 
 
 def _overview(p: Preset) -> list:
@@ -498,11 +482,6 @@ def _axis(values: list, log: bool) -> tuple[float, float, list, bool]:
 
 
 # ---------------------------------------------------------------- HTML pieces
-
-def _html(title: str, body: str) -> str:
-    return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{_e(title)}</title>"
-            f"<style>{CSS}</style></head><body>\n{body}\n</body></html>\n")
-
 
 def _figure(title: str, svg: str) -> str:
     return f"<figure><figcaption>{_e(title)}</figcaption>{svg}</figure>"

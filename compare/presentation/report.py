@@ -33,6 +33,7 @@ import numpy as np
 
 from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.diagnosis import KINDS
+from gearcheck.compare.presentation.html_page import page
 from gearcheck.train.json_schema import DRAFT
 from gearcheck.train.loader import preset_text
 from gearcheck.train.schema import MEASUREMENT
@@ -406,23 +407,11 @@ def write_markdown(data, path: Path, figures: list[str]) -> None:
 
 OPEN_ROWS = 12  # a table longer than this, with nothing failing or unresolved in it, starts folded in the HTML
 
-STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
-         "table{border-collapse:collapse;font-size:0.85em;margin-bottom:1.5em}"
-         "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}th{background:#eee}"
-         "td:first-child{text-align:left}.fail{background:#fdd}.pass{background:#dfd}.unresolved{background:#ffd}"
-         ".negligible{color:#777}summary{font-size:1.2em;font-weight:bold;margin:0.8em 0;cursor:pointer}"
-         ".banner{padding:0.8em 1.2em;border-radius:6px;color:#fff;margin:1em 0}"
-         ".banner .verdict{font-size:2em;font-weight:bold;margin-right:0.6em}.banner p{margin:0.4em 0 0}"
-         ".banner a{color:#fff}.PASS{background:#2e7d32}.FAIL{background:#c62828}"
-         ".INCONCLUSIVE{background:#e08a00}img{max-width:100%}")
-
 
 def write_html(data, path: Path, figure_paths: list[Path]) -> None:
     esc = html.escape
-    parts = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
-             f"<title>gearcheck cross-check: {esc(data['train']['name'])}</title>",
-             f"<style>{STYLE}</style></head><body>",
-             f"<h1>gearcheck cross-check: {esc(data['train']['name'])}</h1>"]
+    title = f"gearcheck cross-check: {data['train']['name']}"
+    parts = [f"<h1>{esc(title)}</h1>"]
     verdict, counts, reasons = banner(data)
     names = [fig.name for fig in figure_paths]
     parts.append(f"<div class=\"banner {verdict}\"><span class=\"verdict\">{verdict}</span>{esc(counts)}"
@@ -433,14 +422,14 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
     parts.append(f"<p>{esc(_run_line(data))}</p>")
     if data["notes"]:
         parts.append("<h2>Findings</h2>" + "".join(f"<p>{esc(note)}</p>" for note in data["notes"]))
-    for title, header, rows, notes in markdown_tables(data):
+    for heading, header, rows, notes in markdown_tables(data):
         statuses = [r[-1] for r in rows if r[-1] in STATUSES]
         folded = len(rows) > OPEN_ROWS and not {"fail", "unresolved"} & set(statuses)
         tally = _counts_text({k: statuses.count(k) for k in STATUSES if k in statuses})
-        parts.append(f"<details{'' if folded else ' open'}><summary>{esc(title)}"
+        parts.append(f"<details class=\"section\"{'' if folded else ' open'}><summary>{esc(heading)}"
                      + (f" — {esc(tally)}" if tally else "") + "</summary>"
                      + "".join(f"<p>{esc(note)}</p>" for note in notes)
-                     + "<table><tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>")
+                     + "<table class=\"numbers\"><tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>")
         for r in rows:
             cls = f" class=\"{r[-1]}\"" if r[-1] in STATUSES else ""
             parts.append(f"<tr{cls}>" + "".join(f"<td>{esc(c)}</td>" for c in r) + "</tr>")
@@ -452,8 +441,7 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
                      f"src=\"data:image/png;base64,{encoded}\"><figcaption>{esc(fig.name)}</figcaption></figure>")
     parts.append("<h2>References</h2><ul>" + "".join(f"<li>[{esc(r['key'])}] {esc(r['citation'])}</li>"
                                                      for r in data["references"]) + "</ul>")
-    parts.append("</body></html>\n")
-    path.write_text("\n".join(parts), encoding="utf-8")
+    path.write_text(page(title, "\n".join(parts)), encoding="utf-8")
 
 
 def write_report(result, directory) -> dict:

@@ -7,6 +7,8 @@ import json
 import math
 from pathlib import Path
 
+from gearcheck.compare.presentation.html_page import page
+
 
 def summary_row(data: dict) -> dict:
     """One preset's row of the summary, from its report data (:func:`gearcheck.compare.presentation.report.to_dict`)."""
@@ -52,14 +54,11 @@ def write_summary(out: Path, rows: list[dict]) -> None:
         lines.append("| " + " | ".join(cells) + " |")
     (out / "summary.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
     esc = html.escape
-    body = ["<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>gearcheck summary</title>",
-            "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid "
-            "#ccc;padding:3px 8px}.FAIL{background:#fdd}.PASS{background:#dfd}.INCONCLUSIVE{background:#ffd}</style></head><body>",
-            "<h1>gearcheck cross-check of every preset</h1><table><tr>"
+    body = ["<h1>gearcheck cross-check of every preset</h1><table><tr>"
             + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>"]
     for r in rows:
         cells = [f"<a href=\"{esc(r['train'])}/report.html\">{esc(r['train'])}</a>"]
         cells += [esc(_cell(r[k])) for k, _ in SUMMARY_COLUMNS[1:]]
         body.append(f"<tr class=\"{r['status']}\">" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    body.append("</table></body></html>\n")
-    (out / "summary.html").write_text("\n".join(body), encoding="utf-8")
+    body.append("</table>")
+    (out / "summary.html").write_text(page("gearcheck summary", "\n".join(body)), encoding="utf-8")

@@ -35,7 +35,7 @@ from gearcheck.lumped.response_sensitivity import (
     harmonic_balance_sensitivity,
     parameter_derivative,
 )
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, did_you_mean
 
 METHODS = ("harmonic balance", "Fourier series")
 ORDERS = (3, 2)  # harmonics kept per clock by default: the mesh's, then an RV reducer's eccentrics'
@@ -182,8 +182,8 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
         model = _model(text, source, None, None, rpm)
         labels = model.dofs.labels()
         if coordinate not in labels:
-            raise GearcheckError(f"--coordinate {coordinate!r}: not a coordinate of {model.spec.name} "
-                                 f"(e.g. {', '.join(labels[:4])}, ...)")
+            raise GearcheckError(f"--coordinate {coordinate!r}: not a coordinate of {model.spec.name}"
+                                 + did_you_mean(coordinate, labels, n=3, cutoff=0))
         index = labels.index(coordinate)
         base = parametric_problem(model, contacts=contacts, **grids)
         orders = lattice(base, orders)

@@ -76,7 +76,7 @@ from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.outputs import OutputDirectory, check_place
 from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.units import rad_s_to_rpm
+from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
 
 FORMAT = 2  # of the table; part of every point's key
 SOLVERS = ("lumped", "mujoco")
@@ -200,9 +200,7 @@ def _numbers(text: str, what: str, positive: bool) -> list[float]:
         values = [low + (high - low) * i / max(count - 1, 1) for i in range(count)]
     if not values or not all(math.isfinite(v) for v in values):
         raise GearcheckError(f"{what}: every value must be a finite number")
-    if positive and min(values) <= 0:
-        raise GearcheckError(f"{what}: every speed must be > 0 rpm, got {min(values):g}")
-    return values
+    return [checked_rpm(v, f"{what}: every speed") for v in values] if positive else values
 
 
 # ----------------------------------------------------------------------------- points
@@ -284,12 +282,9 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
     if len({f.path for f in list(grid) + list(laws)}) != len(grid) + len(laws):
         raise GearcheckError("a field is given twice")
     if speeds is not None:
-        speeds = [float(s) for s in speeds]
+        speeds = [checked_rpm(float(s), "--speeds: every speed") for s in speeds]
         if not speeds:
             raise GearcheckError("--speeds: an empty list of speeds")
-        bad = [s for s in speeds if not (math.isfinite(s) and s > 0)]
-        if bad:
-            raise GearcheckError(f"--speeds: every speed must be a positive number of rpm, got {bad[0]:g}")
         if any(f.keys[:2] == ("operating", "input_speed_rpm") for f in list(grid) + list(laws)):
             raise GearcheckError("operating.input_speed_rpm is swept by --speeds: give it there only")
     if laws:

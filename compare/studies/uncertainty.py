@@ -46,7 +46,7 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.train.loader import load_text, load_train
 from gearcheck.lumped.modal import settling_time
 from gearcheck.shared.errors import GearcheckError
-from gearcheck.shared.units import rad_s_to_rpm
+from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
 
 NOMINAL = -1  # the ``sample`` of the row with the file's own values (``nominal=True``)
 STEADY_FRACTION = 2e-3  # the calibration's decay threshold (gearcheck.compare.engine.align.STEADY_THRESHOLD)
@@ -187,9 +187,9 @@ def uncertainty_study(text: str, source: str, entries: list[dict], distributions
     for f in parsed_fits:
         f.get(document)
     laws = _parse_distributions(distributions, document, {f.path for f in parsed_fits})
-    for name, value in (("fit_speed", fit_speed), ("predict_speed", predict_speed), ("duration", duration)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value) and value > 0):
-            raise GearcheckError(f"{name} {value!r}: needs a number > 0")
+    fit_speed, predict_speed = checked_rpm(fit_speed, "fit_speed"), checked_rpm(predict_speed, "predict_speed")
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 < duration < math.inf:
+        raise GearcheckError(f"duration {duration!r}: needs a number > 0")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise GearcheckError(f"workers {workers!r}: needs an integer >= 1")
     base = load_text(text, source)

@@ -29,7 +29,7 @@ from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.units import rpm_to_rad_s
+from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
 
 __all__ = ["SOLVERS", "campbell", "crosscheck", "export_model", "harmonic_response", "load", "mjcf", "mode_pairing",
            "modes", "presets", "sensitivity", "simulate", "sweep", "write_report"]
@@ -94,7 +94,7 @@ def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalRes
     side = _side(solver, load(train))
     if speed is None:
         return side.modes()
-    return side.modes_at_speed(rpm_to_rad_s(_speed(speed)))
+    return side.modes_at_speed(rpm_to_rad_s(checked_rpm(speed, zero=True)))
 
 
 def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> CampbellResult:
@@ -120,7 +120,7 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
     spec = load(train)
     solvers = tuple(SOLVERS) if solver == "both" else (solver,)
     sides = {s: _side(s, spec) for s in solvers}
-    speeds = [_speed(v) for v in speeds]
+    speeds = [checked_rpm(v, zero=True) for v in speeds]
     if len(speeds) < 2 or any(b <= a for a, b in zip(speeds, speeds[1:])):
         raise GearcheckError(f"speeds: give at least two speeds in ascending order, got {list(speeds)}")
     return campbell_diagram(spec, speeds, lambda s, w: sides[s].modes_at_speed(w), solvers, harmonics)
@@ -141,12 +141,6 @@ def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
     if model is None:
         return pair_modes(spec.name, _side("lumped", spec), _side("mujoco", spec))
     return pair_modes(spec.name, _side(against, spec), user_side(model, spec))
-
-
-def _speed(value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value >= 0 and value < float("inf")):
-        raise GearcheckError(f"speed must be a number of rpm >= 0, got {value!r}")
-    return float(value)
 
 
 def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: float | None = None,

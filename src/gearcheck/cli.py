@@ -30,8 +30,9 @@ from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.presentation.summary import summary_row, write_summary
 from gearcheck.lumped.describe import describe
 from gearcheck.shared.citations import REFERENCES
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, did_you_mean
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
+from gearcheck.shared.units import checked_rpm
 
 
 class Terminated(Exception):
@@ -518,8 +519,8 @@ def cmd_sensitivity(args) -> int:
     spec = gearcheck.load(args.train)
     coordinate = args.coordinate or f"{spec.output}.theta"
     method = sensitivity.METHODS[0] if args.method == "hb" else sensitivity.METHODS[1]
-    if args.speeds and min(args.speeds) <= 0:
-        raise GearcheckError(f"--speeds: every speed must be positive, got {min(args.speeds):g} rpm")
+    for rpm in args.speeds or ():
+        checked_rpm(rpm, "--speeds: every speed")
     index = _coordinate(spec, coordinate)
     with OutputDirectory(args.out) as place:
         if args.speeds:
@@ -567,7 +568,8 @@ def _coordinate(spec, name: str) -> int:
 
     labels = build_model(spec).dofs.labels()
     if name not in labels:
-        raise GearcheckError(f"--coordinate {name!r}: not a coordinate of {spec.name} (e.g. {', '.join(labels[:4])})")
+        raise GearcheckError(f"--coordinate {name!r}: not a coordinate of {spec.name}"
+                             + did_you_mean(name, labels, n=3, cutoff=0))
     return labels.index(name)
 
 

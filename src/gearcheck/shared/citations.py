@@ -8,8 +8,9 @@ work as authors and year, which is its key here.
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass
+
+from gearcheck.shared.errors import did_you_mean
 
 
 @dataclass(frozen=True)
@@ -102,9 +103,7 @@ REFERENCES: dict[str, Reference] = {
 
 def unknown(key: str) -> str:
     """The message for a key that is not in :data:`REFERENCES`, with a did-you-mean."""
-    close = difflib.get_close_matches(key, list(REFERENCES), n=1)
-    hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(REFERENCES)})"
-    return f"no reference {key!r} in gearcheck's table{hint}"
+    return f"no reference {key!r} in gearcheck's table{did_you_mean(key, REFERENCES, 'known')}"
 
 
 def cite(keys) -> list[dict]:

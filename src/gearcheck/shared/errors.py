@@ -3,10 +3,13 @@
 Every error a user can provoke with a train file or a command-line option is a
 ``GearcheckError``.  Messages name the file and the field path
 (``demo.toml: stages[0].sun.teeth: ...``) so the command-line interface can print
-them as one line and exit with status 2, never a traceback.
+them as one line and exit with status 2, never a traceback; a name that is not known ends
+with :func:`did_you_mean`'s hint.
 """
 
 from __future__ import annotations
+
+import difflib
 
 
 class GearcheckError(ValueError):
@@ -34,3 +37,14 @@ class DivergenceError(SolverError):
     def __init__(self, time: float, message: str):
         self.time = time
         super().__init__(f"diverged at t = {time:.6g} s: {message}")
+
+
+def did_you_mean(name: str, choices, listing: str = "", *, n: int = 1, cutoff: float = 0.6) -> str:
+    """The hint that follows an unknown ``name``: `` (did you mean 'x'?)`` with the entry of ``choices``
+    closest to it (up to ``n`` of them, as near as ``cutoff``: :func:`difflib.get_close_matches`); with
+    none close, `` (LISTING: a, b, ...)`` naming every choice when ``listing`` is given, else ``""``."""
+    choices = list(choices)
+    close = difflib.get_close_matches(name, choices, n=n, cutoff=cutoff)
+    if close:
+        return f" (did you mean {', '.join(map(repr, close))}?)"
+    return f" ({listing}: {', '.join(choices)})" if listing else ""

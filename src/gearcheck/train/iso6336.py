@@ -73,11 +73,6 @@ def mean_stiffness_of(single: float, contact_ratio: float, face_width: float) ->
     return single * (0.75 * contact_ratio + 0.25) * face_width
 
 
-def theoretical_single_stiffness(mesh) -> float:
-    """c'_th = 1/q' in N/m² of a mesh (:class:`~gearcheck.train.spec.MeshSpec`)."""
-    return theoretical_single_stiffness_of(*_pair(mesh), *_helix(mesh))
-
-
 def _helix(mesh) -> tuple[float, float]:
     """(|beta|, alpha_n) of the pair."""
     gear = mesh.central_gear

@@ -7,7 +7,6 @@ data: they install with gearcheck.
 from __future__ import annotations
 
 import hashlib
-import math
 from importlib import resources
 from pathlib import Path
 
@@ -16,7 +15,7 @@ from gearcheck.train.files import parse_toml, read_text
 from gearcheck.train.kinematics import kinematics
 from gearcheck.train.spec import TrainSpec, build_spec
 from gearcheck.shared.errors import GearcheckError, TrainFileError
-from gearcheck.shared.units import rpm_to_rad_s
+from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
 
 PRESET_PACKAGE = "gearcheck.train.presets"
 
@@ -47,10 +46,7 @@ def load_train(train: str | Path | TrainSpec, speed: float | None = None) -> Tra
     spec = train if isinstance(train, TrainSpec) else load_text(*read_train_text(train))
     if speed is None:
         return spec
-    if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not (math.isfinite(speed) and speed > 0):
-        raise GearcheckError(f"speed must be a positive number of rpm, got {speed!r}")
-    schema.OPERATING.fields["input_speed_rpm"].parse(speed, "speed", schema.Context(spec.name))  # its bounds
-    spec = spec.with_operating(input_speed=rpm_to_rad_s(speed))
+    spec = spec.with_operating(input_speed=rpm_to_rad_s(checked_rpm(speed)))
     try:
         kinematics(spec)
     except TrainFileError as exc:

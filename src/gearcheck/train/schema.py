@@ -10,15 +10,14 @@ dropped).  The README's field reference is generated from the same objects
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 from dataclasses import dataclass
 from typing import Any
 
 from gearcheck.shared.citations import REFERENCES
-from gearcheck.shared.errors import TrainFileError
-from gearcheck.shared.units import RAD_S_PER_RPM, SUFFIXES
+from gearcheck.shared.errors import TrainFileError, did_you_mean
+from gearcheck.shared.units import MAX_RPM, RAD_S_PER_RPM, SUFFIXES
 
 REQUIRED = object()
 
@@ -89,7 +88,7 @@ LIMITS = {
     "inertia": (1e8, "kg·m²: a million kilograms at a 10 m radius"),
     "stiffness": (1e18, "N/m or N·m/rad: a steel block of 1 m² section and 0.2 µm length; 'rigid' is 1e16"),
     "damping": (1e12, "N·s/m or N·m·s/rad: critical damping of the stiffest part on the lightest one"),
-    "speed": (1e6 * RAD_S_PER_RPM, "rad/s (a million rpm): pitch-line speeds past 300 m/s are refused separately"),
+    "speed": (MAX_RPM * RAD_S_PER_RPM, "rad/s (a million rpm): pitch-line speeds past 300 m/s are refused separately"),
     "torque": (1e9, "N·m: a hundred times the largest wind-turbine gearbox"),
     "frequency": (1e7, "Hz: far above any mesh harmonic"),
     "time": (1e4, "s: a ramp of hours is no start-up"),
@@ -153,8 +152,8 @@ class Text:
         if not isinstance(value, str):
             raise ctx.fail(path, f"must be a string, got {value!r}")
         if self.choices is not None and value not in self.choices:
-            hint = _did_you_mean(value, self.choices)
-            raise ctx.fail(path, f"must be one of {', '.join(self.choices)}; got {value!r}{hint}")
+            raise ctx.fail(path, f"must be one of {', '.join(self.choices)}; got {value!r}"
+                                 + did_you_mean(value, self.choices))
         if self.pattern is not None and not re.fullmatch(self.pattern, value):
             raise ctx.fail(path, f"{value!r} is not of the form {self.pattern}")
         return value
@@ -213,8 +212,7 @@ class Table:
                 if self.open:
                     out[key] = raw
                     continue
-                hint = _did_you_mean(key, list(self.fields))
-                raise ctx.fail(sub, f"unknown key{hint}")
+                raise ctx.fail(sub, "unknown key" + did_you_mean(key, self.fields))
             name, factor = _si_name(key)
             parsed = spec.parse(raw, sub, ctx)
             out[name] = _scale(parsed, factor)
@@ -276,11 +274,6 @@ def _scale(value, factor: float):
     if isinstance(value, list):
         return [v * factor for v in value]
     return value * factor
-
-
-def _did_you_mean(word: str, candidates) -> str:
-    close = difflib.get_close_matches(word, list(candidates), n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 # --------------------------------------------------------------------------------------

@@ -9,12 +9,12 @@ with an error that names the file and the field.
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import math
 from dataclasses import dataclass, field, replace
 from math import gcd
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -22,8 +22,9 @@ from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, palmgren_s
 from gearcheck.train.files import read_text, read_toml
 from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
 from gearcheck.train.mesh_stiffness import MODELS
+from gearcheck.train.parts import train_parts
 from gearcheck.train.schema import Context, parse_measurements
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
 
 MIN_TEETH = 6
 MAX_BACKLASH = 0.5  # modules: beyond, the backlash is more than the tooth space leaves
@@ -47,13 +48,25 @@ class Support:
     axial_damping: float = 0.0
 
 
+# Where a member's two translations are measured, by the frame its centre is carried in: "axis", on the stage's
+# axis (sun, ring, carrier, pin wheel), along the axes that turn with the stage's carrier; "pin", on a pin of
+# the carrier (planets, crankshafts), along the carrier's radial and tangential axes at the pin; "eccentric", on
+# the eccentrics of the crankshafts (cycloid discs), along the carrier's axes like a central member.
+TRANSLATIONS = {"axis": ("x", "y"), "pin": ("radial", "tangential"), "eccentric": ("x", "y")}
+ROTATION = "theta"  # absolute, about the stage axis
+AXIAL = "z"  # translation along the stage axis (absolute, like the others)
+FRAMES = {"sun": "axis", "ring": "axis", "carrier": "axis", "pin_wheel": "axis", "planet": "pin", "crank": "pin",
+          "disc": "eccentric"}
+
+
 @dataclass(frozen=True)
 class Member:
-    """A rigid body of the train: a central member (sun, ring, carrier) or a planet."""
+    """A rigid body of the train: a central member (sun, ring, carrier, pin wheel), a planet, or an RV
+    reducer's crankshaft or cycloid disc."""
 
     id: str  # "stage1.sun", "stage1.planet2"
     stage: str
-    kind: str  # sun | ring | carrier | planet
+    kind: str  # sun | ring | carrier | planet | crank | disc | pin_wheel
     mass: float
     inertia: float
     support: Support | None = None  # central members: support on the housing
@@ -61,16 +74,29 @@ class Member:
     gears: dict[str, Gear] = field(default_factory=dict)
     angle: float = 0.0  # planets: angle psi_n on the carrier circle
     radius: float = 0.0  # planets: carrier radius (position of the centre)
+    axial: bool = False  # slides along its stage's axis (every member of a helical stage)
 
     @property
     def is_planet(self) -> bool:
         return self.kind == "planet"
 
     @property
+    def frame(self) -> str:
+        """Where its translations are measured (:data:`TRANSLATIONS`)."""
+        return FRAMES[self.kind]
+
+    @property
     def orbits(self) -> bool:
         """Sits on a pin of its carrier (a planet, an RV reducer's crankshaft): its translations are along the
         carrier's radial and tangential axes at its place."""
-        return self.kind in ("planet", "crank")
+        return self.frame == "pin"
+
+    @property
+    def dofs(self) -> tuple[str, ...]:
+        """Its degrees of freedom, defined here once for both models and the result names: two translations
+        (:data:`TRANSLATIONS`), the absolute rotation ``theta``, and ``z`` along the stage axis when it slides
+        axially."""
+        return TRANSLATIONS[self.frame] + (ROTATION,) + ((AXIAL,) if self.axial else ())
 
     @property
     def label(self) -> str:
@@ -81,6 +107,7 @@ class Member:
 class MeshSpec:
     """A central gear meshing with one planet gear."""
 
+    element: ClassVar[str] = "mesh"
     id: str  # "stage1.planet2.ring"
     stage: str
     central: str  # member id
@@ -107,6 +134,9 @@ class MeshSpec:
 
 @dataclass(frozen=True)
 class Coupling:
+    """Central members of two stages joined in torsion and, with a radial stiffness, in both translations."""
+
+    element: ClassVar[str] = "coupling"
     name: str
     kind: str
     a: str
@@ -146,6 +176,8 @@ class CycloidStage:
     eccentrics and mesh with the pin wheel's pins (Yang, Chen & Wang 2018; geometry in
     :mod:`gearcheck.train.cycloid`)."""
 
+    element: ClassVar[str] = "cycloid"
+    stage: str  # the planetary stage whose carrier it rides on
     geometry: CycloidGeometry
     phases: tuple[float, ...]  # rad: each disc's eccentric from the cranks' first eccentric
     cranks: tuple[str, ...]  # member ids, crank k at planet k's place
@@ -211,6 +243,12 @@ class TrainSpec:
         name = self.members[member_id].stage
         return next(s for s in self.stages if s.name == name)
 
+    @property
+    def parts(self) -> tuple:
+        """Every part that joins the members, in the order both models build them
+        (:func:`~gearcheck.train.parts.train_parts`)."""
+        return train_parts(self)
+
     def with_operating(self, **changes) -> "TrainSpec":
         """A copy with operating-point fields replaced (e.g. ``input_speed``)."""
         return replace(self, operating=replace(self.operating, **changes))
@@ -237,12 +275,12 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     train = data["train"]
     for key in ("input", "output"):
         if train[key] not in members:
-            raise fail(f"train.{key}", f"no member {train[key]!r}{_known(train[key], members)}")
+            raise fail(f"train.{key}", f"no member {train[key]!r}{did_you_mean(train[key], members, 'members')}")
     for j, ref in enumerate(train["held"]):
         if ref in train["held"][:j]:
             raise fail(f"train.held[{j}]", f"{ref} is held twice")
         if ref not in members:
-            raise fail(f"train.held[{j}]", f"no member {ref!r}{_known(ref, members)}")
+            raise fail(f"train.held[{j}]", f"no member {ref!r}{did_you_mean(ref, members, 'members')}")
         if members[ref].kind not in HOLDABLE:
             raise fail(f"train.held[{j}]", f"{ref} is a {members[ref].kind}; only a sun, ring, carrier or pin wheel "
                                            "can be held")
@@ -258,7 +296,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     for j, c in enumerate(data["couplings"]):
         for key in ("from", "to"):
             if c[key] not in members:
-                raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{_known(c[key], members)}")
+                raise fail(f"couplings[{j}].{key}", f"no member {c[key]!r}{did_you_mean(c[key], members, 'members')}")
             if members[c[key]].kind not in HOLDABLE:
                 raise fail(f"couplings[{j}].{key}", f"{c[key]} is a {members[c[key]].kind}; a coupling joins "
                                                     "central members (sun, ring, carrier, pin wheel)")
@@ -318,11 +356,6 @@ def flat_tolerances(table: dict, fail) -> dict[str, float]:
 
     walk(table, "")
     return flat
-
-
-def _known(ref: str, members) -> str:
-    close = difflib.get_close_matches(ref, list(members), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else f" (members: {', '.join(members)})"
 
 
 def beside(source: str, name: str):
@@ -496,30 +529,55 @@ def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:
 
 
 def _build_stage(st: dict, path: str, fail):
-    name = st["name"]
-    n = st["planets"]
-    # --- planet gears
+    """A stage's members, its :class:`Stage` and its meshes, every geometric rule checked."""
+    name, n = st["name"], st["planets"]
+    planet_gears = _planet_gears(st, path, fail)
+    centrals = _central_gears(st, planet_gears, path, fail)
+    rv = _check_rv_layout(st, centrals, path, fail)
+    geoms = _mesh_geometries(centrals, planet_gears, path, fail)
+    carrier_radius = _centre_distance(centrals, planet_gears, geoms, path, fail)
+    angles, equally = _planet_angles(st, n, path, fail)
+    _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
+    _check_carrier_radius(st["carrier_radius"], carrier_radius, path, fail)
+    _check_collision(planet_gears, angles, carrier_radius, path, fail)
+    members = _stage_members(st, centrals, planet_gears, angles, carrier_radius, rv, path, fail)
+    planet_ids = tuple(f"{name}.planet{k + 1}" for k in range(n))
+    cycloid = _cycloid_stage(st, members, angles, carrier_radius, path, fail) if rv else None
+    meshes = _stage_meshes(st, centrals, planet_gears, geoms, planet_ids, path, fail)
+    helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
+    if helical:
+        _check_helical(st, centrals, meshes, path, fail)
+    if helical and rv:
+        raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
+    if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
+        members = {mid: replace(m, axial=True) for mid, m in members.items()}
+    stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
+                  f"{name}.carrier", helical, cycloid)
+    return members, stage, meshes
+
+
+def _planet_gears(st: dict, path: str, fail) -> dict[str, Gear]:
+    """The planet's gear, or a compound planet's gears by name."""
     planet_raw = st["planet"]
     if planet_raw["gears"] is not None and planet_raw["gears"]:
         if planet_raw["teeth"] is not None:
             raise fail(f"{path}.planet.teeth", "give teeth on each of planet.gears, not on the planet")
-        planet_gears = {g: _gear(g, raw, st, False, f"{path}.planet.gears.{g}", fail)
-                        for g, raw in planet_raw["gears"].items()}
-    else:
-        if planet_raw["teeth"] is None:
-            raise fail(f"{path}.planet.teeth", "missing required field (or give planet.gears)")
-        planet_gears = {"planet": _gear("planet", planet_raw, st, False, f"{path}.planet", fail)}
+        return {g: _gear(g, raw, st, False, f"{path}.planet.gears.{g}", fail) for g, raw in planet_raw["gears"].items()}
+    if planet_raw["teeth"] is None:
+        raise fail(f"{path}.planet.teeth", "missing required field (or give planet.gears)")
+    return {"planet": _gear("planet", planet_raw, st, False, f"{path}.planet", fail)}
 
-    # --- central gears (sun, ring, sun_*, ring_*)
+
+def _central_gears(st: dict, planet_gears: dict, path: str, fail) -> dict[str, tuple[Gear, str, dict]]:
+    """Central gears (sun, ring, sun_*, ring_*) by key: (gear, the planet gear it meshes, its table)."""
     central_keys = [k for k in st if (k in ("sun", "ring") or k.startswith(("sun_", "ring_"))) and st[k] is not None]
     if not central_keys:
         raise fail(path, "a stage needs at least one central gear (sun or ring)")
-    centrals: dict[str, tuple[Gear, str, dict]] = {}
+    centrals = {}
     for key in central_keys:
         raw = st[key]
         gpath = f"{path}.{key}"
-        internal = key.startswith("ring")
-        gear = _gear(key, raw, st, internal, gpath, fail)
+        gear = _gear(key, raw, st, key.startswith("ring"), gpath, fail)
         if raw["planet_gear"] is None:
             if len(planet_gears) > 1:
                 raise fail(f"{gpath}.planet_gear", f"missing required field for compound planets "
@@ -530,14 +588,19 @@ def _build_stage(st: dict, path: str, fail):
             if pg not in planet_gears:
                 raise fail(f"{gpath}.planet_gear", f"no planet gear {pg!r} (have {', '.join(planet_gears)})")
         centrals[key] = (gear, pg, raw)
+    return centrals
 
-    # --- an RV reducer: crankshafts in place of planet pins, and no ring (the cranks set the planets' spin)
+
+def _check_rv_layout(st: dict, centrals: dict, path: str, fail) -> bool:
+    """Whether the stage is an RV reducer's first stage (crankshafts in place of planet pins, and no ring: the
+    cranks set the planets' spin), its tables checked either way."""
+    planet_raw = st["planet"]
     rv = st["crank"] is not None or st["cycloid"] is not None
     if rv:
         for key in ("crank", "cycloid"):
             if st[key] is None:
                 raise fail(f"{path}.{key}", "missing: an RV reducer's stage needs both [crank] and [cycloid]")
-        rings = [key for key in central_keys if key.startswith("ring")]
+        rings = [key for key in centrals if key.startswith("ring")]
         if rings:
             raise fail(f"{path}.{rings[0]}", "an RV reducer's planets are turned by their crankshafts: a ring "
                                              "would lock them (remove the ring, or the crank and cycloid tables)")
@@ -546,10 +609,17 @@ def _build_stage(st: dict, path: str, fail):
                                                  "crank's bearing and spline instead)")
     elif planet_raw["bearing"] is None:
         raise fail(f"{path}.planet.bearing", "missing required field")
+    return rv
 
-    # --- every gear an involute gear, every pair an involute mesh
-    planet_paths = {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}"
-                    for name in planet_gears}
+
+def _planet_paths(planet_gears: dict, path: str) -> dict[str, str]:
+    return {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}" for name in planet_gears}
+
+
+def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dict:
+    """Every gear an involute gear, every central gear's pair with its planet gear an involute mesh: the operating
+    geometry of each pair by central key."""
+    planet_paths = _planet_paths(planet_gears, path)
     for gear, gpath in [(planet_gears[n], p) for n, p in planet_paths.items()] + \
             [(g, f"{path}.{key}") for key, (g, _, _) in centrals.items()]:
         problem = gear_problem(gear)
@@ -569,11 +639,15 @@ def _build_stage(st: dict, path: str, fail):
         if problem:
             where = f"{path}.{key}" if problem[0] == "central" else planet_paths[pg]
             raise fail(f"{where}.teeth", f"meshing {key} with the planet: {problem[1]}")
+    return geoms
 
-    # --- operating centre distances must agree (ring teeth consistent with sun and planet)
-    first = central_keys[0]
+
+def _centre_distance(centrals: dict, planet_gears: dict, geoms: dict, path: str, fail) -> float:
+    """The operating centre distance, which every central gear's pair must share (ring teeth consistent with sun
+    and planet): the carrier radius."""
+    first, *others = centrals
     a0 = geoms[first].centre_distance
-    for key in central_keys[1:]:
+    for key in others:
         a = geoms[key].centre_distance
         if abs(a - a0) > CENTRE_DISTANCE_TOLERANCE:
             g, pg, _ = centrals[key]
@@ -583,51 +657,61 @@ def _build_stage(st: dict, path: str, fail):
                 hint = f"; with zero profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth"
             raise fail(f"{path}.{key}.teeth", f"{key} with {g.teeth} teeth meets the planet at centre distance "
                                               f"{a * 1e3:.4f} mm but {first} at {a0 * 1e3:.4f} mm{hint}")
+    return a0
 
-    # --- planet angles and the assembly condition
-    if st["planet_angles"] is None:
-        angles = tuple(2.0 * math.pi * k / n for k in range(n))
-        equally = True
-    else:
-        if len(st["planet_angles"]) != n:
-            raise fail(f"{path}.planet_angles_deg", f"has {len(st['planet_angles'])} angles for {n} planets")
-        angles = tuple(st["planet_angles"])
-        spacing = [((angles[k] - angles[0]) - 2 * math.pi * k / n) for k in range(n)]
-        equally = max(abs(s) for s in spacing) < 1e-12
-    _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
-    carrier_radius = a0
-    stated = st["carrier_radius"]
+
+def _check_carrier_radius(stated: float | None, a0: float, path: str, fail) -> None:
+    """A stated carrier radius must be the operating centre distance ``a0``."""
     if stated is not None and abs(stated - a0) > CARRIER_RADIUS_TOLERANCE:
         raise fail(f"{path}.carrier_radius_mm", f"{stated * 1e3:.6g} mm, but the gears mesh at an operating centre "
                                                 f"distance of {a0 * 1e3:.6g} mm: the pins must sit there (change the "
                                                 "teeth or profile shifts, or the radius)")
-    _check_collision(planet_gears, angles, carrier_radius, path, fail)
 
-    # --- members
+
+def _planet_angles(st: dict, n: int, path: str, fail) -> tuple[tuple[float, ...], bool]:
+    """The planets' angles on the carrier and whether they are equally spaced."""
+    if st["planet_angles"] is None:
+        return tuple(2.0 * math.pi * k / n for k in range(n)), True
+    if len(st["planet_angles"]) != n:
+        raise fail(f"{path}.planet_angles_deg", f"has {len(st['planet_angles'])} angles for {n} planets")
+    angles = tuple(st["planet_angles"])
+    spacing = [((angles[k] - angles[0]) - 2 * math.pi * k / n) for k in range(n)]
+    return angles, max(abs(s) for s in spacing) < 1e-12
+
+
+def _stage_members(st: dict, centrals: dict, planet_gears: dict, angles, carrier_radius: float, rv: bool,
+                   path: str, fail) -> dict[str, Member]:
+    """The central members, the carrier and the planets (an RV reducer's planets bear on their cranks)."""
+    name, planet_raw = st["name"], st["planet"]
     members: dict[str, Member] = {}
     for key, (gear, _, raw) in centrals.items():
         mid = f"{name}.{key}"
         members[mid] = Member(mid, name, "ring" if gear.internal else "sun",
-                              *_body(raw, gear.base_radius, f"{path}.{key}", fail, gear), support=_support(raw["support"]),
-                              gears={key: gear})
+                              *_body(raw, gear.base_radius, f"{path}.{key}", fail, gear),
+                              support=_support(raw["support"]), gears={key: gear})
     carrier_raw = st["carrier"]
     carrier_id = f"{name}.carrier"
-    members[carrier_id] = Member(carrier_id, name, "carrier", *_body(carrier_raw, carrier_radius, f"{path}.carrier", fail),
+    members[carrier_id] = Member(carrier_id, name, "carrier",
+                                 *_body(carrier_raw, carrier_radius, f"{path}.carrier", fail),
                                  support=_support(carrier_raw["support"]))
     first_planet_gear = next(iter(planet_gears.values()))
     planet_mass, planet_inertia = _body(planet_raw, first_planet_gear.base_radius, f"{path}.planet", fail,
                                         first_planet_gear)
-    planet_ids = []
     for k, psi in enumerate(angles):
         pid = f"{name}.planet{k + 1}"
-        planet_ids.append(pid)
         members[pid] = Member(pid, name, "planet", planet_mass, planet_inertia,
                               bearing=None if rv else _support(planet_raw["bearing"]), gears=dict(planet_gears),
                               angle=psi, radius=carrier_radius)
-    cycloid = _cycloid_stage(st, members, angles, carrier_radius, path, fail) if rv else None
+    return members
 
-    # --- meshes
-    for layer, lpath in [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]:
+
+def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, planet_ids, path: str,
+                  fail) -> list[MeshSpec]:
+    """Every central gear's mesh with every planet, its stiffness model, damping, backlash and transmission error
+    checked (a central gear's [mesh] over the stage's)."""
+    name = st["name"]
+    layers = [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]
+    for layer, lpath in layers:
         if layer and layer["stiffness"] is not None:
             _check_stiffness(layer["stiffness"], f"{lpath}.stiffness", fail)
     meshes = []
@@ -654,14 +738,7 @@ def _build_stage(st: dict, path: str, fail):
                 damping_ratio=damping["ratio"], damping_coefficient=damping["coefficient"],
                 backlash=mesh["backlash"] or 0.0, ste=ste, planet_index=k,
             ))
-    helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
-    if helical:
-        _check_helical(st, centrals, meshes, path, fail)
-    if helical and rv:
-        raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
-    stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in central_keys),
-                  tuple(planet_ids), carrier_id, helical, cycloid)
-    return members, stage, meshes
+    return meshes
 
 
 def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path: str, fail) -> CycloidStage:
@@ -703,7 +780,7 @@ def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path:
     spline = crank["spline"]
     contact = cyc["contact"]
     return CycloidStage(
-        geometry, phases, tuple(cranks), tuple(discs), wheel,
+        name, geometry, phases, tuple(cranks), tuple(discs), wheel,
         Support(spline["radial_stiffness"], spline["radial_damping"], spline["torsional_stiffness"],
                 spline["torsional_damping"]),
         Support(cyc["bearing"]["radial_stiffness"], cyc["bearing"]["radial_damping"]),
@@ -745,9 +822,7 @@ def _check_stiffness(params: dict, path: str, fail):
     """Check a ``stiffness`` table against its model's parameter table; store SI values in place."""
     name = params["model"]
     if name not in MODELS:
-        close = difflib.get_close_matches(name, list(MODELS), n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{hint}")
+        raise fail(f"{path}.model", f"must be one of {', '.join(MODELS)}; got {name!r}{did_you_mean(name, MODELS)}")
     values = {k: v for k, v in params.items() if k != "model"}
     checked = MODELS[name].parameters.parse(values, path, Context(fail("", "").source))
     params.clear()

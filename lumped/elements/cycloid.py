@@ -1,4 +1,4 @@
-"""The cycloid-pin stage of an RV reducer in the reference model: rows that turn with the eccentrics.
+"""An RV reducer's cycloid-pin stage in the reference model: rows that turn with the eccentrics.
 
 Coordinates are those of the stage's carrier frame (turning at Omega, see :mod:`gearcheck.lumped.assembly`):
 crank k has (radial, tangential, theta) at its place psi_k on the carrier like a planet, disc j and the pin
@@ -25,16 +25,46 @@ of t = 0 with the contact set of the static solution (like a turning coupling), 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from gearcheck.lumped.elements import ELEMENTS
+from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning
+from gearcheck.lumped.static import mean_load
+from gearcheck.shared.errors import SolverError
 from gearcheck.train.cycloid import pin_contacts
 
 
+@ELEMENTS.register("cycloid")
+def cycloid_element(cyc, build: Build) -> Contribution:
+    """The stage's turning rows, placed in the finished model at t = 0 with the static contact set."""
+    spec, dofs, kin = build.spec, build.dofs, build.kin
+    stage = spec.stage_of(cyc.cranks[0])
+    omega = kin.speeds[stage.carrier]
+    wheel = kin.speeds[cyc.pin_wheel] if cyc.pin_wheel else 0.0
+    element = CycloidRows(
+        stage.name, build.n, np.array([dofs.indices(c) for c in cyc.cranks]),
+        np.array([dofs.indices(d) for d in cyc.discs]), dofs.indices(cyc.pin_wheel) if cyc.pin_wheel else None,
+        np.array([spec.members[c].angle for c in cyc.cranks]), np.array(cyc.phases),
+        kin.speeds[cyc.cranks[0]] - omega, wheel - omega, kin.speeds[cyc.cranks[0]], cyc.geometry,
+        stage.carrier_radius, cyc.needle.radial_stiffness, cyc.needle.radial_damping,
+        cyc.pin_stiffness(spec.operating.output_torque), cyc.contact_damping, cyc.clearance,
+        spec.members[cyc.discs[0]].mass, gap_load=np.zeros(build.n))
+
+    def place(model):
+        unplaced = replace(model, turning=model.turning + [element], F_static=model.F_static + element.static_load)
+        return element.place(unplaced, 0.0)
+    return Contribution(place=place)
+
+
 @dataclass(frozen=True)
-class CycloidRows:
+class CycloidRows(Turning):
     """The time-periodic rows and loads of one cycloid-pin stage (see the module docstring)."""
+
+    has_contacts = True
+    smooth = False
 
     stage: str
     n: int  # coordinates of the model
@@ -167,3 +197,52 @@ class CycloidRows:
         if self.wheel is not None:
             out[..., self.wheel] -= np.einsum("...ji,...jik->...k", p, coefficients[1])
         return out
+
+    # ------------------------------------------------------------------ the element in the model
+    def frequencies(self) -> np.ndarray:
+        """The eccentrics' turn (needles, orbit) and the pins passing (identical pins)."""
+        return np.array([abs(self.omega_eccentric), self.geometry.pins * abs(self.omega_pins - self.omega_eccentric)]
+                        ) / (2 * math.pi)
+
+    def without_frame_terms(self) -> "CycloidRows":
+        return replace(self, omega_orbit=0.0)
+
+    def held_load(self, n: int) -> np.ndarray:
+        return self.gap_load
+
+    def contact_set(self, model) -> np.ndarray:
+        names = {r.name for r in model.rows if r.kind == "contact"}
+        return np.array([name in names for name, _ in self.pin_rows(self.placed_at)])
+
+    def place(self, model, t: float, touching=None):
+        """``model`` with this stage's rows and loads of time ``t`` in place of those it had; the pins of
+        ``touching`` in contact, or those of the static solution."""
+        rows = [r for r in model.rows if r.name not in self.rows]
+        needles = [Row(name, "bearing", a, self.needle_stiffness, self.needle_damping)
+                   for name, a in self.needle_rows(t)]
+        pins = self.pin_rows(t)
+        base = replace(model, rows=rows + needles,
+                       F_static=model.F_static - self.static_load + self.orbit_force(t))  # gaps: below
+        A = np.array([a for _, a in pins])
+        touching = self._static_contact_set(base, A) if touching is None else np.asarray(touching, dtype=bool)
+        contacts = [Row(name, "contact", a, self.pin_stiffness, self.pin_damping)
+                    for (name, a), on in zip(pins, touching) if on]
+        gap_load = self.pin_stiffness * self.clearance * A[touching].sum(axis=0)  # a row k (a.q - gap)
+        placed = replace(self, rows=tuple(r.name for r in needles + contacts), placed_at=t, gap_load=gap_load)
+        return replace(base, rows=base.rows + contacts, F_static=base.F_static + gap_load,
+                       turning=[placed if e is self else e for e in model.turning])
+
+    def _static_contact_set(self, model, A: np.ndarray) -> np.ndarray:
+        """Which pins (rows ``A``, of the time the rows are placed at) touch in the static equilibrium under the
+        mean load (active set, from all of them touching)."""
+        K0 = model.K_b + model.K_mesh(model.excitation.mean_stiffness) + model.K_frame
+        F = mean_load(model)
+        active = np.ones(len(A), dtype=bool)
+        for _ in range(len(A) + 1):
+            K = K0 + self.pin_stiffness * A[active].T @ A[active]
+            q = np.linalg.lstsq(K, F + self.pin_stiffness * self.clearance * A[active].sum(axis=0), rcond=None)[0]
+            touching = A @ q - self.clearance > 0.0
+            if np.array_equal(touching, active):
+                return active
+            active = touching
+        raise SolverError(f"{self.stage}: the static pin contact set did not settle")  # pragma: no cover

@@ -1,0 +1,123 @@
+"""What every lumped element is made of: rows on named coordinates, and what an element adds to the model.
+
+Every elastic connection is a row (DESIGN.md 4): a scalar deflection delta = a . q with stiffness k and damping
+c.  An element builds its rows on the coordinates of :class:`DofMap` (each member's :attr:`dofs
+<gearcheck.train.spec.Member.dofs>`) and returns them in a :class:`Contribution`: constant rows, a driven mesh
+row, turning elements whose rows move with time (:class:`Turning`), and a last step that places it in the
+finished model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, ClassVar
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Row:
+    """One elastic connection: deflection a . q, stiffness, damping."""
+
+    name: str
+    kind: str  # mesh | bearing | support | coupling | shaft | contact
+    a: np.ndarray
+    stiffness: float
+    damping: float
+
+
+@dataclass
+class DofMap:
+    """Named coordinates: (member id, dof name) -> index."""
+
+    names: list[tuple[str, str]] = field(default_factory=list)
+    _index: dict[tuple[str, str], int] = field(default_factory=dict)
+
+    def add(self, member: str, dofs) -> None:
+        for d in dofs:
+            self._index[(member, d)] = len(self.names)
+            self.names.append((member, d))
+
+    def __call__(self, member: str, dof: str) -> int:
+        return self._index[(member, dof)]
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def of_member(self, member: str) -> list[int]:
+        return [i for i, (m, _) in enumerate(self.names) if m == member]
+
+    def labels(self) -> list[str]:
+        return [f"{m}.{d}" for m, d in self.names]
+
+    def unit(self, *entries: tuple[str, str, float]) -> np.ndarray:
+        """A row with ``value`` on coordinate (member, dof) for each (member, dof, value)."""
+        a = np.zeros(len(self.names))
+        for member, dof, value in entries:
+            a[self(member, dof)] += value
+        return a
+
+    def indices(self, member: str) -> np.ndarray:
+        """The coordinates of ``member`` in the order of its dofs."""
+        return np.array(self.of_member(member))
+
+
+@dataclass(frozen=True)
+class Build:
+    """What an element reads of the train being assembled."""
+
+    spec: object  # TrainSpec
+    kin: object  # Kinematics
+    dofs: DofMap
+    mean_stiffness: dict  # mesh id -> its mean stiffness, N/m (the excitation's)
+
+    @property
+    def n(self) -> int:
+        return len(self.dofs)
+
+
+@dataclass
+class Contribution:
+    """What one part adds: constant rows, its driven mesh row (a, damping), turning elements, and a step that
+    places it in the finished model (``LumpedModel -> LumpedModel``)."""
+
+    rows: list[Row] = field(default_factory=list)
+    mesh: tuple[np.ndarray, float] | None = None
+    turning: list = field(default_factory=list)
+    place: Callable | None = None
+
+
+class Turning:
+    """An element whose rows move with time (a radial coupling across turning frames, a cycloid-pin stage).
+
+    The model holds its rows of one time (``rows``, placed at :attr:`placed_at`) for the modal and static
+    analyses; the time solvers call :meth:`forces` at every stage instead.  The defaults are those of an element
+    with no contact set, no rotating-frame load and rows that the model keeps at t = 0."""
+
+    rows: tuple[str, ...]
+    has_contacts: ClassVar[bool] = False  # rows that touch or not (their set is solved with the static state)
+    smooth: ClassVar[bool] = True  # its forces are linear in the state (no contact switching)
+
+    def forces(self, t, q, v) -> np.ndarray:
+        """Generalized forces (time along axis 0 allowed) of its rows at times ``t``."""
+        raise NotImplementedError
+
+    def frequencies(self) -> np.ndarray:
+        """The frequencies (Hz) at which its rows move."""
+        raise NotImplementedError
+
+    def without_frame_terms(self):
+        """The element with the rotating frame's terms off."""
+        return self
+
+    def held_load(self, n: int) -> np.ndarray:
+        """(n,) the static load the model keeps of it without the rotating frame's terms."""
+        return np.zeros(n)
+
+    def place(self, model, t: float, touching=None):
+        """``model`` with this element's rows of time ``t`` (and the contact set ``touching``)."""
+        return model
+
+    def contact_set(self, model):
+        """Which of its contacts touch in the configuration ``model`` is placed at (None: it has none)."""
+        return None

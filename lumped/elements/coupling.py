@@ -1,0 +1,77 @@
+"""An interstage coupling: torsion between two central members and, with a radial stiffness, both
+translations; across frames that turn at different speeds, the radial part turns with time
+(:class:`TurningCoupling`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearcheck.lumped.elements import ELEMENTS
+from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning
+from gearcheck.train.spec import ROTATION
+
+
+@ELEMENTS.register("coupling")
+def coupling_rows(part, build: Build) -> Contribution:
+    spec, dofs, c = build.spec, build.dofs, part
+    rows = [Row(f"{c.name}.torsion", "coupling", dofs.unit((c.a, ROTATION, 1.0), (c.b, ROTATION, -1.0)),
+                c.torsional_stiffness, c.torsional_damping)]
+    turning = []
+    if c.radial_stiffness or c.radial_damping:
+        axes = spec.members[c.a].dofs[:2]
+        for axis in axes:
+            rows.append(Row(f"{c.name}.{axis}", "coupling", dofs.unit((c.a, axis, 1.0), (c.b, axis, -1.0)),
+                            c.radial_stiffness, c.radial_damping))
+        wa = build.kin.speeds[f"{spec.members[c.a].stage}.carrier"]
+        wb = build.kin.speeds[f"{spec.members[c.b].stage}.carrier"]
+        if abs(wa - wb) > 1e-12 * max(abs(wa), abs(wb), 1.0):
+            turning.append(TurningCoupling(tuple(dofs(c.a, x) for x in axes), tuple(dofs(c.b, x) for x in axes),
+                                           wa, wb, c.radial_stiffness, c.radial_damping,
+                                           tuple(f"{c.name}.{axis}" for axis in axes)))
+    return Contribution(rows, turning=turning)
+
+
+@dataclass(frozen=True)
+class TurningCoupling(Turning):
+    """A radial coupling between members whose frames turn at different speeds (a ring shared by two
+    stages, a radial spline between stages): member b's frame turns by phi = (Omega_b - Omega_a) t
+    relative to a's, so the coupling's rows are periodic in time.  Its rows in ``rows`` are those of
+    t = 0, when every frame coincides (what the modal and static analyses use, like MuJoCo's
+    linearisation at its initial configuration); the time solver replaces them by
+    :meth:`forces` at every stage."""
+
+    a: tuple[int, int]  # (x, y) coordinates of member a
+    b: tuple[int, int]
+    omega_a: float
+    omega_b: float
+    stiffness: float
+    damping: float
+    rows: tuple[str, str]  # names of its t = 0 rows
+
+    def frequencies(self) -> np.ndarray:
+        return np.array([abs(self.omega_b - self.omega_a) / (2 * np.pi)])
+
+    def forces(self, t, q, v) -> np.ndarray:
+        """Generalized forces (time along axis 0 allowed) of the spring-damper between the two centres,
+        acting on world-frame displacement and velocity and resolved in each member's own axes."""
+        phi = (self.omega_b - self.omega_a) * np.asarray(t, dtype=float)
+        c, s = np.cos(phi), np.sin(phi)
+        ua = np.stack([q[..., self.a[0]], q[..., self.a[1]]], axis=-1)
+        ub = np.stack([q[..., self.b[0]], q[..., self.b[1]]], axis=-1)
+        # world velocities in own axes: u' + Omega k x u
+        va = np.stack([v[..., self.a[0]] - self.omega_a * ua[..., 1], v[..., self.a[1]] + self.omega_a * ua[..., 0]],
+                      axis=-1)
+        vb = np.stack([v[..., self.b[0]] - self.omega_b * ub[..., 1], v[..., self.b[1]] + self.omega_b * ub[..., 0]],
+                      axis=-1)
+        # b's vectors in a's axes: R(phi) x
+        rot = lambda x: np.stack([c * x[..., 0] - s * x[..., 1], s * x[..., 0] + c * x[..., 1]], axis=-1)  # noqa
+        pull = self.stiffness * (ua - rot(ub)) + self.damping * (va - rot(vb))  # force on b, in a's axes
+        on_b = np.stack([c * pull[..., 0] + s * pull[..., 1], -s * pull[..., 0] + c * pull[..., 1]], axis=-1)
+        out = np.zeros(np.shape(q))
+        out[..., self.a[0]] -= pull[..., 0]
+        out[..., self.a[1]] -= pull[..., 1]
+        out[..., self.b[0]] += on_b[..., 0]
+        out[..., self.b[1]] += on_b[..., 1]
+        return out

@@ -1,0 +1,61 @@
+"""What a kind of part adds to the twin's MJCF: every hook of :class:`Element` adds nothing by default."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+
+@dataclass
+class TendonValues:
+    """The numbers of the tendons that are known only once the model is compiled, by tendon name: their joint
+    coefficients [(joint, coefficient)], stiffness, damping and spring length (dead band)."""
+
+    coefficients: dict = field(default_factory=dict)
+    stiffness: dict = field(default_factory=dict)
+    damping: dict = field(default_factory=dict)
+    band: dict = field(default_factory=dict)
+
+
+class Element:
+    """The MJCF of one kind of part (hooks get the part and the :class:`~gearcheck.train.spec.TrainSpec`)."""
+
+    def joint_springs(self, part, spec) -> dict:
+        """{(member id, joint suffix): (stiffness, damping)} the part puts on its members' joints."""
+        return {}
+
+    def tendons(self, part, spec, values: TendonValues) -> list[str]:
+        return []
+
+    def actuators(self, part, spec) -> list[str]:
+        return []
+
+    def sensors(self, part, spec) -> list[str]:
+        return []
+
+    def header(self, part) -> list[str]:
+        """Lines for the file's comment."""
+        return []
+
+    def assets(self, part, spec) -> list[str]:
+        return []
+
+    def sites(self, part, spec, member) -> list[str]:
+        """Sites the part needs on ``member``'s body."""
+        return []
+
+    def visuals(self, part, spec, member) -> list[str] | None:
+        """``member``'s visual geoms when the part draws it (None: the builder's gears and plates)."""
+        return None
+
+    def bodies(self, part, spec, z_stage: float, visuals: bool, geoms, springs: dict) -> list[str]:
+        """Bodies of the world the part adds after its stage's carrier (``geoms(member)``: a member's visuals)."""
+        return []
+
+    def bore(self, part, stage) -> float:
+        """The radius within which the stage's carrier plate must stay to clear the part."""
+        return math.inf
+
+    def reach(self, part) -> list[float]:
+        """Radii the front camera must take in."""
+        return []

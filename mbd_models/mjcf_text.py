@@ -1,0 +1,153 @@
+"""The MJCF vocabulary that the twin's builder and its element files write with.
+
+Every number is written with full precision (the shortest repr that round-trips), angles in radian, so the text
+is deterministic and lossless.  A member's joints realise its degrees of freedom
+(:attr:`gearcheck.train.spec.Member.dofs`) by the frame that carries it (:data:`AXES`).
+"""
+
+from __future__ import annotations
+
+import math
+
+RGBA = {
+    "sun": "0.95 0.6 0.1 1",
+    "ring": "0.62 0.62 0.68 1",
+    "carrier": "0.2 0.4 0.85 1",
+    "planet": "0.2 0.75 0.3 1",
+    "crank": "0.75 0.25 0.25 1",
+    "disc": "0.55 0.35 0.75 0.9",
+    "pin_wheel": "0.62 0.62 0.68 1",
+}
+MARKER_RGBA = "0.1 0.1 0.1 1"
+VISUAL = 'contype="0" conaffinity="0" group="1"'  # visual geoms: no contact (no mass: explicit inertials)
+# The joints that realise a member's two translations, by the frame that carries it: world-frame slides on the
+# stage axis, slides along the carrier's radial and tangential axes on a pin, and on an eccentric polar joints
+# about the stage axis (a hinge, and a slide along the eccentric)
+AXES = {"axis": ("x", "y"), "pin": ("radial", "tangential"), "eccentric": ("orbit", "radial")}
+ROTATION = "rz"  # the hinge of the member's rotation theta
+AXIAL = "z"  # the slide along the stage axis
+
+
+def member_axes(member) -> tuple[str, str]:
+    """The names of a member's first two joints (:data:`AXES`; its rotation is ``rz``)."""
+    return AXES[member.frame]
+
+
+def member_joints(member) -> tuple[str, ...]:
+    """The suffixes of all of a member's joints, one per degree of freedom in the order of its ``dofs``."""
+    return member_axes(member) + (ROTATION,) + ((AXIAL,) if member.axial else ())
+
+
+def num(x) -> str:
+    """A float written with full precision (shortest repr that round-trips)."""
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    return repr(x)
+
+
+def vec(*xs) -> str:
+    return " ".join(num(x) for x in xs)
+
+
+def joint(name: str, kind: str, axis, stiffness: float = 0.0, damping: float = 0.0, pos=(0.0, 0.0, 0.0)) -> str:
+    attrs = [f'name="{name}"', f'type="{kind}"', f'axis="{vec(*axis)}"', f'pos="{vec(*pos)}"']
+    if stiffness:
+        attrs.append(f'stiffness="{num(stiffness)}"')
+    if damping:
+        attrs.append(f'damping="{num(damping)}"')
+    return f"<joint {' '.join(attrs)}/>"
+
+
+def inertial(member) -> str:
+    polar = member.inertia
+    return (f'<inertial pos="0 0 0" mass="{num(member.mass)}" '
+            f'diaginertia="{vec(0.5 * polar, 0.5 * polar, polar)}"/>')
+
+
+def site(name: str, pos) -> str:
+    return f'<site name="{name}" pos="{vec(*pos)}" size="0.001" group="4"/>'
+
+
+def cylinder(name: str, kind: str, radius: float, a, b) -> str:
+    return (f'<geom name="{name}" type="cylinder" size="{num(radius)}" fromto="{vec(*a, *b)}" '
+            f'rgba="{RGBA[kind]}" {VISUAL}/>')
+
+
+def marker(member, r: float, z: float, size: float) -> str:
+    """A small box on the member's +x axis (body frame): it turns with the body."""
+    return (f'<geom name="{member.label}_marker" type="box" size="{vec(size, size, size)}" pos="{vec(r, 0, z)}" '
+            f'rgba="{MARKER_RGBA}" {VISUAL}/>')
+
+
+def fixed(name: str, coefs: list[tuple[str, float]], stiffness: float, damping: float,
+          springlength: tuple[float, float] = (0.0, 0.0)) -> list[str]:
+    """A ``<fixed>`` tendon: length sum coef q_joint, spring-damper with a dead band ``springlength``."""
+    attrs = [f'name="{name}"', f'stiffness="{num(stiffness)}"', f'springlength="{vec(*springlength)}"']
+    if damping:
+        attrs.append(f'damping="{num(damping)}"')
+    lines = [f"    <fixed {' '.join(attrs)}>"]
+    lines += [f'      <joint joint="{j}" coef="{num(c)}"/>' for j, c in coefs]
+    lines.append("    </fixed>")
+    return lines
+
+
+def _joints(member, springs: dict, axes, indent: str) -> list[str]:
+    """The body's joints, (suffix, type, axis) each, with the springs its parts put on them, and its axial slide
+    when it slides axially."""
+    if member.axial:
+        axes = axes + [(AXIAL, "slide", (0, 0, 1))]
+    return [f"{indent}  {joint(f'{member.label}_{name}', kind, axis, *springs.get((member.id, name), (0.0, 0.0)))}"
+            for name, kind, axis in axes]
+
+
+def central_body(member, springs: dict, z_stage: float, indent: str, visuals: list[str],
+                 children: list[str]) -> list[str]:
+    """A member on the stage axis: a child of the world with world-frame slides and a hinge."""
+    x, y = AXES["axis"]
+    lines = [f'{indent}<body name="{member.label}" pos="{vec(0, 0, z_stage)}">', f"{indent}  {inertial(member)}"]
+    lines += _joints(member, springs, [(x, "slide", (1, 0, 0)), (y, "slide", (0, 1, 0)),
+                                       (ROTATION, "hinge", (0, 0, 1))], indent)
+    lines += [f"{indent}  {g}" for g in visuals]
+    lines += children
+    lines.append(f"{indent}</body>")
+    return lines
+
+
+def pin_body(member, springs: dict, indent: str, visuals: list[str]) -> list[str]:
+    """A member on a pin of its carrier (a planet, an RV reducer's crankshaft): a child of the carrier at its place,
+    with slides along the carrier's radial and tangential axes and a hinge relative to the carrier."""
+    c, s = math.cos(member.angle), math.sin(member.angle)
+    radial, tangential = AXES["pin"]
+    lines = [f'{indent}<body name="{member.label}" pos="{vec(member.radius * c, member.radius * s, 0)}">',
+             f"{indent}  {inertial(member)}"]
+    lines += _joints(member, springs, [(radial, "slide", (c, s, 0)), (tangential, "slide", (-s, c, 0)),
+                                       (ROTATION, "hinge", (0, 0, 1))], indent)
+    return lines + [f"{indent}  {g}" for g in visuals] + [f"{indent}</body>"]
+
+
+def gear_z(spec) -> dict[tuple[str, str], float]:
+    """Axial offset (m, in the body) of every gear: a compound planet's gears side by side, each central gear
+    at the offset of the planet gear it meshes with."""
+    z = {}
+    for mid, member in spec.members.items():
+        if member.is_planet:
+            step = 1.5 * max(g.face_width for g in member.gears.values())
+            for i, name in enumerate(member.gears):
+                z[mid, name] = (i - 0.5 * (len(member.gears) - 1)) * step
+    for mesh in spec.meshes:
+        planet = spec.members[mesh.planet]
+        name = next(n for n, g in planet.gears.items() if g == mesh.planet_gear)
+        central = next(n for n, g in spec.members[mesh.central].gears.items() if g == mesh.central_gear)
+        z.setdefault((mesh.central, central), z[mesh.planet, name])
+    return z
+
+
+def plate(spec, stage, z: dict) -> tuple[float, float, float]:
+    """(axial offset of its centre, half thickness, the planets' tip radius) of a carrier's plate behind the
+    planets (``z``: :func:`gear_z`)."""
+    back = min((z[p, n] - 0.5 * g.face_width for p in stage.planets for n, g in spec.members[p].gears.items()),
+               default=0.0)
+    tip = max((g.tip_radius for p in stage.planets for g in spec.members[p].gears.values()), default=0.01)
+    h = max(0.25 * tip, 0.002)
+    return back - 2 * h, h, tip

@@ -1,0 +1,71 @@
+"""The parts that join a train's members, each a kind of element that both models build
+(:class:`gearcheck.shared.elements.Registry`).
+
+:func:`train_parts` lists them in the one order both models build them: the meshes, supports of the members
+on the housing, bearings of the members on carrier pins, interstage couplings, splines, the drive and the
+cycloid-pin stages.  The meshes (:class:`~gearcheck.train.spec.MeshSpec`), couplings
+(:class:`~gearcheck.train.spec.Coupling`) and cycloid-pin stages (:class:`~gearcheck.train.spec.CycloidStage`)
+are parts as the train file describes them; the others are written here from the members that carry them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+
+@dataclass(frozen=True)
+class SupportPart:
+    """A central member on the housing: radial springs along both translations, torsion, and axial."""
+
+    element: ClassVar[str] = "support"
+    member: str
+    support: object  # gearcheck.train.spec.Support
+    axial: bool
+
+
+@dataclass(frozen=True)
+class BearingPart:
+    """A member on a pin of its carrier (planet, crankshaft): isotropic in the plane, and axial."""
+
+    element: ClassVar[str] = "bearing"
+    member: str
+    carrier: str
+    bearing: object  # gearcheck.train.spec.Support
+    axial: bool
+
+
+@dataclass(frozen=True)
+class SplinePart:
+    """An RV reducer's planet on its crankshaft, both at the same pin: bending and torsion."""
+
+    element: ClassVar[str] = "spline"
+    planet: str
+    crank: str
+    spline: object  # gearcheck.train.spec.Support
+
+
+@dataclass(frozen=True)
+class DrivePart:
+    """The drive: torques on the input and output members and, when the input is driven by angle, the input
+    shaft, a torsional spring-damper between the input member and the drive's reference angle."""
+
+    element: ClassVar[str] = "drive"
+    member: str  # the input
+    output: str
+    stiffness: float | None  # the input shaft's; None: the input is driven by torque
+    damping: float
+
+
+def train_parts(spec) -> tuple:
+    """Every part of ``spec`` (a :class:`~gearcheck.train.spec.TrainSpec`), in build order."""
+    supports = [SupportPart(mid, m.support, m.axial) for mid, m in spec.members.items() if m.support is not None]
+    bearings = [BearingPart(mid, stage.carrier, spec.members[mid].bearing, spec.members[mid].axial)
+                for stage in spec.stages for mid in stage.planets + (stage.cycloid.cranks if stage.cycloid else ())
+                if spec.members[mid].bearing is not None]
+    splines = [SplinePart(planet, crank, stage.cycloid.spline) for stage in spec.stages if stage.cycloid
+               for planet, crank in zip(stage.planets, stage.cycloid.cranks)]
+    op = spec.operating
+    drive = DrivePart(spec.input, spec.output, op.input_shaft_stiffness, op.input_shaft_damping)
+    cycloids = [stage.cycloid for stage in spec.stages if stage.cycloid]
+    return (*spec.meshes, *supports, *bearings, *spec.couplings, *splines, drive, *cycloids)

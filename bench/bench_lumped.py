@@ -122,7 +122,7 @@ def solver_cost(model, duration: float, repeats: int = 1):
     best, info = np.inf, None
     for _ in range(repeats):
         info = simulate(model, RunSettings(duration)).info
-        best = min(best, info["wall_time_s"] / info["steps"])
+        best = min(best, info.wall_s / info.steps)
     return 1e6 * best, info
 
 
@@ -135,10 +135,10 @@ def cost_table(title: str, label: str, cases, repeats: int = 1):
     for name, spec, duration in cases:
         model = build_model(spec)
         per_step, info = solver_cost(model, duration, repeats)
-        yard = yardstick_cost(model, info["dt_s"], info["steps"], max(repeats, 3))
-        first = first or per_step * info["steps"]
-        print(f"{name:<22} {model.n:>4} {info['dt_s']:>10.4g} {info['steps']:>7} {info['wall_time_s']:>10.3f} "
-              f"{per_step:>8.2f} {yard:>9.2f} {per_step / yard:>6.2f} {per_step * info['steps'] / first:>7.2f}")
+        yard = yardstick_cost(model, info["dt_s"], info.steps, max(repeats, 3))
+        first = first or per_step * info.steps
+        print(f"{name:<22} {model.n:>4} {info['dt_s']:>10.4g} {info.steps:>7} {info.wall_s:>10.3f} "
+              f"{per_step:>8.2f} {yard:>9.2f} {per_step / yard:>6.2f} {per_step * info.steps / first:>7.2f}")
         rows.append((name, per_step, yard))
     return rows
 
@@ -165,10 +165,10 @@ def equal_accuracy(name: str, duration: float, every: int = 16):
         if error <= target:
             break
     rtol, run, error = chosen
-    ratio = run.info["wall_time_s"] / rk4.info["wall_time_s"]
-    print(f"{name:<10} {duration:>6g} {rk4.info['steps']:>7} {1e6 * rk4.info['wall_time_s'] / rk4.info['steps']:>8.2f} "
-          f"{rk4.info['wall_time_s']:>9.4f} {target:>9.2e} {rtol:>7.0e} {run.info['rhs_evaluations']:>8} "
-          f"{run.info['wall_time_s']:>9.3f} {error:>9.2e} {ratio:>7.1f}")
+    ratio = run.info.wall_s / rk4.info.wall_s
+    print(f"{name:<10} {duration:>6g} {rk4.info.steps:>7} {1e6 * rk4.info.wall_s / rk4.info.steps:>8.2f} "
+          f"{rk4.info.wall_s:>9.4f} {target:>9.2e} {rtol:>7.0e} {run.info.rhs_calls:>8} "
+          f"{run.info.wall_s:>9.3f} {error:>9.2e} {ratio:>7.1f}")
     return ratio
 
 
@@ -196,11 +196,11 @@ def steady_state_row(label: str, spec, settle: float = 1e-7, max_periods: int = 
     error = np.max(np.abs(q - shot.q), axis=1) / np.max(np.abs(shot.q))
     settled = np.flatnonzero(error < settle)
     periods = int(settled[0]) if settled.size else None
-    march = None if periods is None else run.info["wall_time_s"] * periods / (run.t.size - 1)
+    march = None if periods is None else run.info.wall_s * periods / (run.t.size - 1)
     marched = "not within the march" if periods is None else \
-        f"{periods:>8} {march:>8.3f} {march / shot.wall_time_s:>7.1f}"
+        f"{periods:>8} {march:>8.3f} {march / shot.info.wall_s:>7.1f}"
     print(f"{label:<22} {shot.period * 1e3:>9.4f} {shot.steps:>6} {shot.method:>6} {shot.residual:>9.1e} "
-          f"{shot.runs:>5} {shot.wall_time_s:>8.3f} {marched}")
+          f"{shot.runs:>5} {shot.info.wall_s:>8.3f} {marched}")
 
 
 def steady_state_table():

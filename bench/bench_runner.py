@@ -66,8 +66,8 @@ def rollout_step_cost(mb, n_steps: int, dt: float) -> float:
 
 def runner_step_cost(mb, n_steps: int, dt: float, engine: str) -> float:
     res = simulate_mujoco(mb, RunSettings(n_steps * dt, dt), engine=engine)
-    assert res.info["engine"] == engine
-    return res.info["wall_time_s"] / res.info["steps"]
+    assert res.info.engine == f"mujoco-{engine}"
+    return res.info.wall_s / res.info.steps
 
 
 def many_step_cost(mb, n_steps: int, dt: float, twins: int, threads: int) -> float:

@@ -16,6 +16,10 @@ chunk, and runs RK4 through them in compiled code.  Its right-hand side is that 
   pins' normals and arms from one sine and cosine per disc by the angle-addition formulas, as
   :func:`gearcheck.train.cycloid.pin_contacts` states them).
 
+It takes the model and the chunk in named groups (numba passes named tuples of arrays as structs):
+:class:`Matrices`, :class:`Meshes`, :class:`Couplings` and :class:`Discs` built once per model
+(:func:`kernel_groups`), :class:`Chunk` per chunk of steps, :class:`Output` where the samples go.
+
 numba (``@njit(cache=True)``, compiled on the first call and cached on disk) is the one compiled dependency:
 a step is a loop over a few hundred numbers with branches (dead zones, contacts) that numpy cannot vectorise
 over time, and that Python runs 10-100 times slower than compiled code.
@@ -23,7 +27,7 @@ over time, and that Python runs 10-100 times slower than compiled code.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -32,8 +36,7 @@ from gearcheck.lumped.elements.coupling import TurningCoupling
 from gearcheck.lumped.elements.cycloid import CycloidRows
 
 
-@dataclass(frozen=True)
-class Sparse:
+class Sparse(NamedTuple):
     """A matrix as compressed sparse rows (its exact non-zeros)."""
 
     indptr: np.ndarray
@@ -49,90 +52,151 @@ class Sparse:
         return cls(np.cumsum(indptr), cols.astype(np.int64), np.ascontiguousarray(matrix[rows, cols]))
 
 
-# ---------------------------------------------------------------------------------------------- turning elements
-@dataclass(frozen=True)
-class Turning:
-    """The model's turning elements as the arrays :func:`rk4_steps` takes.
+# ---------------------------------------------------------------------------------------------- the kernel's groups
+class Matrices(NamedTuple):
+    """The linear part, M q'' = load + b_in T_in + b_out T_out - D v - K q: ``minv`` the inverse of the diagonal
+    M, ``load`` F0 less the cycloid loads the static load holds, K (``K_c``) and D as sparse rows."""
 
-    couplings: ``coupling_index`` (T, 4) the (a_x, a_y, b_x, b_y) coordinates, ``coupling`` (T, 4) their
-    (Omega_a, Omega_b, stiffness, damping).  Cycloid discs, one row per disc of every cycloid stage:
-    ``disc_index`` (D, 3) its (x, y, theta), ``wheel_index`` (D, 3) its pin wheel's (-1: fixed),
-    ``crank_index`` (D, M, 3) its stage's cranks, ``crank_place`` (D, M, 2) cos and sin of their places psi_k
-    (padded), ``cranks`` (D,) their number, ``pin_place`` (D, Z, 2) cos and sin of 2 pi i / Z_p (padded), ``pins``
-    (D,) Z_p, and ``disc`` (D, 14): phase, w_H - Omega, w_w - Omega, K1, r_c, Z_p e, e, m e w_H^2, needle k and
-    c, pin k and c, clearance, and the carrier radius.  ``static_load`` (n,): the cycloid loads the model's
-    static load holds."""
+    minv: np.ndarray
+    load: np.ndarray
+    b_in: np.ndarray
+    b_out: np.ndarray
+    K: Sparse
+    D: Sparse
 
-    coupling_index: np.ndarray
-    coupling: np.ndarray
-    disc_index: np.ndarray
-    wheel_index: np.ndarray
+
+class Meshes(NamedTuple):
+    """The meshes: their ``rows`` a_m (sparse), ``damping`` c_m, ``half_backlash``, whether any has ``backlash``,
+    and ``relieved``, each mesh's place among the relieved meshes' tooth pairs (-1: not relieved)."""
+
+    rows: Sparse
+    damping: np.ndarray
+    half_backlash: np.ndarray
+    backlash: bool
+    relieved: np.ndarray
+
+
+class Couplings(NamedTuple):
+    """Radial couplings between turning frames: ``index`` (T, 4) the (a_x, a_y, b_x, b_y) coordinates, ``values``
+    (T, 4) their (Omega_a, Omega_b, stiffness, damping)."""
+
+    index: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, couplings) -> "Couplings":
+        return cls(np.array([[*e.a, *e.b] for e in couplings], dtype=np.int64).reshape(-1, 4),
+                   np.array([[e.omega_a, e.omega_b, e.stiffness, e.damping] for e in couplings],
+                            dtype=float).reshape(-1, 4))
+
+
+class Discs(NamedTuple):
+    """Cycloid discs, one row per disc of every cycloid stage: ``index`` (D, 3) its (x, y, theta), ``wheel`` (D, 3)
+    its pin wheel's (-1: fixed), ``crank_index`` (D, M, 3) its stage's cranks, ``crank_place`` (D, M, 2) cos and sin
+    of their places psi_k (padded), ``cranks`` (D,) their number, ``pin_place`` (D, Z, 2) cos and sin of
+    2 pi i / Z_p (padded), ``pins`` (D,) Z_p, and ``values`` (D, 14): phase, w_H - Omega, w_w - Omega, K1, r_c,
+    Z_p e, e, m e w_H^2, needle k and c, pin k and c, clearance, and the carrier radius."""
+
+    index: np.ndarray
+    wheel: np.ndarray
     crank_index: np.ndarray
     crank_place: np.ndarray
     cranks: np.ndarray
     pin_place: np.ndarray
     pins: np.ndarray
-    disc: np.ndarray
-    static_load: np.ndarray
+    values: np.ndarray
 
     @classmethod
-    def of(cls, turning, n: int) -> "Turning":
-        couplings = [e for e in turning if isinstance(e, TurningCoupling)]
-        cycloids = [e for e in turning if isinstance(e, CycloidRows)]
-        unknown = [type(e).__name__ for e in turning if not isinstance(e, (TurningCoupling, CycloidRows))]
-        if unknown:
-            raise TypeError(f"no compiled form of the turning element(s) {', '.join(unknown)}")
-        coupling_index = np.array([[*e.a, *e.b] for e in couplings], dtype=np.int64).reshape(-1, 4)
-        coupling = np.array([[e.omega_a, e.omega_b, e.stiffness, e.damping] for e in couplings],
-                            dtype=float).reshape(-1, 4)
+    def of(cls, cycloids) -> "Discs":
         discs = [(e, j) for e in cycloids for j in range(len(e.disc))]
         most_cranks = max((len(e.crank) for e in cycloids), default=0)
-        pins = max((e.geometry.pins for e in cycloids), default=0)
-        disc_index = np.zeros((len(discs), 3), dtype=np.int64)
-        wheel_index = np.full((len(discs), 3), -1, dtype=np.int64)
+        most_pins = max((e.geometry.pins for e in cycloids), default=0)
+        index = np.zeros((len(discs), 3), dtype=np.int64)
+        wheel = np.full((len(discs), 3), -1, dtype=np.int64)
         crank_index = np.zeros((len(discs), most_cranks, 3), dtype=np.int64)
         crank_place = np.zeros((len(discs), most_cranks, 2))
         cranks = np.zeros(len(discs), dtype=np.int64)
-        pin_place = np.zeros((len(discs), pins, 2))
-        count = np.zeros(len(discs), dtype=np.int64)
-        disc = np.zeros((len(discs), 14))
+        pin_place = np.zeros((len(discs), most_pins, 2))
+        pins = np.zeros(len(discs), dtype=np.int64)
+        values = np.zeros((len(discs), 14))
         for d, (e, j) in enumerate(discs):
             g = e.geometry
-            disc_index[d] = e.disc[j]
+            index[d] = e.disc[j]
             if e.wheel is not None:
-                wheel_index[d] = e.wheel
+                wheel[d] = e.wheel
             cranks[d] = len(e.crank)
             crank_index[d, :cranks[d]] = e.crank
             crank_place[d, :cranks[d]] = np.stack([np.cos(e.psi), np.sin(e.psi)], axis=-1)
             angles = 2 * np.pi * np.arange(g.pins) / g.pins
             pin_place[d, :g.pins] = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
-            count[d] = g.pins
-            disc[d] = (e.phases[j], e.omega_eccentric, e.omega_pins, g.K1, g.rolling_radius, g.pitch_radius,
-                       g.eccentricity, e.disc_mass * g.eccentricity * e.omega_orbit**2, e.needle_stiffness,
-                       e.needle_damping, e.pin_stiffness, e.pin_damping, e.clearance, e.carrier_radius)
-        static_load = sum((e.static_load for e in cycloids), np.zeros(n))
-        return cls(coupling_index, coupling, disc_index, wheel_index, crank_index, crank_place, cranks, pin_place,
-                   count, disc, static_load)
+            pins[d] = g.pins
+            values[d] = (e.phases[j], e.omega_eccentric, e.omega_pins, g.K1, g.rolling_radius, g.pitch_radius,
+                         g.eccentricity, e.disc_mass * g.eccentricity * e.omega_orbit**2, e.needle_stiffness,
+                         e.needle_damping, e.pin_stiffness, e.pin_damping, e.clearance, e.carrier_radius)
+        return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
 
-    def arrays(self) -> tuple:
-        return (self.coupling_index, self.coupling, self.disc_index, self.wheel_index, self.crank_index,
-                self.crank_place, self.cranks, self.pin_place, self.pins, self.disc)
+
+def kernel_groups(system) -> tuple[Matrices, Meshes, Couplings, Discs]:
+    """The groups of a model's right-hand side (:class:`gearcheck.lumped.time_solver._System`) that
+    :func:`rk4_steps` takes after q and v; TypeError for a turning element without a compiled form."""
+    turning = system.turning
+    unknown = [type(e).__name__ for e in turning if not isinstance(e, (TurningCoupling, CycloidRows))]
+    if unknown:
+        raise TypeError(f"no compiled form of the turning element(s) {', '.join(unknown)}")
+    cycloids = [e for e in turning if isinstance(e, CycloidRows)]
+    static_load = sum((e.static_load for e in cycloids), np.zeros(system.Minv.size))
+    return (Matrices(system.Minv, system.F0 - static_load, system.b_in, system.b_out, Sparse.of(system.Kc),
+                     Sparse.of(system.D)),
+            Meshes(Sparse.of(system.A), system.c, system.b, system.has_backlash, system.relieved_index),
+            Couplings.of([e for e in turning if isinstance(e, TurningCoupling)]), Discs.of(cycloids))
+
+
+class Chunk(NamedTuple):
+    """A chunk of sub-steps and their drive: sub-step r spans [times[r, 0], times[r, 0] + lengths[r]] and ends a
+    whole step when ``ends[r]``; ``times`` (sub-steps, 3) its stage times t, t + h/2, t + h; the drive (mesh
+    stiffness ``k``, transmission error ``e`` and its rate ``de``, torques ``tin`` and ``tout``, the relieved
+    meshes' tooth pairs ``pairs`` (k_j, e_j) or None) with time along axes (0, 1): the stage times of
+    :data:`~gearcheck.shared.stepping.STAGE_OFFSETS`."""
+
+    lengths: np.ndarray
+    ends: np.ndarray
+    times: np.ndarray
+    k: np.ndarray
+    e: np.ndarray
+    de: np.ndarray
+    tin: np.ndarray
+    tout: np.ndarray
+    pairs: np.ndarray | None
+
+
+class Output(NamedTuple):
+    """Where the steps go: after whole step ``first_step + i + 1`` that is a multiple of ``every``, the state goes
+    to the next rows of ``q`` and ``v``."""
+
+    first_step: int
+    every: int
+    q: np.ndarray
+    v: np.ndarray
 
 
 # ---------------------------------------------------------------------------------------------- the kernel
 @njit(cache=True)
-def rk4_steps(q, v, lengths, ends, first_step, every, q_out, v_out,
-              minv, F0, b_in, b_out, kp, ki, kx, dp, di, dx, ap, ai, ax, c, half, backlash, relieved,
-              coupling_index, coupling, disc_index, wheel_index, crank_index, crank_place, cranks, pin_place, pins,
-              disc, times, tin, tout, k, e, de, pairs):
-    """Classical RK4 through the sub-steps r of lengths ``lengths[r]``, q and v updated in place.  The drive of
-    sub-step r at its stage times ``times[r]`` (t, t + h/2, t + h) is ``[r, 0|1|2]`` of the drive arrays (stages 2
-    and 3 both see index 1); the turning elements (:class:`Turning`) are placed at ``times[r]``.  ``ends[r]``:
-    sub-step r ends a whole step; after whole step ``first_step + i + 1`` that is a multiple of ``every`` the state
-    goes to the next rows of q_out, v_out.  Returns the samples written.
+def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out):
+    """Classical RK4 through the sub-steps of ``chunk`` (:class:`Chunk`, its ``pairs`` an array), q and v updated
+    in place.  The drive of sub-step r at its stage times ``times[r]`` (t, t + h/2, t + h) is ``[r, 0|1|2]`` of the
+    drive arrays (stages 2 and 3 both see index 1); the turning elements (:class:`Couplings`, :class:`Discs`) are
+    placed at ``times[r]``.  Returns the samples written to ``out`` (:class:`Output`).
 
-    One function, the right-hand side written out in the loop over the four stages (a call per stage with its
-    forty arrays costs more than the stage itself on a small train)."""
+    One function, the right-hand side written out in the loop over the four stages (a call per stage costs more
+    than the stage itself on a small train)."""
+    minv, F0, b_in, b_out = matrices.minv, matrices.load, matrices.b_in, matrices.b_out
+    kp, ki, kx = matrices.K
+    dp, di, dx = matrices.D
+    (ap, ai, ax), c, half, backlash, relieved = meshes
+    coupling_index, coupling = couplings
+    disc_index, wheel_index, crank_index, crank_place, cranks, pin_place, pins, disc = discs
+    lengths, ends, times, k, e, de, tin, tout, pairs = chunk
+    first_step, every, q_out, v_out = out
     n = q.size
     Q, V, acc = np.empty((4, n)), np.empty((4, n)), np.empty((4, n))  # each stage's state and q''
     time_index = (0, 1, 1, 2)

@@ -24,6 +24,7 @@ from gearcheck.shared import stepping
 from gearcheck.shared.errors import DivergenceError
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
 from gearcheck.shared.results import TimeResult, coordinate_signals, train_signals
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
 
@@ -107,8 +108,9 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
         raise DivergenceError(float(t[-1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
     if progress is not None:
         progress(1.0)
-    info = {"method": f"{model.name}, rk4", "dt_s": dt, "steps": steps,
-            "wall_time_s": time.perf_counter() - started}
+    wall = time.perf_counter() - started
+    info = RunInfo("linear-rk4", steps, 4, 4 * steps, wall,
+                   {"method": f"{model.name}, rk4", "dt_s": dt, "steps": steps, "wall_time_s": wall})
     return linear_result(model, train, t[::every], Q, V, Qdd, q0, info)
 
 

@@ -40,6 +40,7 @@ import numpy as np
 from gearcheck.lumped.time_solver import initial_state, step_limits, stepper
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import SolverError
+from gearcheck.shared.run_info import RunInfo
 
 PERIOD_TOLERANCE = 1e-9  # cycles over the common period by which a frequency may miss a whole number
 MAX_MESH_PERIODS = 64  # the longest common period sought, in periods of the slowest time-varying mesh
@@ -55,8 +56,8 @@ class PeriodicSteadyState:
     q, v: pass ``(q, v)`` as ``y0`` to :func:`~gearcheck.lumped.time_solver.simulate` with ``dt``;
     period: T (s); steps: RK4 steps per period; method: "anderson", "anderson, then newton", "affine" (Newton on
     a linear model: one solve) or "newton"; iterations: Anderson and Newton steps; residual: max |y(T) - y0|
-    over the largest |y| of the first guess (v weighted by 1/omega_max); runs: one-period runs taken;
-    wall_time_s."""
+    over the largest |y| of the first guess (v weighted by 1/omega_max); runs: one-period runs taken; info: their
+    work (:class:`~gearcheck.shared.run_info.RunInfo`, the search's own wall time included)."""
 
     q: np.ndarray
     v: np.ndarray
@@ -67,7 +68,7 @@ class PeriodicSteadyState:
     iterations: int
     residual: float
     runs: int
-    wall_time_s: float
+    info: RunInfo
 
     @property
     def y0(self) -> tuple[np.ndarray, np.ndarray]:
@@ -206,7 +207,8 @@ def periodic_steady_state(model, dt: float | None = None, drive: str = "steps", 
     q0, v0 = initial_state(model) if y0 is None else y0
     y = np.concatenate([q0, v0])
     scale = float(np.max(np.abs(w * y))) or 1e-6
-    P = _PeriodMap(stepper(model, h, steps, drive), w, scale)
+    run, sub_steps = stepper(model, h, steps, drive)
+    P = _PeriodMap(run, w, scale)
     z, residual, iterations = w * y / scale, math.inf, 0
     if method == "anderson":
         z, residual, iterations = _anderson(P, z, tolerance, MAX_ANDERSON_RUNS)
@@ -220,5 +222,6 @@ def periodic_steady_state(model, dt: float | None = None, drive: str = "steps", 
         raise SolverError(f"{name}: shooting did not converge (residual {residual:.3g} > {tolerance:g} after "
                           f"{P.runs} period runs); time-march with a settle time (RunSettings.settle) instead")
     y = z * scale / w
-    return PeriodicSteadyState(y[:n].copy(), y[n:].copy(), period, h, steps, used, iterations, residual, P.runs,
-                               clock.perf_counter() - started)
+    info = RunInfo("numba-rk4", P.runs * steps, 4, 4 * P.runs * sub_steps, clock.perf_counter() - started,
+                   {"method": used, "dt_s": h, "steps": P.runs * steps})
+    return PeriodicSteadyState(y[:n].copy(), y[n:].copy(), period, h, steps, used, iterations, residual, P.runs, info)

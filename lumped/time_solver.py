@@ -31,13 +31,14 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearcheck.lumped.compiled_steps import Sparse, Turning, rk4_steps
+from gearcheck.lumped.compiled_steps import Chunk, Output, kernel_groups, rk4_steps
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.results import TimeResult, bearing_names, train_result
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
@@ -84,10 +85,9 @@ class _System:
         self.relieved = self.exc.relieved
         self.relieved_index = np.full(self.c.size, -1, dtype=np.int64)  # mesh -> its place among the relieved
         self.relieved_index[self.relieved] = np.arange(self.relieved.size)
-        self.turning_arrays = Turning.of(self.turning, model.n)  # for the compiled steps
-        self.sparse = Sparse.of(self.Kc), Sparse.of(self.D), Sparse.of(self.A)
         self.F0 = model.F_static
         self.b_in, self.b_out = model.b_input, model.b_output
+        self.kernel = kernel_groups(self)
 
     def drive(self, t):
         """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``
@@ -126,16 +126,10 @@ class _System:
             force = force + coupling.forces(t, q, v)
         return force * self.Minv
 
-    def compiled_steps(self, q, v, lengths, ends, times, inputs, first_step, every, q_out, v_out) -> int:
+    def compiled_steps(self, q, v, chunk: Chunk, out: Output) -> int:
         """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` on this system (see :func:`_chunk`)."""
-        k, e, de, tin, tout, pairs = inputs
-        pairs = np.zeros((0, 3, 0, 0, 2)) if pairs is None else np.ascontiguousarray(pairs)
-        K, D, A = self.sparse
-        turning = self.turning_arrays
-        return rk4_steps(q, v, lengths, ends, first_step, every, q_out, v_out,
-                         self.Minv, self.F0 - turning.static_load, self.b_in, self.b_out, K.indptr, K.indices, K.data,
-                         D.indptr, D.indices, D.data, A.indptr, A.indices, A.data, self.c, self.b, self.has_backlash,
-                         self.relieved_index, *turning.arrays(), times, tin, tout, k, e, de, pairs)
+        pairs = np.zeros((0, 3, 0, 0, 2)) if chunk.pairs is None else np.ascontiguousarray(chunk.pairs)
+        return rk4_steps(q, v, *self.kernel, chunk._replace(pairs=pairs), out)
 
 
 def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
@@ -183,25 +177,25 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
 
     started = clock.perf_counter()
     if method in ("rk4", "rk4-stages"):
-        t_out, q_out, v_out = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway, method == "rk4-stages", drive)
-        evaluations = 4 * n_steps
+        t_out, q_out, v_out, sub_steps = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway,
+                                              method == "rk4-stages", drive)
+        engine, stages, calls = "numba-rk4" if method == "rk4" else "python-rk4", 4, 4 * sub_steps
     else:
-        t_out, q_out, v_out, evaluations = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
+        t_out, q_out, v_out, calls = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
         runaway(t_out, q_out)
+        engine, stages = f"scipy-{method}", None
     wall = clock.perf_counter() - started
-    info = {"method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
-            "rhs_evaluations": evaluations, "wall_time_s": wall,
-            "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms}
+    info = RunInfo(engine, n_steps, stages, calls, wall, {
+        "method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
+        "rhs_evaluations": calls if stages is None else 4 * n_steps, "wall_time_s": wall,  # as reports state them
+        "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms})
     return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
-def _chunk(sys, h, start, stop, drive):
-    """The (sub-)steps of steps start..stop-1 and their drive: a step inside which a mesh stiffness jumps is
-    split there (:func:`~gearcheck.shared.stepping.split_steps`).  Returns (lengths, ends, times, inputs):
-    sub-step r spans [times[r, 0], times[r, 0] + lengths[r]], ``ends[r]`` when it ends a whole step, ``times``
-    (sub-steps, 3) its stage times t, t + h/2, t + h (at which the turning elements' rows are placed), and
-    ``inputs`` the drive (k, e, de, T_in, T_out, pairs) at the stage times of :data:`STAGE_OFFSETS`, with
-    time along axes (0, 1), held per step when ``drive == "steps"``."""
+def _chunk(sys, h, start, stop, drive) -> Chunk:
+    """The (sub-)steps of steps start..stop-1 and their drive (:class:`~gearcheck.lumped.compiled_steps.Chunk`): a
+    step inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`); the
+    drive held per step when ``drive == "steps"``."""
     steps = np.arange(start, stop)
     lengths = np.full(steps.size, h)
     sample = (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
@@ -229,7 +223,7 @@ def _chunk(sys, h, start, stop, drive):
         if sys.exc.has_transmission_error:  # else zeros
             e, de = per_step_drive(e), per_step_drive(de)
         pairs = None if pairs is None else per_step_pairs(pairs)
-    return lengths, ends, times, (k, e, de, tin, tout, pairs)
+    return Chunk(lengths, ends, times, k, e, de, tin, tout, pairs)
 
 
 def _chunk_steps(sys) -> int:
@@ -243,7 +237,8 @@ def _chunk_steps(sys) -> int:
 def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, drive="steps"):
     """Fixed-step RK4 over n_steps, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
     samples and its last state for divergence.  The compiled steps (:func:`~gearcheck.lumped.compiled_steps.
-    rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python."""
+    rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python.  Returns the
+    samples' (t, q, v) and the sub-steps taken (steps split at stiffness jumps count each of theirs)."""
     n = q.size
     n_out = n_steps // every + 1
     t_out = np.empty(n_out)
@@ -251,27 +246,26 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
     v_out = np.empty((n_out, n))
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     q, v = q.copy(), v.copy()
-    j = 1
+    j, sub_steps = 1, 0
     chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
-        lengths, ends, times, inputs = _chunk(sys, h, start, stop, drive)
-        if stage_by_stage:
-            written = _python_steps(sys, q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
-        else:
-            written = sys.compiled_steps(q, v, lengths, ends, times, inputs, start, every, q_out[j:], v_out[j:])
+        steps = _chunk(sys, h, start, stop, drive)
+        sub_steps += steps.lengths.size
+        out = Output(start, every, q_out[j:], v_out[j:])
+        written = _python_steps(sys, q, v, steps, out) if stage_by_stage else sys.compiled_steps(q, v, steps, out)
         t_out[j:j + written] = h * (every * (start // every + 1 + np.arange(written)))
         runaway(np.append(t_out[j:j + written], stop * h), np.vstack([q_out[j:j + written], q[None]]))
         j += written
         if progress is not None:
             progress(stop / n_steps)
-    return t_out[:j], q_out[:j], v_out[:j]
+    return t_out[:j], q_out[:j], v_out[:j], sub_steps
 
 
 def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
-    """A function (q, v) -> (q, v) at t = n_steps dt, from (q, v) at t = 0, by the compiled RK4 steps of
-    :func:`simulate` (same drive sampling and splits); the drive is sampled once, for every call (a shooting
-    method's many runs over one period)."""
+    """(a function (q, v) -> (q, v) at t = n_steps dt, from (q, v) at t = 0, by the compiled RK4 steps of
+    :func:`simulate` (same drive sampling and splits), the sub-steps it takes); the drive is sampled once, for every
+    call (a shooting method's many runs over one period)."""
     sys = _System(model)
     chunk = _chunk_steps(sys)
     chunks = [(start, _chunk(sys, dt, start, min(start + chunk, n_steps), drive)) for start in range(0, n_steps, chunk)]
@@ -279,16 +273,17 @@ def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
 
     def run(q, v):
         q, v = np.array(q, dtype=float), np.array(v, dtype=float)
-        for start, (lengths, ends, times, inputs) in chunks:
-            sys.compiled_steps(q, v, lengths, ends, times, inputs, start, n_steps + 1, none, none)
+        for start, steps in chunks:
+            sys.compiled_steps(q, v, steps, Output(start, n_steps + 1, none, none))
         return q, v
 
-    return run
+    return run, sum(steps.lengths.size for _, steps in chunks)
 
 
-def _python_steps(sys, q, v, lengths, ends, times, inputs, first_step, every, q_out, v_out) -> int:
+def _python_steps(sys, q, v, chunk: Chunk, out: Output) -> int:
     """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` stage by stage in Python (the reference)."""
-    k, e, de, tin, tout, pairs = inputs
+    lengths, ends, times, k, e, de, tin, tout, pairs = chunk
+    first_step, every, q_out, v_out = out
     step, written = first_step, 0
     for r, h in enumerate(lengths):
         def stage(s, q, v):

@@ -21,6 +21,7 @@ import ctypes
 import math
 import os
 from glob import glob
+from typing import NamedTuple
 
 import mujoco
 import numba
@@ -92,6 +93,180 @@ def timestep_view(m: mujoco.MjModel) -> np.ndarray:
     return view
 
 
+# ---------------------------------------------------------------------------------------------- the kernel's groups
+class Pointers(NamedTuple):
+    """Addresses of the mjModel, the mjData, and the force reader's mesh probe and joints-only probe (mjModels)."""
+
+    model: int
+    data: int
+    probe: int
+    joints_only: int
+
+
+class ModelViews(NamedTuple):
+    """Views of the model fields the loop writes (``timestep``: :func:`timestep_view`; the probe's mesh fields)."""
+
+    tendon_stiffness: np.ndarray
+    tendon_lengthspring: np.ndarray
+    wrap_prm: np.ndarray
+    timestep: np.ndarray
+    probe_stiffness: np.ndarray
+    probe_lengthspring: np.ndarray
+    tendon_damping: np.ndarray
+
+
+class DataViews(NamedTuple):
+    """Views of the mjData fields the loop reads or writes."""
+
+    qpos: np.ndarray
+    qvel: np.ndarray
+    ctrl: np.ndarray
+    qfrc_applied: np.ndarray
+    sensordata: np.ndarray
+    qfrc_spring: np.ndarray
+    qfrc_damper: np.ndarray
+    energy: np.ndarray
+    xpos: np.ndarray
+    xmat: np.ndarray
+    site_xpos: np.ndarray
+    ten_length: np.ndarray
+    ten_velocity: np.ndarray
+
+
+class Turning(NamedTuple):
+    """The mesh tendons' turning slide coefficients (``MbdModel.turning``: their ``wrap_prm`` entries, world-frame
+    bases, carriers' qpos addresses, tendons, slides' qpos and dof addresses), the meshes' damping and half
+    backlash."""
+
+    wraps: np.ndarray
+    base: np.ndarray
+    carrier_qadr: np.ndarray
+    tendon: np.ndarray
+    slide_qadr: np.ndarray
+    slide_dof: np.ndarray
+    damping: np.ndarray
+    half_backlash: np.ndarray
+
+
+class Contacts(NamedTuple):
+    """The relieved meshes' tooth contacts (``_ToothContacts``): tendons, ``wrap_prm`` entries and qpos addresses
+    of their coefficients, and each tendon's first coefficient (one more at the end)."""
+
+    tendons: np.ndarray
+    wraps: np.ndarray
+    qadr: np.ndarray
+    starts: np.ndarray
+
+
+class Work(NamedTuple):
+    """Work space of the damping correction: the mesh Jacobian, the turned coefficients, g."""
+
+    jacobian: np.ndarray
+    coef: np.ndarray
+    g: np.ndarray
+
+
+class Reader(NamedTuple):
+    """The force reader's dofs and slides (``ForceReader``)."""
+
+    dofs: np.ndarray
+    slides: np.ndarray
+
+
+class Pins(NamedTuple):
+    """Per pin tendon (in its rows' order): tendon, stiffness, damping, clearance, pin site, ``wrap_prm`` entries."""
+
+    tendons: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    clearance: np.ndarray
+    site: np.ndarray
+    wraps: np.ndarray
+
+
+class Discs(NamedTuple):
+    """Per cycloid disc: body, pin wheel (-1: none), phase, lobes, eccentricity, pitch radius, first pin row, pins,
+    and its tendons' dofs (their number, and the dofs and qpos addresses, padded)."""
+
+    body: np.ndarray
+    wheel: np.ndarray
+    phase: np.ndarray
+    lobes: np.ndarray
+    eccentricity: np.ndarray
+    pitch_radius: np.ndarray
+    first: np.ndarray
+    count: np.ndarray
+    ndof: np.ndarray
+    dofs: np.ndarray
+    qadr: np.ndarray
+
+
+class PinWork(NamedTuple):
+    """Work space of the pin contacts: a Jacobian, the contact point, G, each row's compression and length."""
+
+    jacobian: np.ndarray
+    point: np.ndarray
+    G: np.ndarray
+    delta: np.ndarray
+    length: np.ndarray
+
+
+class Cycloid(NamedTuple):
+    """An RV reducer's pin contacts (:func:`cycloid_arrays`)."""
+
+    pins: Pins
+    discs: Discs
+    work: PinWork
+
+
+class Drive(NamedTuple):
+    """The drive of stage 1 and of stages 2-4 (as :meth:`gearcheck.mbd_models.runner._Drive.steps` gives them), a
+    row per (sub-)step: mesh stiffness, controls, transmission error and its rate, the relieved meshes' tooth
+    pairs; the absent ones empty along their last axes."""
+
+    k1: np.ndarray
+    k2: np.ndarray
+    u1: np.ndarray
+    u2: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+    de1: np.ndarray
+    de2: np.ndarray
+    p1: np.ndarray
+    p2: np.ndarray
+
+
+class Split(NamedTuple):
+    """The split steps' sub-steps: step i is split when ``count[i - start] > 0``, into the sub-steps ``first``.. of
+    ``lengths`` and ``drive``."""
+
+    first: np.ndarray
+    count: np.ndarray
+    lengths: np.ndarray
+    drive: Drive
+
+
+class Flags(NamedTuple):
+    """What the loop drives and records besides the mesh stiffness and the sensors."""
+
+    transmission_error: bool
+    tooth_pairs: bool
+    record_stiffness: bool
+    record_energy: bool
+    pin_contacts: bool
+
+
+class Outputs(NamedTuple):
+    """The sampled rows: sensordata, the force reader's forces, and (possibly empty) stiffness, energy, pin forces."""
+
+    sensors: np.ndarray
+    forces: np.ndarray
+    stiffness: np.ndarray
+    energy: np.ndarray
+    pin_forces: np.ndarray
+
+
+# ---------------------------------------------------------------------------------------------- the kernel
 @numba.njit(cache=True)
 def _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef):
     """The world-frame slide coefficients turned to the carriers' angles (``MbdModel.refresh``)."""
@@ -101,11 +276,9 @@ def _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef):
         wrap_prm[wraps[w]] = coef[w]
 
 
-def cycloid_arrays(cyc, nv: int):
+def cycloid_arrays(cyc, nv: int) -> Cycloid:
     """An RV reducer's pin contacts (:class:`~gearcheck.mbd_models.cycloid_twin.CycloidTwin`) as flat arrays for
-    :func:`_pins`: per pin tendon (its rows' order) its tendon, stiffness, damping, clearance, pin site and
-    ``wrap_prm`` entries; per disc its body, pin wheel (-1: none), phase, lobes, eccentricity, pitch radius, first
-    row and its tendons' dofs and qpos addresses; and work space.  None: empty arrays of the same types."""
+    :func:`_pins`; None: empty arrays of the same types."""
     rows, discs = [], []
     width = 6
     if cyc is not None:
@@ -123,28 +296,30 @@ def cycloid_arrays(cyc, nv: int):
                     rows.append((site, wraps))
     i64, f64 = np.int64, np.float64
     n_pins = len(rows)
-    pins = (np.asarray(cyc.tendons if cyc is not None else [], dtype=i64),
-            np.asarray(cyc.stiffness if cyc is not None else [], dtype=f64),
-            np.asarray(cyc.damping if cyc is not None else [], dtype=f64),
-            np.asarray(cyc.clearance if cyc is not None else [], dtype=f64),
-            np.array([r[0] for r in rows], dtype=i64), np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
+    pins = Pins(np.asarray(cyc.tendons if cyc is not None else [], dtype=i64),
+                np.asarray(cyc.stiffness if cyc is not None else [], dtype=f64),
+                np.asarray(cyc.damping if cyc is not None else [], dtype=f64),
+                np.asarray(cyc.clearance if cyc is not None else [], dtype=f64),
+                np.array([r[0] for r in rows], dtype=i64),
+                np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
     columns = list(zip(*discs)) if discs else [[]] * 11
     types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
     disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))
-    disc = disc[:9] + tuple(x.reshape(len(discs), width) for x in disc[9:])
-    work = (np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins))
-    return pins, disc, work
+    disc = Discs(*disc[:9], *(x.reshape(len(discs), width) for x in disc[9:]))
+    work = PinWork(np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins))
+    return Cycloid(pins, disc, work)
 
 
 @numba.njit(cache=True)
-def _pins(kinematics, com_pos, jac, m, d, model, data, cyc, work):
+def _pins(kinematics, com_pos, jac, m, d, model, data, cycloid):
     """``CycloidTwin.refresh(d)`` (a run's compression-only contacts): every pin tendon's coefficients, spring
     lengths, stiffness and damping at the discs' present poses, from MuJoCo's kinematics and Jacobians."""
-    stiffness, lengthspring, wrap_prm, damping_model = model[0], model[1], model[2], model[6]
-    qpos, xpos, xmat, site_xpos = data[0], data[8], data[9], data[10]
-    tendons, k_pin, c_pin, clearance, site, wraps = cyc[0]
-    body, wheel, phase, lobes, ecc, pitch_radius, first, count, ndof, dofs, qadr = cyc[1]
-    jacobian, point, G, delta, length = work
+    stiffness, lengthspring, wrap_prm, damping_model = (model.tendon_stiffness, model.tendon_lengthspring,
+                                                        model.wrap_prm, model.tendon_damping)
+    qpos, xpos, xmat, site_xpos = data.qpos, data.xpos, data.xmat, data.site_xpos
+    tendons, k_pin, c_pin, clearance, site, wraps = cycloid.pins
+    body, wheel, phase, lobes, ecc, pitch_radius, first, count, ndof, dofs, qadr = cycloid.discs
+    jacobian, point, G, delta, length = cycloid.work
     kinematics(m, d)
     com_pos(m, d)
     for i in range(body.size):
@@ -195,8 +370,8 @@ def _pins(kinematics, com_pos, jac, m, d, model, data, cyc, work):
 @numba.njit(cache=True)
 def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, contacts, work):
     """``_Stepper.set_stage``: stiffness, controls, spring lengths, tooth contacts, damping correction."""
-    stiffness, lengthspring, wrap_prm = model[0], model[1], model[2]
-    qpos, qvel, ctrl, applied = data[0], data[1], data[2], data[3]
+    stiffness, lengthspring, wrap_prm = model.tendon_stiffness, model.tendon_lengthspring, model.wrap_prm
+    qpos, qvel, ctrl, applied = data.qpos, data.qvel, data.ctrl, data.qfrc_applied
     wraps, base, carrier_qadr, tendon, slide_qadr, slide_dof, damping, half_backlash = turning
     rel_tendons, rel_wraps, rel_qadr, rel_starts = contacts
     J, coef, g = work
@@ -248,37 +423,38 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
 
 
 @numba.njit(cache=True)
-def _sample(j, passive, pointers, model, data, reader, outputs, record, pins):
+def _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid):
     """``_Stepper.sample``: sensordata, the force reader's generalized forces (``ForceReader.sample``), and
     optionally the stiffness used and MuJoCo's energy, into row ``j``."""
-    stiffness, lengthspring = model[0], model[1]
-    probe_stiffness, probe_lengthspring = model[4], model[5]
-    sensordata, spring, damper, energy, applied = data[4], data[5], data[6], data[7], data[3]
+    stiffness, lengthspring = model.tendon_stiffness, model.tendon_lengthspring
+    probe_stiffness, probe_lengthspring = model.probe_stiffness, model.probe_lengthspring
+    sensordata, spring, damper, energy, applied = (data.sensordata, data.qfrc_spring, data.qfrc_damper, data.energy,
+                                                   data.qfrc_applied)
     dofs, slides = reader
     sensors, forces, used, energies, pin_forces = outputs
-    record_stiffness, record_energy, has_pins = record
     sensors[j, :] = sensordata
     n = probe_stiffness.size
     for i in range(n):
         probe_stiffness[i] = stiffness[i]
         probe_lengthspring[i, 0] = lengthspring[i, 0]
         probe_lengthspring[i, 1] = lengthspring[i, 1]
-    passive(pointers[2], pointers[1])
+    passive(pointers.probe, pointers.data)
     nd = dofs.size
     for i in range(nd):
         forces[j, i] = spring[dofs[i]] + damper[dofs[i]]
         forces[j, nd + i] = applied[dofs[i]]
-    passive(pointers[3], pointers[1])
+    passive(pointers.joints_only, pointers.data)
     for i in range(slides.size):
         forces[j, 2 * nd + i] = spring[slides[i]] + damper[slides[i]]
-    if record_stiffness:
+    if flags.record_stiffness:
         for i in range(n):
             used[j, i] = stiffness[i]
-    if record_energy:
+    if flags.record_energy:
         energies[j, 0] = energy[0]
         energies[j, 1] = energy[1]
-    if has_pins:  # CycloidTwin.pin_forces
-        tendons, ten_length, ten_velocity, damping = pins[0][0], data[11], data[12], model[6]
+    if flags.pin_contacts:  # CycloidTwin.pin_forces
+        tendons, ten_length, ten_velocity, damping = (cycloid.pins.tendons, data.ten_length, data.ten_velocity,
+                                                      model.tendon_damping)
         for p in range(tendons.size):
             t = tendons[p]
             compression = ten_length[t] - lengthspring[t, 1]
@@ -289,27 +465,17 @@ def _sample(j, passive, pointers, model, data, reader, outputs, record, pins):
 def run_steps(forward, runge_kutta, passive, kinematics, com_pos, jac, pointers, model, data, turning, contacts,
               work, reader, cycloid, drive, split, flags, outputs, h, start, stop, every, j):
     """Steps start..stop-1 of one twin, sampling those that begin on a multiple of ``every`` into rows j.. of
-    ``outputs``; returns the next row.
-
-    pointers: (mjModel, mjData, the force reader's mesh probe, its joints-only probe) addresses.  model: views of
-    (tendon_stiffness, tendon_lengthspring, wrap_prm, opt.timestep, the probe's tendon_stiffness and
-    tendon_lengthspring, tendon_damping).  data: views of (qpos, qvel, ctrl, qfrc_applied, sensordata, qfrc_spring,
-    qfrc_damper, energy, xpos, xmat, site_xpos, ten_length, ten_velocity).  cycloid: (pins, discs, work) of
-    :func:`cycloid_arrays`.  drive: (k1, k2, u1, u2, e1, e2, de1, de2, p1, p2), one row per step, stage 1 and
-    stages 2-4 as :meth:`gearcheck.mbd_models.runner._Drive.steps` gives them.  split: (first, count, lengths,
-    then the same ten arrays over sub-steps): step i is split when count[i - start] > 0, into sub-steps first.. of
-    those rows.
-    flags: (transmission error, tooth pairs, record stiffness, record energy, pin contacts).  outputs: (sensordata,
-    force reader, stiffness, energy, pin forces) rows."""
-    wrap_prm, timestep = model[2], model[3]
-    qpos = data[0]
-    wraps, base, carrier_qadr = turning[0], turning[1], turning[2]
-    coef = work[1]
+    ``outputs``; returns the next row.  MuJoCo's C functions, then the twin in the groups above: ``drive`` one row
+    per step, ``split`` the split steps' sub-steps."""
+    wrap_prm, timestep = model.wrap_prm, model.timestep
+    qpos = data.qpos
+    wraps, base, carrier_qadr = turning.wraps, turning.base, turning.carrier_qadr
+    coef = work.coef
     k1, k2, u1, u2, e1, e2, de1, de2, p1, p2 = drive
-    first, count, lengths, sk1, sk2, su1, su2, se1, se2, sde1, sde2, sp1, sp2 = split
-    has_te, has_pairs, has_pins = flags[0], flags[1], flags[4]
-    record = (flags[2], flags[3], has_pins)
-    m, d = pointers[0], pointers[1]
+    first, count, lengths = split.first, split.count, split.lengths
+    sk1, sk2, su1, su2, se1, se2, sde1, sde2, sp1, sp2 = split.drive
+    has_te, has_pairs, has_pins = flags.transmission_error, flags.tooth_pairs, flags.pin_contacts
+    m, d = pointers.model, pointers.data
     for step in range(start, stop):
         i = step - start
         sample = step % every == 0
@@ -317,13 +483,13 @@ def run_steps(forward, runge_kutta, passive, kinematics, com_pos, jac, pointers,
             for s in range(first[i], first[i] + count[i]):
                 timestep[0] = lengths[s]
                 if has_pins:
-                    _pins(kinematics, com_pos, jac, m, d, model, data, cycloid[0:2], cycloid[2])
+                    _pins(kinematics, com_pos, jac, m, d, model, data, cycloid)
                 _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef)
                 _set_stage(sk1[s], su1[s], se1[s], sde1[s], sp1[s], has_te, has_pairs, model, data, turning,
                            contacts, work)
                 forward(m, d)
                 if sample and s == first[i]:
-                    _sample(j, passive, pointers, model, data, reader, outputs, record, cycloid)
+                    _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid)
                     j += 1
                 _set_stage(sk2[s], su2[s], se2[s], sde2[s], sp2[s], has_te, has_pairs, model, data, turning,
                            contacts, work)
@@ -331,12 +497,12 @@ def run_steps(forward, runge_kutta, passive, kinematics, com_pos, jac, pointers,
             timestep[0] = h
             continue
         if has_pins:
-            _pins(kinematics, com_pos, jac, m, d, model, data, cycloid[0:2], cycloid[2])
+            _pins(kinematics, com_pos, jac, m, d, model, data, cycloid)
         _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef)
         _set_stage(k1[i], u1[i], e1[i], de1[i], p1[i], has_te, has_pairs, model, data, turning, contacts, work)
         forward(m, d)
         if sample:
-            _sample(j, passive, pointers, model, data, reader, outputs, record, cycloid)
+            _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid)
             j += 1
         _set_stage(k2[i], u2[i], e2[i], de2[i], p2[i], has_te, has_pairs, model, data, turning, contacts, work)
         runge_kutta(m, d, 4)

@@ -33,6 +33,7 @@ differences of ``qfrc_passive``, both at q = 0, at rest.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import mujoco
@@ -41,6 +42,7 @@ import numpy as np
 from gearcheck.train.published_parameters import LABELS, PaperParameters, four_dof_result
 from gearcheck.shared.errors import DivergenceError
 from gearcheck.shared.modal import ModalResult, modal_result
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import transient_step
 
@@ -184,6 +186,7 @@ def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: 
     m_h, t_b = twin.params.torques(t, load)
     q = np.zeros((steps + 1, 4))
     a = np.zeros((steps + 1, 4))
+    started = time.perf_counter()
     for i in range(steps + 1):
         d.qfrc_applied[:] = 0.0
         d.qfrc_applied[ih] = m_h[i]
@@ -194,6 +197,8 @@ def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: 
             mujoco.mj_step(m, d)
     if not np.all(np.isfinite(q)):
         raise DivergenceError(float(t[np.argmax(~np.isfinite(q).all(axis=1))]), "the MuJoCo 4-DOF twin")
-    info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": steps, "y1": twin.y1,
-            "carrier_mass": twin.carrier_mass, "mujoco_version": mujoco.__version__}
+    wall = time.perf_counter() - started
+    info = RunInfo("mujoco-step", steps, 4, 5 * steps, wall,  # the sampling mj_forward, then mj_step's own and RK4's 3
+                   {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": steps, "y1": twin.y1,
+                    "carrier_mass": twin.carrier_mass, "mujoco_version": mujoco.__version__})
     return four_dof_result(twin.params.source, "mujoco", model, t, q, a, info)

@@ -73,6 +73,7 @@ from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.results import Signal, TimeResult, train_result
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
 
@@ -315,38 +316,40 @@ class _CompiledStepper(_Stepper):
         super().__init__(mb, d, h, n_samples, bodies, energy)
         m, n, tc, reader = self.m, self.n_mesh, mb.turning, self.reader
         self.c = compiled.library()
-        self.pointers = (m._address, d._address, reader.probe._address, reader.joints_only._address)
-        self.model_views = (m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm, compiled.timestep_view(m),
-                            reader.probe.tendon_stiffness[:n], reader.probe.tendon_lengthspring[:n], m.tendon_damping)
-        self.data_views = (d.qpos, d.qvel, d.ctrl, d.qfrc_applied, d.sensordata, d.qfrc_spring, d.qfrc_damper,
-                           d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length, d.ten_velocity)
-        self.cycloid_arrays = compiled.cycloid_arrays(mb.cycloid, m.nv)
-        self.turning_arrays = tuple(np.ascontiguousarray(x) for x in (
-            tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
-            mb.half_backlash))
         c = self.contacts
         none = np.zeros(0, dtype=np.int64)
-        self.contact_arrays = ((none, none, none, np.zeros(1, dtype=np.int64)) if c is None else
-                               tuple(np.ascontiguousarray(x, dtype=np.int64) for x in
-                                     (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps)))))
-        self.work = (mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n))
-        self.reader_arrays = (np.ascontiguousarray(reader.dofs, dtype=np.int64),
-                              np.ascontiguousarray(reader.slides, dtype=np.int64))
-        self.outputs = (self.sensors, self.forces,
-                        np.zeros((0, n)) if self.stiffness is None else self.stiffness,
-                        np.zeros((0, 2)) if self.energy is None else self.energy,
-                        np.zeros((0, 0)) if self.pins is None else self.pins)
-        self.flags = (self.drive.has_te, self.contacts is not None, self.stiffness is not None,
-                      self.energy is not None, self.pins is not None)
+        self.twin = (  # the kernel's groups of this twin, as run_steps takes them after the C functions
+            compiled.Pointers(m._address, d._address, reader.probe._address, reader.joints_only._address),
+            compiled.ModelViews(m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm, compiled.timestep_view(m),
+                                reader.probe.tendon_stiffness[:n], reader.probe.tendon_lengthspring[:n],
+                                m.tendon_damping),
+            compiled.DataViews(d.qpos, d.qvel, d.ctrl, d.qfrc_applied, d.sensordata, d.qfrc_spring, d.qfrc_damper,
+                               d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length, d.ten_velocity),
+            compiled.Turning(*(np.ascontiguousarray(x) for x in (
+                tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
+                mb.half_backlash))),
+            compiled.Contacts(none, none, none, np.zeros(1, dtype=np.int64)) if c is None else compiled.Contacts(
+                *(np.ascontiguousarray(x, dtype=np.int64) for x in
+                  (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps))))),
+            compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n)),
+            compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
+                            np.ascontiguousarray(reader.slides, dtype=np.int64)),
+            compiled.cycloid_arrays(mb.cycloid, m.nv))
+        self.outputs = compiled.Outputs(self.sensors, self.forces,
+                                        np.zeros((0, n)) if self.stiffness is None else self.stiffness,
+                                        np.zeros((0, 2)) if self.energy is None else self.energy,
+                                        np.zeros((0, 0)) if self.pins is None else self.pins)
+        self.flags = compiled.Flags(self.drive.has_te, self.contacts is not None, self.stiffness is not None,
+                                    self.energy is not None, self.pins is not None)
 
-    def _arrays(self, values, rows: int):
-        """(k1, k2, u1, u2, e1, e2, de1, de2, p1, p2) of :meth:`_Drive.steps` as contiguous arrays, the absent
-        ones empty along their last axes."""
+    def _arrays(self, values, rows: int) -> compiled.Drive:
+        """(k, u, e, de, pairs) of :meth:`_Drive.steps` as contiguous arrays, the absent ones empty along their last
+        axes."""
         n = self.n_mesh
         empty = (np.zeros((rows, n)), np.zeros((rows, self.m.nu)), np.zeros((rows, 0)), np.zeros((rows, 0)),
                  np.zeros((rows, 0, 0, 2)))
-        return tuple(np.ascontiguousarray(y) if y is not None else blank
-                     for (first, later), blank in zip(values, empty) for y in (first, later))
+        return compiled.Drive(*(np.ascontiguousarray(y) if y is not None else blank
+                                for (first, later), blank in zip(values, empty) for y in (first, later)))
 
     def run(self, start, stop, every, values, split) -> None:
         rows = stop - start
@@ -360,13 +363,11 @@ class _CompiledStepper(_Stepper):
         lengths = np.array(lengths, dtype=float)
         sub = (self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size
                else [(None, None)] * 5)
-        split_arrays = (first, count, lengths) + self._arrays(sub, lengths.size)
         c = self.c
-        self.j = compiled.run_steps(c.forward, c.runge_kutta, c.passive, c.kinematics, c.com_pos, c.jac,
-                                    self.pointers, self.model_views, self.data_views, self.turning_arrays,
-                                    self.contact_arrays, self.work, self.reader_arrays, self.cycloid_arrays,
-                                    self._arrays(values, rows), split_arrays, self.flags, self.outputs, self.h, start,
-                                    stop, every, self.j)
+        self.j = compiled.run_steps(c.forward, c.runge_kutta, c.passive, c.kinematics, c.com_pos, c.jac, *self.twin,
+                                    self._arrays(values, rows),
+                                    compiled.Split(first, count, lengths, self._arrays(sub, lengths.size)),
+                                    self.flags, self.outputs, self.h, start, stop, every, self.j)
 
 
 def compiled_unsupported(mb: MbdModel, stiffness_clock: str = "nominal") -> str | None:
@@ -393,8 +394,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     the static start.  record_energy: enable ``mjENBL_ENERGY`` and return MuJoCo's kinetic and
     potential energy in ``raw``.  engine: "compiled" (the step loop in C,
     :mod:`gearcheck.mbd_models.compiled`; the same steps, equal to round-off), "python" (the loop in Python),
-    or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); ``info["engine"]`` says which
-    ran.
+    or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); the result's ``info``
+    (:class:`~gearcheck.shared.run_info.RunInfo`) says which ran.
     """
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
@@ -429,6 +430,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     kind = _CompiledStepper if use_compiled else _LeanStepper if lean else _Stepper
     stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
+    sub_steps = n_steps
     try:
         started = clock.perf_counter()
         for start in range(0, n_steps, CHUNK):
@@ -436,6 +438,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
             j0 = stepper.j
             split = ({} if stiffness_clock == "bodies"
                      else stepping.split_steps(dt, start, stop, mb.excitation.switch_times(start * dt, stop * dt)))
+            sub_steps += sum(inner.size for inner in split.values())
             stepper.run(start, stop, every, stepper.drive.steps(dt * np.arange(start, stop), dt), split)
             _check_divergence(stepper, j0, stop * dt, every * dt, scale, what)
             if progress is not None:
@@ -447,11 +450,13 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         m.opt.enableflags, m.opt.timestep, m.opt.integrator = saved[3], saved[4], saved[5]
         m.tendon_damping[:] = saved[6]
     t = dt * every * np.arange(stepper.j)
-    info = {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
-            "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
-            "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
-            "static_newton_iterations": static.iterations, "static_residual": static.residual,
-            "forward_evaluations": 4 * n_steps, "engine": "compiled" if use_compiled else "python"}
+    loop = "compiled" if use_compiled else "python"
+    info = RunInfo(f"mujoco-{loop}", n_steps, 4, 4 * sub_steps, wall, {  # mj_forward, then mj_RungeKutta's 3
+        "method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
+        "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
+        "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
+        "static_newton_iterations": static.iterations, "static_residual": static.residual,
+        "forward_evaluations": 4 * n_steps, "engine": loop})  # as reports state them
     return _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
 
 

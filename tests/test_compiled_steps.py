@@ -1,11 +1,13 @@
 """The compiled RK4 steps against the same RK4 stage by stage in Python, and no Python per step."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model
-from gearcheck.lumped.compiled_steps import Turning
+from gearcheck.lumped.compiled_steps import kernel_groups
 from gearcheck.train.loader import load_train
 from gearcheck.train.variants import chained, edited
 from gearcheck.shared.settings import RunSettings
@@ -78,10 +80,11 @@ def test_chunks_hold_a_bounded_drive():
     assert time_solver._chunk_steps(plain) == time_solver.CHUNK
     steps = time_solver._chunk_steps(relief)
     assert steps < time_solver.CHUNK
-    lengths, ends, times, inputs = time_solver._chunk(relief, 1e-6, 0, steps, "steps")
-    assert sum(x.nbytes for x in inputs) <= time_solver.CHUNK_BYTES
+    chunk = time_solver._chunk(relief, 1e-6, 0, steps, "steps")
+    assert sum(x.nbytes for x in (chunk.k, chunk.e, chunk.de, chunk.tin, chunk.tout, chunk.pairs)) <= \
+        time_solver.CHUNK_BYTES
 
 
 def test_turning_elements_of_unknown_kind_are_refused():
     with pytest.raises(TypeError, match="no compiled form"):
-        Turning.of([object()], 3)
+        kernel_groups(SimpleNamespace(turning=[object()]))

@@ -48,6 +48,8 @@ def test_linear_train_is_shot_in_one_solve_by_newton():
     shot = periodic_steady_state(model, method="newton")
     assert shot.method == "affine" and shot.iterations == 1 and shot.runs == 2 * model.n + 2
     assert shot.residual < 1e-12
+    assert (shot.info.engine, shot.info.steps) == ("numba-rk4", shot.runs * shot.steps)
+    assert shot.info.rhs_calls >= 4 * shot.info.steps  # 4 a sub-step: demo-3p's steps split at stiffness jumps
     anderson = periodic_steady_state(model)
     assert np.max(np.abs(anderson.q - shot.q)) < 1e-9 * np.max(np.abs(shot.q))
 

@@ -517,7 +517,7 @@ def cmd_run(args) -> int:
         bar.close()
         written = [path.name for path in result.write_files(place.path, args.format)]
     print(f"{spec.name} ({args.solver}): {result.t.size} samples over {result.t[-1]:.6g} s, "
-          f"dt = {result.info['dt_s']:.4g} s, wall {result.info['wall_time_s']:.3g} s")
+          f"dt = {result.info['dt_s']:.4g} s, wall {result.info.wall_s:.3g} s")
     for name in written:
         print(f"  wrote {args.out / name}")
     return 0

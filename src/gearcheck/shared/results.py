@@ -22,6 +22,7 @@ planets through their meshes and bearings.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -52,7 +53,7 @@ class TimeResult:
     signals: list[Signal]
     values: np.ndarray  # (n_t, n_signals)
     settle_time: float = 0.0
-    info: dict = field(default_factory=dict)  # solver settings, wall time, step counts
+    info: Mapping = field(default_factory=dict)  # the run's RunInfo (a recording's: where it came from)
     raw: dict = field(default_factory=dict)  # solver-specific extra series (coordinates, sensors)
     static: dict = field(default_factory=dict)  # signal name -> its value in the static equilibrium
 
@@ -109,7 +110,7 @@ class TimeResult:
             stats[s.name] = {"unit": s.unit, "mean": float(np.mean(x)), "rms": float(np.sqrt(np.mean(x**2))),
                              "peak_to_peak": float(np.ptp(x)), "max_abs": float(np.max(np.abs(x)))}
         return {"train": self.train, "solver": self.solver, "settle_time_s": self.settle_time,
-                "samples": int(w.sum()), "info": self.info, "series": stats}
+                "samples": int(w.sum()), "info": dict(self.info), "series": stats}
 
     def write(self, directory, fmt: str = "parquet") -> list[Path]:
         """Write ``timeseries.parquet`` (or ``.csv``), ``raw.parquet`` (if any) and ``summary.json`` as the folder

@@ -32,8 +32,6 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from gearcheck.lumped.elements.coupling import TurningCoupling
-from gearcheck.lumped.elements.cycloid import CycloidRows
 
 
 class Sparse(NamedTuple):
@@ -136,19 +134,23 @@ class Discs(NamedTuple):
         return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
 
 
+GROUPS = {"couplings": Couplings, "discs": Discs}  # the compiled groups a turning element names (Turning.compiled)
+
+
 def kernel_groups(system) -> tuple[Matrices, Meshes, Couplings, Discs]:
     """The groups of a model's right-hand side (:class:`gearcheck.lumped.time_solver._System`) that
-    :func:`rk4_steps` takes after q and v; TypeError for a turning element without a compiled form."""
-    turning = system.turning
-    unknown = [type(e).__name__ for e in turning if not isinstance(e, (TurningCoupling, CycloidRows))]
-    if unknown:
-        raise TypeError(f"no compiled form of the turning element(s) {', '.join(unknown)}")
-    cycloids = [e for e in turning if isinstance(e, CycloidRows)]
-    static_load = sum((e.static_load for e in cycloids), np.zeros(system.Minv.size))
+    :func:`rk4_steps` takes after q and v, each turning element in the group it names; TypeError for one that
+    names none."""
+    members = {name: [] for name in GROUPS}
+    for e in system.turning:
+        if e.compiled not in members:
+            raise TypeError(f"no compiled form of the turning element {type(e).__name__}")
+        members[e.compiled].append(e)
+    static_load = sum((e.static_load for e in members["discs"]), np.zeros(system.Minv.size))
     return (Matrices(system.Minv, system.F0 - static_load, system.b_in, system.b_out, Sparse.of(system.Kc),
                      Sparse.of(system.D)),
             Meshes(Sparse.of(system.A), system.c, system.b, system.has_backlash, system.relieved_index),
-            Couplings.of([e for e in turning if isinstance(e, TurningCoupling)]), Discs.of(cycloids))
+            *(GROUPS[name].of(elements) for name, elements in members.items()))
 
 
 class Chunk(NamedTuple):

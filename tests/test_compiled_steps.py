@@ -8,6 +8,7 @@ import pytest
 from gearcheck.lumped import time_solver
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.compiled_steps import kernel_groups
+from gearcheck.lumped.elements.base import Turning
 from gearcheck.train.loader import load_train
 from gearcheck.train.variants import chained, edited
 from gearcheck.shared.settings import RunSettings
@@ -86,5 +87,8 @@ def test_chunks_hold_a_bounded_drive():
 
 
 def test_turning_elements_of_unknown_kind_are_refused():
-    with pytest.raises(TypeError, match="no compiled form"):
-        kernel_groups(SimpleNamespace(turning=[object()]))
+    class Uncompiled(Turning):  # a turning element that names no compiled group
+        rows = ()
+
+    with pytest.raises(TypeError, match="no compiled form of the turning element Uncompiled"):
+        kernel_groups(SimpleNamespace(turning=[Uncompiled()]))

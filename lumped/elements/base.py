@@ -97,6 +97,7 @@ class Turning:
     rows: tuple[str, ...]
     has_contacts: ClassVar[bool] = False  # rows that touch or not (their set is solved with the static state)
     smooth: ClassVar[bool] = True  # its forces are linear in the state (no contact switching)
+    compiled: ClassVar[str | None] = None  # the group of the compiled steps that evaluates it (None: none)
 
     def forces(self, t, q, v) -> np.ndarray:
         """Generalized forces (time along axis 0 allowed) of its rows at times ``t``."""

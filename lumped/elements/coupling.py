@@ -49,6 +49,7 @@ class TurningCoupling(Turning):
     stiffness: float
     damping: float
     rows: tuple[str, str]  # names of its t = 0 rows
+    compiled = "couplings"
 
     def frequencies(self) -> np.ndarray:
         return np.array([abs(self.omega_b - self.omega_a) / (2 * np.pi)])

@@ -65,6 +65,7 @@ class CycloidRows(Turning):
 
     has_contacts = True
     smooth = False
+    compiled = "discs"
 
     stage: str
     n: int  # coordinates of the model

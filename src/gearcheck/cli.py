@@ -17,6 +17,7 @@ import os
 import re
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -132,234 +133,28 @@ def _parser() -> argparse.ArgumentParser:
                                               "models against MuJoCo multibody twins.")
     p.add_argument("--version", action="version", version=f"gearcheck {gearcheck.__version__}")
     sub = p.add_subparsers(dest="command", required=True)
-
-    s = sub.add_parser("presets", help="list the shipped train presets")
-    s.set_defaults(func=cmd_presets)
-
-    s = sub.add_parser("show", help="the validated train with derived quantities")
-    _train_arg(s)
-    s.add_argument("--json", action="store_true", help="machine-readable output")
-    s.set_defaults(func=cmd_show)
-
-    s = sub.add_parser("modes", help="natural frequencies and mode types (at rest, or turning at --speed)")
-    _train_arg(s)
-    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="lumped")
-    s.add_argument("--speed", type=RPM_OR_ZERO, metavar="RPM",
-                   help="the gyroscopic modes of the train turning at this input speed (0 allowed)")
-    s.add_argument("--json", action="store_true", help="machine-readable output")
-    s.set_defaults(func=cmd_modes)
-
-    s = sub.add_parser("campbell", help="Campbell diagram: gyroscopic modes over a speed range (PNG and JSON)")
-    _train_arg(s)
-    s.add_argument("--speeds", type=SPEED_RANGE, required=True, metavar="A:B:N",
-                   help="N input speeds from A to B rpm (0 <= A < B, N >= 2)")
-    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both")
-    s.add_argument("--harmonics", type=int, default=3, metavar="H", help="mesh harmonics drawn (default 3)")
-    s.add_argument("--out", type=Path, default=Path("out/campbell"), metavar="DIR",
-                   help="writes campbell.png and campbell.json (default out/campbell)")
-    s.set_defaults(func=cmd_campbell)
-
-    s = sub.add_parser("mac", help="mode shapes of the lumped model and the MuJoCo twin (or your --model and "
-                                   "--against) paired by the modal assurance criterion (PNG heat map and JSON)")
-    _train_arg(s)
-    s.add_argument("--model", metavar="MODEL", help="your model: a .mat/.npz file of matrices, module:factory or "
-                                                   "file.py:factory")
-    s.add_argument("--against", default="lumped", choices=("lumped", "mujoco"), help="what --model is paired with")
-    s.add_argument("--out", type=Path, default=Path("out/mac"), metavar="DIR",
-                   help="writes mac.png and mac.json (default out/mac)")
-    s.set_defaults(func=cmd_mac)
-
-    s = sub.add_parser("ste", help="static transmission error of every mesh, unloaded and loaded, with its tip "
-                                   "reliefs (PNG and JSON)")
-    _train_arg(s)
-    s.add_argument("--relief-sweep", type=MICROMETRE_RANGE, metavar="A:B:N",
-                   help="also the loaded STE peak-to-peak for N tip relief amounts from A to B um (every tip "
-                        "relief of the train, lengths as given)")
-    s.add_argument("--slices", type=int, metavar="N", help="slices across a helical face (default 400)")
-    s.add_argument("--out", type=Path, default=Path("out/ste"), metavar="DIR",
-                   help="writes ste.png, ste.json (and relief_sweep.png) (default out/ste)")
-    s.set_defaults(func=cmd_ste)
-
-    s = sub.add_parser("run", help="time response at the operating point")
-    _train_arg(s)
-    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS), default="lumped")
-    s.add_argument("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)")
-    s.add_argument("--duration", type=SECONDS, default=0.2, metavar="S", help="simulated time (default 0.2 s)")
-    s.add_argument("--dt", type=SECONDS, metavar="S", help="time step (default: from the highest natural frequency)")
-    s.add_argument("--output-dt", type=SECONDS, metavar="S", help="output sampling interval (default: every step)")
-    s.add_argument("--method", default="rk4", help="lumped integrator: rk4 (default) or RK45, DOP853, Radau, "
-                                                   "BDF, LSODA")
-    s.add_argument("--format", choices=("parquet", "csv"), default="parquet",
-                   help="time series file format: parquet (default: full precision, compressed, units in its "
-                        "metadata) or csv")
-    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
-    s.set_defaults(func=cmd_run)
-
-    s = sub.add_parser("crosscheck", help="run both solvers, compare them, write a report; exit 1 when a "
-                                          "tolerance is exceeded or a baseline metric moved, 3 when the "
-                                          "comparison is inconclusive")
-    s.add_argument("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file")
-    s.add_argument("--all", action="store_true", help="every shipped preset, with a summary table")
-    s.add_argument("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)")
-    s.add_argument("--duration", type=SECONDS, metavar="S",
-                   help="simulated time (default: the baseline's with --baseline, else 0.1 s; 0.02 s for a "
-                        "--model other than general)")
-    s.add_argument("--model", default="general", metavar="MODEL",
-                   help="the model checked: gearcheck's general model against MuJoCo (default), a published "
-                        f"4-DOF model ({', '.join(MODELS[1:])}: double-planet) against the twin of its "
-                        "idealisation, or your own: a .mat/.npz file of matrices, module:factory, "
-                        "file.py:factory, or 'user' (the train file's train.user_model), checked against --against")
-    s.add_argument("--against", default="lumped", choices=("lumped", "mujoco"),
-                   help="what your own model is checked against: the reference lumped model (default) or the "
-                        "MuJoCo twin")
-    s.add_argument("--results", type=Path, metavar="FILE",
-                   help="another solver's time series as the model checked (.csv, .parquet, .mat)")
-    s.add_argument("--columns", type=Path, metavar="FILE", help="TOML map of --results' columns to signals")
-    s.add_argument("--modes", type=Path, metavar="FILE",
-                   help="with --results: its natural frequencies and mode shapes (.npz, .mat, .csv)")
-    s.add_argument("--dt-lumped", type=SECONDS, metavar="S", help="lumped RK4 step (default: derived)")
-    s.add_argument("--dt-mujoco", type=SECONDS, metavar="S", help="MuJoCo step (default: derived)")
-    s.add_argument("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table")
-    s.add_argument("--sensor-band", type=HZ, nargs=2, metavar=("LOW", "HIGH"),
-                   help="accelerometer chain: band-pass both solvers' accelerations to LOW-HIGH Hz")
-    s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]")
-    s.add_argument("--baseline", type=str, metavar="FILE", nargs="?", const="shipped",
-                   help="compare with a stored baseline (without FILE: the shipped one of the preset)")
-    s.add_argument("--update-baseline", action="store_true", help="rewrite the baseline instead of checking it")
-    s.add_argument("--junit", type=Path, metavar="FILE",
-                   help="also write the verdicts as JUnit XML: a testcase per gated quantity and mode, for any CI")
-    s.add_argument("--history", type=Path, metavar="STORE",
-                   help="append each run's metrics, versions and wall times to this history store (SQLite), one "
-                        "record per commit and train (a rerun replaces it); draw it with `gearcheck dashboard`")
-    s.add_argument("--commit", metavar="SHA", help="the commit --history records (default: $GITHUB_SHA, else "
-                                                   "`git rev-parse HEAD` here)")
-    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
-    s.set_defaults(func=cmd_crosscheck)
-
-    s = sub.add_parser("calibrate", help="least-squares fit of train-file parameters to measured amplitudes")
-    _train_arg(s)
-    s.add_argument("--fit", action="append", required=True, metavar="PATH[=LOW:HIGH]",
-                   help="a train-file field in its own units, e.g. stages[0].mesh.ste[0].amplitude_um=0.05:20")
-    s.add_argument("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]] "
-                                                                     "(default: the train file's)")
-    s.add_argument("--fit-speed", type=RPM, action="append", metavar="RPM",
-                   help="use only the measurements at this speed for the fit; the others are predicted")
-    s.add_argument("--duration", type=SECONDS, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)")
-    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
-    s.set_defaults(func=cmd_calibrate)
-
-    s = sub.add_parser("sweep", help="speed sweeps, parameter studies and Monte Carlo: many runs reduced to one "
-                                     "Parquet table of mesh-harmonic amplitudes with order plots; cached points, "
-                                     "local processes or a Dask cluster")
-    _train_arg(s)
-    s.add_argument("--speeds", metavar="A:B:N|V,V,...",
-                   help="input speeds in rpm: N from A to B, or a list (default: the train file's)")
-    s.add_argument("--set", action="append", default=[], metavar="FIELD=V,V,...",
-                   help="a parameter study: values of a train-file field in its own units, or FIELD=A:B:N "
-                        "(repeatable: the grid over all), e.g. stages[0].mesh.ste[0].amplitude_um=5,10,20")
-    s.add_argument("--vary", action="append", default=[], metavar="FIELD=DIST",
-                   help="Monte Carlo: a field's distribution, normal(mean,sd), uniform(low,high) or "
-                        "lognormal(median,factor) (repeatable)")
-    s.add_argument("--distributions", type=Path, metavar="FILE",
-                   help="Monte Carlo: a TOML file with a [distributions] table, \"FIELD\" = \"normal(mean, sd)\"")
-    s.add_argument("--samples", type=int, metavar="N", help="Monte Carlo draws (default 32)")
-    s.add_argument("--seed", type=int, default=0, metavar="S", help="Monte Carlo seed (default 0)")
-    s.add_argument("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both")
-    s.add_argument("--duration", type=SECONDS, default=0.5, metavar="S", help="simulated time per run (default 0.5 s)")
-    s.add_argument("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics per mesh frequency "
-                                                                         "(default 3)")
-    s.add_argument("--no-integration-check", dest="integration_check", action="store_false",
-                   help="run each solver once per point, without the second run at twice the step that estimates "
-                        "each line's integration error (about 1.5 times faster; every line then counts)")
-    s.add_argument("--refine", type=int, default=1, metavar="N",
-                   help="divide each solver's default step by N (default 1), for lines whose integration error "
-                        "estimate is too large to read them; the work grows N times")
-    s.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the cores available; "
-                                                           "1 runs in this process)")
-    s.add_argument("--scheduler", metavar="ADDRESS", help="run the points on a Dask distributed cluster, e.g. "
-                                                         "tcp://scheduler.example.org:8786")
-    s.add_argument("--cache", type=Path, metavar="DIR", help="finished points, one Parquet file per input hash: a "
-                                                            "rerun skips them (default OUT.cache)")
-    s.add_argument("--no-cache", action="store_true", help="keep no cache")
-    s.add_argument("--quantity", action="append", metavar="NAME",
-                   help="a quantity to plot (repeatable; default: carrier and ring accelerations and the first sun "
-                        "and ring mesh forces of each stage)")
-    s.add_argument("--out", type=Path, default=Path("out/sweep"), metavar="DIR",
-                   help="writes sweep.parquet, sweep.json and the figures (default out/sweep)")
-    s.set_defaults(func=cmd_sweep)
-
-    s = sub.add_parser("sensitivity", help="derivatives of the steady harmonic response to train-file numbers "
-                                           "(closed form, checked by finite differences; maps over speed)")
-    _train_arg(s)
-    s.add_argument("--parameter", action="append", required=True, metavar="PATH",
-                   help="a number of the train file, e.g. stages[0].crank.eccentricity_mm (repeatable)")
-    s.add_argument("--coordinate", metavar="NAME", help="the coordinate whose harmonics are reported (default: the "
-                                                        "output's rotation, e.g. rv.carrier.theta)")
-    s.add_argument("--method", choices=("hb", "fourier"), default="fourier",
-                   help="harmonic balance, or the paper's Fourier-series method (default; shows its Eq. 15 beside)")
-    s.add_argument("--orders", type=int, nargs="+", metavar="H",
-                   help="harmonics kept per clock (mesh, then an RV reducer's eccentrics), default 3 2")
-    s.add_argument("--speeds", type=SPEED_RANGE, metavar="A:B:N", help="a map over input speeds (rpm) instead of "
-                                                                       "the train's speed")
-    s.add_argument("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)")
-    s.set_defaults(func=cmd_sensitivity)
-
-    s = sub.add_parser("pins", help="an RV reducer's static pin loads over a pin pitch or an eccentric turn (PNG)")
-    _train_arg(s)
-    s.add_argument("--span", choices=("pitch", "turn"), default="pitch",
-                   help="frozen configurations over one pin pitch (default) or a whole turn of the eccentrics")
-    s.add_argument("--samples", type=int, default=16, metavar="N", help="frozen times (default 16)")
-    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-pins.png)")
-    s.set_defaults(func=cmd_pins)
-
-    s = sub.add_parser("stiffness", help="plot the mesh stiffness over the mesh cycle (PNG)")
-    _train_arg(s)
-    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)")
-    s.set_defaults(func=cmd_stiffness)
-
-    s = sub.add_parser("animate", help="render the MuJoCo twin running (or a mode shape) offscreen as a GIF or MP4, "
-                                       "vibration magnified, with time and mesh-force overlays")
-    _train_arg(s)
-    s.add_argument("-o", "--output", type=Path, required=True, metavar="FILE", help="the .gif (or .mp4, with ffmpeg)")
-    s.add_argument("--duration", type=SECONDS, default=4.0, metavar="S", help="playback length (default 4 s)")
-    s.add_argument("--fps", type=float, default=15.0, metavar="N", help="frames per second (default 15)")
-    s.add_argument("--slow-motion", type=float, default=100.0, metavar="X",
-                   help="playback time per simulated time (default 100: 4 s show 40 ms)")
-    s.add_argument("--magnify", type=float, default=1000.0, metavar="X",
-                   help="vibration displacements (from the rigid-body motion) times X (default 1000)")
-    s.add_argument("--mode", type=int, metavar="K", help="animate mode shape K (1-based) instead of the running train")
-    s.add_argument("--solver", choices=("mujoco", "lumped"), default="mujoco", help="whose mode shape (--mode)")
-    s.add_argument("--size", type=int, nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (480 360)")
-    s.set_defaults(func=cmd_animate)
-
-    s = sub.add_parser("view", help="the MuJoCo viewer with the twin running live (needs a display)")
-    _train_arg(s)
-    s.add_argument("--slow-motion", type=float, default=100.0, metavar="X", help="wall time per simulated time")
-    s.add_argument("--magnify", type=float, default=1000.0, metavar="X", help="vibration displacements times X")
-    s.set_defaults(func=cmd_view)
-
-    s = sub.add_parser("dashboard", help="draw a history store as a static site: each metric over commits with "
-                                         "its tolerance and change points, wall times, what changed last")
-    s.add_argument("store", type=Path, metavar="STORE", help="the history store (crosscheck --history)")
-    s.add_argument("-o", "--output", type=Path, default=Path("site"), metavar="DIR",
-                   help="the site's folder (default site/); open DIR/index.html")
-    s.set_defaults(func=cmd_dashboard)
-
-    s = sub.add_parser("export", help="write the reference lumped model as a file of matrices (.mat or .npz): the "
-                                      "layout --model reads, with every convention of gearcheck's coordinates")
-    _train_arg(s)
-    s.add_argument("-o", "--output", type=Path, required=True, metavar="FILE", help="output .mat or .npz file")
-    s.set_defaults(func=cmd_export)
-
-    s = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a train")
-    _train_arg(s)
-    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)")
-    s.set_defaults(func=cmd_mjcf)
+    for name, command in COMMANDS.items():
+        s = sub.add_parser(name, help=command.help)
+        for flags, options in command.arguments:
+            s.add_argument(*flags, **options)
+        s.set_defaults(func=command.run)
     return p
 
 
-def _train_arg(s):
-    s.add_argument("train", metavar="TRAIN", help="preset name or path to a train TOML file")
+class Command:
+    """A command of the command line: the function that runs it (each calls the front door), its help line and its
+    arguments, as :func:`arg` writes them."""
+
+    def __init__(self, run: Callable[[argparse.Namespace], int], help: str, *arguments: tuple):
+        self.run, self.help, self.arguments = run, help, arguments
+
+
+def arg(*flags: str, **options) -> tuple:
+    """An argument of a command: ``argparse``'s flags and options."""
+    return flags, options
+
+
+TRAIN = arg("train", metavar="TRAIN", help="preset name or path to a train TOML file")
 
 
 # ----------------------------------------------------------------------------- commands
@@ -849,3 +644,225 @@ def _verdict_line(result, out: Path) -> str:
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
+
+
+COMMANDS = {  # name: the function that runs it, its help line, its arguments (argparse's, by flags)
+    "presets": Command(
+        cmd_presets, "list the shipped train presets",
+    ),
+    "show": Command(
+        cmd_show, "the validated train with derived quantities",
+        TRAIN,
+        arg("--json", action="store_true", help="machine-readable output"),
+    ),
+    "modes": Command(
+        cmd_modes, "natural frequencies and mode types (at rest, or turning at --speed)",
+        TRAIN,
+        arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="lumped"),
+        arg("--speed", type=RPM_OR_ZERO, metavar="RPM",
+            help="the gyroscopic modes of the train turning at this input speed (0 allowed)"),
+        arg("--json", action="store_true", help="machine-readable output"),
+    ),
+    "campbell": Command(
+        cmd_campbell, "Campbell diagram: gyroscopic modes over a speed range (PNG and JSON)",
+        TRAIN,
+        arg("--speeds", type=SPEED_RANGE, required=True, metavar="A:B:N",
+            help="N input speeds from A to B rpm (0 <= A < B, N >= 2)"),
+        arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both"),
+        arg("--harmonics", type=int, default=3, metavar="H", help="mesh harmonics drawn (default 3)"),
+        arg("--out", type=Path, default=Path("out/campbell"), metavar="DIR",
+            help="writes campbell.png and campbell.json (default out/campbell)"),
+    ),
+    "mac": Command(
+        cmd_mac, "mode shapes of the lumped model and the MuJoCo twin (or your --model and --against) paired by the "
+                 "modal assurance criterion (PNG heat map and JSON)",
+        TRAIN,
+        arg("--model", metavar="MODEL",
+            help="your model: a .mat/.npz file of matrices, module:factory or file.py:factory"),
+        arg("--against", default="lumped", choices=("lumped", "mujoco"), help="what --model is paired with"),
+        arg("--out", type=Path, default=Path("out/mac"), metavar="DIR",
+            help="writes mac.png and mac.json (default out/mac)"),
+    ),
+    "ste": Command(
+        cmd_ste, "static transmission error of every mesh, unloaded and loaded, with its tip reliefs (PNG and JSON)",
+        TRAIN,
+        arg("--relief-sweep", type=MICROMETRE_RANGE, metavar="A:B:N",
+            help="also the loaded STE peak-to-peak for N tip relief amounts from A to B um (every tip relief of the "
+                 "train, lengths as given)"),
+        arg("--slices", type=int, metavar="N", help="slices across a helical face (default 400)"),
+        arg("--out", type=Path, default=Path("out/ste"), metavar="DIR",
+            help="writes ste.png, ste.json (and relief_sweep.png) (default out/ste)"),
+    ),
+    "run": Command(
+        cmd_run, "time response at the operating point",
+        TRAIN,
+        arg("--solver", choices=tuple(gearcheck.SOLVERS), default="lumped"),
+        arg("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)"),
+        arg("--duration", type=SECONDS, default=0.2, metavar="S", help="simulated time (default 0.2 s)"),
+        arg("--dt", type=SECONDS, metavar="S", help="time step (default: from the highest natural frequency)"),
+        arg("--output-dt", type=SECONDS, metavar="S", help="output sampling interval (default: every step)"),
+        arg("--method", default="rk4", help="lumped integrator: rk4 (default) or RK45, DOP853, Radau, BDF, LSODA"),
+        arg("--format", choices=("parquet", "csv"), default="parquet",
+            help="time series file format: parquet (default: full precision, compressed, units in its metadata) or "
+                 "csv"),
+        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+    ),
+    "crosscheck": Command(
+        cmd_crosscheck, "run both solvers, compare them, write a report; exit 1 when a tolerance is exceeded or a "
+                        "baseline metric moved, 3 when the comparison is inconclusive",
+        arg("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file"),
+        arg("--all", action="store_true", help="every shipped preset, with a summary table"),
+        arg("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)"),
+        arg("--duration", type=SECONDS, metavar="S",
+            help="simulated time (default: the baseline's with --baseline, else 0.1 s; 0.02 s for a --model other "
+                 "than general)"),
+        arg("--model", default="general", metavar="MODEL",
+            help="the model checked: gearcheck's general model against MuJoCo (default), a published "
+                        f"4-DOF model ({', '.join(MODELS[1:])}: double-planet) against the twin of its "
+                        "idealisation, or your own: a .mat/.npz file of matrices, module:factory, "
+                        "file.py:factory, or 'user' (the train file's train.user_model), checked against --against"),
+        arg("--against", default="lumped", choices=("lumped", "mujoco"),
+            help="what your own model is checked against: the reference lumped model (default) or the MuJoCo twin"),
+        arg("--results", type=Path, metavar="FILE",
+            help="another solver's time series as the model checked (.csv, .parquet, .mat)"),
+        arg("--columns", type=Path, metavar="FILE", help="TOML map of --results' columns to signals"),
+        arg("--modes", type=Path, metavar="FILE",
+            help="with --results: its natural frequencies and mode shapes (.npz, .mat, .csv)"),
+        arg("--dt-lumped", type=SECONDS, metavar="S", help="lumped RK4 step (default: derived)"),
+        arg("--dt-mujoco", type=SECONDS, metavar="S", help="MuJoCo step (default: derived)"),
+        arg("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table"),
+        arg("--sensor-band", type=HZ, nargs=2, metavar=("LOW", "HIGH"),
+            help="accelerometer chain: band-pass both solvers' accelerations to LOW-HIGH Hz"),
+        arg("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]"),
+        arg("--baseline", type=str, metavar="FILE", nargs="?", const="shipped",
+            help="compare with a stored baseline (without FILE: the shipped one of the preset)"),
+        arg("--update-baseline", action="store_true", help="rewrite the baseline instead of checking it"),
+        arg("--junit", type=Path, metavar="FILE",
+            help="also write the verdicts as JUnit XML: a testcase per gated quantity and mode, for any CI"),
+        arg("--history", type=Path, metavar="STORE",
+            help="append each run's metrics, versions and wall times to this history store (SQLite), one record per "
+                 "commit and train (a rerun replaces it); draw it with `gearcheck dashboard`"),
+        arg("--commit", metavar="SHA",
+            help="the commit --history records (default: $GITHUB_SHA, else `git rev-parse HEAD` here)"),
+        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+    ),
+    "calibrate": Command(
+        cmd_calibrate, "least-squares fit of train-file parameters to measured amplitudes",
+        TRAIN,
+        arg("--fit", action="append", required=True, metavar="PATH[=LOW:HIGH]",
+            help="a train-file field in its own units, e.g. stages[0].mesh.ste[0].amplitude_um=0.05:20"),
+        arg("--measurements", type=Path, metavar="FILE",
+            help="TOML file with [[measurements]] (default: the train file's)"),
+        arg("--fit-speed", type=RPM, action="append", metavar="RPM",
+            help="use only the measurements at this speed for the fit; the others are predicted"),
+        arg("--duration", type=SECONDS, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)"),
+        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+    ),
+    "sweep": Command(
+        cmd_sweep, "speed sweeps, parameter studies and Monte Carlo: many runs reduced to one Parquet table of "
+                   "mesh-harmonic amplitudes with order plots; cached points, local processes or a Dask cluster",
+        TRAIN,
+        arg("--speeds", metavar="A:B:N|V,V,...",
+            help="input speeds in rpm: N from A to B, or a list (default: the train file's)"),
+        arg("--set", action="append", default=[], metavar="FIELD=V,V,...",
+            help="a parameter study: values of a train-file field in its own units, or FIELD=A:B:N (repeatable: the "
+                 "grid over all), e.g. stages[0].mesh.ste[0].amplitude_um=5,10,20"),
+        arg("--vary", action="append", default=[], metavar="FIELD=DIST",
+            help="Monte Carlo: a field's distribution, normal(mean,sd), uniform(low,high) or "
+                 "lognormal(median,factor) (repeatable)"),
+        arg("--distributions", type=Path, metavar="FILE",
+            help="Monte Carlo: a TOML file with a [distributions] table, \"FIELD\" = \"normal(mean, sd)\""),
+        arg("--samples", type=int, metavar="N", help="Monte Carlo draws (default 32)"),
+        arg("--seed", type=int, default=0, metavar="S", help="Monte Carlo seed (default 0)"),
+        arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both"),
+        arg("--duration", type=SECONDS, default=0.5, metavar="S", help="simulated time per run (default 0.5 s)"),
+        arg("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics per mesh frequency (default 3)"),
+        arg("--no-integration-check", dest="integration_check", action="store_false",
+            help="run each solver once per point, without the second run at twice the step that estimates each "
+                 "line's integration error (about 1.5 times faster; every line then counts)"),
+        arg("--refine", type=int, default=1, metavar="N",
+            help="divide each solver's default step by N (default 1), for lines whose integration error estimate is "
+                 "too large to read them; the work grows N times"),
+        arg("--workers", type=int, metavar="N",
+            help="local worker processes (default: the cores available; 1 runs in this process)"),
+        arg("--scheduler", metavar="ADDRESS",
+            help="run the points on a Dask distributed cluster, e.g. tcp://scheduler.example.org:8786"),
+        arg("--cache", type=Path, metavar="DIR",
+            help="finished points, one Parquet file per input hash: a rerun skips them (default OUT.cache)"),
+        arg("--no-cache", action="store_true", help="keep no cache"),
+        arg("--quantity", action="append", metavar="NAME",
+            help="a quantity to plot (repeatable; default: carrier and ring accelerations and the first sun and ring "
+                 "mesh forces of each stage)"),
+        arg("--out", type=Path, default=Path("out/sweep"), metavar="DIR",
+            help="writes sweep.parquet, sweep.json and the figures (default out/sweep)"),
+    ),
+    "sensitivity": Command(
+        cmd_sensitivity, "derivatives of the steady harmonic response to train-file numbers (closed form, checked by "
+                         "finite differences; maps over speed)",
+        TRAIN,
+        arg("--parameter", action="append", required=True, metavar="PATH",
+            help="a number of the train file, e.g. stages[0].crank.eccentricity_mm (repeatable)"),
+        arg("--coordinate", metavar="NAME",
+            help="the coordinate whose harmonics are reported (default: the output's rotation, e.g. "
+                 "rv.carrier.theta)"),
+        arg("--method", choices=("hb", "fourier"), default="fourier",
+            help="harmonic balance, or the paper's Fourier-series method (default; shows its Eq. 15 beside)"),
+        arg("--orders", type=int, nargs="+", metavar="H",
+            help="harmonics kept per clock (mesh, then an RV reducer's eccentrics), default 3 2"),
+        arg("--speeds", type=SPEED_RANGE, metavar="A:B:N",
+            help="a map over input speeds (rpm) instead of the train's speed"),
+        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+    ),
+    "pins": Command(
+        cmd_pins, "an RV reducer's static pin loads over a pin pitch or an eccentric turn (PNG)",
+        TRAIN,
+        arg("--span", choices=("pitch", "turn"), default="pitch",
+            help="frozen configurations over one pin pitch (default) or a whole turn of the eccentrics"),
+        arg("--samples", type=int, default=16, metavar="N", help="frozen times (default 16)"),
+        arg("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-pins.png)"),
+    ),
+    "stiffness": Command(
+        cmd_stiffness, "plot the mesh stiffness over the mesh cycle (PNG)",
+        TRAIN,
+        arg("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)"),
+    ),
+    "animate": Command(
+        cmd_animate, "render the MuJoCo twin running (or a mode shape) offscreen as a GIF or MP4, vibration "
+                     "magnified, with time and mesh-force overlays",
+        TRAIN,
+        arg("-o", "--output", type=Path, required=True, metavar="FILE", help="the .gif (or .mp4, with ffmpeg)"),
+        arg("--duration", type=SECONDS, default=4.0, metavar="S", help="playback length (default 4 s)"),
+        arg("--fps", type=float, default=15.0, metavar="N", help="frames per second (default 15)"),
+        arg("--slow-motion", type=float, default=100.0, metavar="X",
+            help="playback time per simulated time (default 100: 4 s show 40 ms)"),
+        arg("--magnify", type=float, default=1000.0, metavar="X",
+            help="vibration displacements (from the rigid-body motion) times X (default 1000)"),
+        arg("--mode", type=int, metavar="K", help="animate mode shape K (1-based) instead of the running train"),
+        arg("--solver", choices=("mujoco", "lumped"), default="mujoco", help="whose mode shape (--mode)"),
+        arg("--size", type=int, nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (480 360)"),
+    ),
+    "view": Command(
+        cmd_view, "the MuJoCo viewer with the twin running live (needs a display)",
+        TRAIN,
+        arg("--slow-motion", type=float, default=100.0, metavar="X", help="wall time per simulated time"),
+        arg("--magnify", type=float, default=1000.0, metavar="X", help="vibration displacements times X"),
+    ),
+    "dashboard": Command(
+        cmd_dashboard, "draw a history store as a static site: each metric over commits with its tolerance and "
+                       "change points, wall times, what changed last",
+        arg("store", type=Path, metavar="STORE", help="the history store (crosscheck --history)"),
+        arg("-o", "--output", type=Path, default=Path("site"), metavar="DIR",
+            help="the site's folder (default site/); open DIR/index.html"),
+    ),
+    "export": Command(
+        cmd_export, "write the reference lumped model as a file of matrices (.mat or .npz): the layout --model "
+                    "reads, with every convention of gearcheck's coordinates",
+        TRAIN,
+        arg("-o", "--output", type=Path, required=True, metavar="FILE", help="output .mat or .npz file"),
+    ),
+    "mjcf": Command(
+        cmd_mjcf, "write the MuJoCo model (MJCF) of a train",
+        TRAIN,
+        arg("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)"),
+    ),
+}

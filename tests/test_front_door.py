@@ -95,8 +95,8 @@ def demo():
 
 
 def test_a_session_builds_each_side_once(monkeypatch):
-    """Modes, runs, a Campbell diagram, the mode pairing and the MJCF text of one session share one compiled
-    twin and one lumped model."""
+    """Modes, runs, a cross-check, a Campbell diagram, the mode pairing and the MJCF text of one session share one
+    compiled twin and one lumped model."""
     import mujoco
 
     from gearcheck.lumped import side
@@ -115,7 +115,10 @@ def test_a_session_builds_each_side_once(monkeypatch):
     assert train.mjcf() == gearcheck.mjcf("demo-3p")
     assert type(train.mac()).__name__ == "ModePairing"
     assert type(train.campbell([0, 500])).__name__ == "CampbellResult"
+    assert train.crosscheck(duration=0.02).verdict in ("PASS", "FAIL", "INCONCLUSIVE")
     assert len(compiles) == 2 and len(builds) == 1  # gearcheck.mjcf compiled its own twin: the second
+    train.crosscheck(duration=0.02, speed=1000)  # another speed: models of their own
+    assert len(compiles) == 3 and len(builds) == 2
 
 
 def test_every_session_method_returns_its_result(demo, tmp_path):

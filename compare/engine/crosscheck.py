@@ -29,7 +29,7 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
                against: str = "lumped", results=None, columns=None, modes=None, dt_lumped: float | None = None,
                dt_mujoco: float | None = None, tolerances=None, measurements=None,
                sensor_band: tuple[float, float] | None = None, baseline=None, update_baseline: bool = False,
-               progress=None) -> CrosscheckResult:
+               progress=None, sides=None) -> CrosscheckResult:
     """Cross-check a train's lumped model against its MuJoCo twin, or the model ``model`` names.
 
     Parameters
@@ -69,6 +69,9 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         Rewrite ``baseline`` with this run instead of comparing.
     progress : callable, optional
         Called with the fraction done.
+    sides : callable, optional
+        The lumped model and the twin already built for this train at this speed (``"lumped"``/``"mujoco"`` ->
+        side, as :meth:`gearcheck.Train.side`); default: built here.
 
     Returns
     -------
@@ -77,7 +80,7 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         (``result[name]``), ``.measurements``, ``.moved`` (metrics moved from the baseline), ``.write(directory)``.
     """
     spec = load_train(train, speed)
-    pair = resolve_model(spec, model, against, results, columns, modes)
+    pair = resolve_model(spec, model, against, results, columns, modes, sides)
     _check_band(sensor_band)
     tol = Tolerances.for_train(spec, tolerances)
     path = baseline_path(baseline, spec.name)

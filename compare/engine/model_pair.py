@@ -112,32 +112,33 @@ class PublishedPair(ModelPair):
 
 
 def resolve_model(spec, model="general", against: str = "lumped", results=None, columns=None,
-                  modes=None) -> ModelPair:
+                  modes=None, sides=None) -> ModelPair:
     """The sides that ``model`` names for the train ``spec`` (module docstring); ``against`` what a user's model
     is checked against, ``"lumped"`` or ``"mujoco"``; ``results``, ``columns``, ``modes``: another solver's
-    results as the user's model (:class:`~gearcheck.compare.engine.recorded.RecordedSide`)."""
+    results as the user's model (:class:`~gearcheck.compare.engine.recorded.RecordedSide`); ``sides``: the
+    built-in sides already built (a callable ``"lumped"``/``"mujoco"`` -> side, a session's), else built here."""
     if against not in AGAINST:
         raise GearcheckError(f"against={against!r}: choose {' or '.join(AGAINST)}")
-    reference = AGAINST[against]
+    built = sides or (lambda solver: AGAINST[solver](spec))
     named = model if isinstance(model, str) else None
     if results is not None:
         if named != "general":
             raise GearcheckError("results= gives the model checked: leave model= out")
         if columns is None:
             raise GearcheckError("results= needs columns=, the map of its columns to gearcheck's signals")
-        return RecordedPair(reference(spec), RecordedSide(spec, results, columns, modes))
+        return RecordedPair(built(against), RecordedSide(spec, results, columns, modes))
     if named == "general":
-        return ModelPair(LumpedSide(spec), MujocoSide(spec))
+        return ModelPair(built("lumped"), built("mujoco"))
     if named in PUBLISHED_MODELS:
         return PublishedPair(PublishedSide(spec, named), PublishedTwinSide(spec, named))
     if named == USER:
         if spec.user_model is None:
             raise GearcheckError(f"model=user: {spec.name} registers no user_model (train.user_model in its file)")
-        return UserPair(reference(spec), user_side(spec.user_model, spec))
+        return UserPair(built(against), user_side(spec.user_model, spec))
     if named is not None and ":" not in named and Path(named).suffix not in SUFFIXES:
         if Path(named).suffix:
             raise GearcheckError(f"model={named}: a model file is {' or '.join(SUFFIXES)}, "
                                  f"not {Path(named).suffix!r}")
         raise GearcheckError(f"unknown model {named!r}: choose one of {', '.join(MODELS)}, or give your own: a model "
                              f"file ({' or '.join(SUFFIXES)}), module:factory or file.py:factory")
-    return UserPair(reference(spec), user_side(model, spec))
+    return UserPair(built(against), user_side(model, spec))

@@ -92,9 +92,9 @@ class Train:
         return time_solver.simulate(side.model, settings, method=method, y0=y0, progress=progress)
 
     def crosscheck(self, **options) -> CrosscheckResult:
-        """Both solvers compared; ``options`` those of :func:`gearcheck.crosscheck`.  The engine builds its own
-        pair of models (:func:`gearcheck.compare.engine.crosscheck.crosscheck` takes none)."""
-        return crosscheck(self.spec, **options)
+        """Both solvers compared, on the session's models (at another ``speed``, new ones); ``options`` those of
+        :func:`gearcheck.crosscheck`."""
+        return crosscheck(self.spec, sides=None if options.get("speed") is not None else self.side, **options)
 
     def campbell(self, speeds, solver: str = "both", harmonics: int = 3) -> CampbellResult:
         """The Campbell diagram over ``speeds`` (rpm, ascending).  See :func:`gearcheck.campbell`."""

@@ -642,10 +642,6 @@ def _verdict_line(result, out: Path) -> str:
     return f"{result.spec.name}: {result.verdict}{detail} (report: {out / 'report.md'})"
 
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
-
-
 COMMANDS = {  # name: the function that runs it, its help line, its arguments (argparse's, by flags)
     "presets": Command(
         cmd_presets, "list the shipped train presets",
@@ -866,3 +862,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)"),
     ),
 }
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

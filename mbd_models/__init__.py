@@ -11,7 +11,6 @@ MuJoCo itself, never from the lumped model's matrices or equations: nothing here
 * ``linearise`` -- MuJoCo's own M and K, natural frequencies and the highest one;
 * ``runner`` -- the driven run;
 * ``static_state`` -- the steady rotating state at the operating point (the runner's start);
-* ``cycloid_twin`` -- an RV reducer's pin contacts, which follow the discs every step;
 * ``forces`` -- mesh and bearing forces read from MuJoCo's generalized forces;
 * ``published_twin`` -- the twin of the 4-DOF model of Matejic et al. (2021);
 * ``gear_visuals`` -- tooth outlines for the viewer;

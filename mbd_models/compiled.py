@@ -276,30 +276,33 @@ def _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef):
         wrap_prm[wraps[w]] = coef[w]
 
 
-def cycloid_arrays(cyc, nv: int) -> Cycloid:
-    """An RV reducer's pin contacts (:class:`~gearcheck.mbd_models.cycloid_twin.CycloidTwin`) as flat arrays for
-    :func:`_pins`; None: empty arrays of the same types."""
-    rows, discs = [], []
-    width = 6
-    if cyc is not None:
-        width = max([g.dofs.shape[1] for g in cyc.stages], default=6)
-        for g in cyc.stages:
-            for i, body in enumerate(g.bodies):
-                first = g.rows.start + i * len(g.sites)
-                dofs, qadr = np.full(width, -1), np.full(width, -1)
-                dofs[:g.dofs.shape[1]], qadr[:g.dofs.shape[1]] = g.dofs[i], g.qadr[i]
-                discs.append((body, g.wheel, g.phases[i], g.lobes, g.eccentricity, g.pitch_radius, first,
-                              len(g.sites), g.dofs.shape[1], dofs, qadr))
-                for p, site in enumerate(g.sites):
-                    wraps = np.full(width, -1)
-                    wraps[:g.dofs.shape[1]] = g.wraps[i, p]
-                    rows.append((site, wraps))
+def cycloid_arrays(contacts, nv: int) -> Cycloid:
+    """The twin's pin contacts (:attr:`gearcheck.mbd_models.twin.MbdModel.moving_contacts`: an RV reducer's
+    ``CycloidTwin``) as flat arrays for :func:`_pins`, every contact's tendons in their order; none: empty arrays
+    of the same types."""
+    rows, discs, stages, offset = [], [], [], 0
+    for c in contacts:  # each contact's stages, with where its tendons start among all
+        stages += [(g, offset) for g in c.stages]
+        offset += len(c.tendons)
+    width = max([g.dofs.shape[1] for g, _ in stages], default=6)
+    for g, offset in stages:
+        for i, body in enumerate(g.bodies):
+            first = offset + g.rows.start + i * len(g.sites)
+            dofs, qadr = np.full(width, -1), np.full(width, -1)
+            dofs[:g.dofs.shape[1]], qadr[:g.dofs.shape[1]] = g.dofs[i], g.qadr[i]
+            discs.append((body, g.wheel, g.phases[i], g.lobes, g.eccentricity, g.pitch_radius, first,
+                          len(g.sites), g.dofs.shape[1], dofs, qadr))
+            for p, site in enumerate(g.sites):
+                wraps = np.full(width, -1)
+                wraps[:g.dofs.shape[1]] = g.wraps[i, p]
+                rows.append((site, wraps))
     i64, f64 = np.int64, np.float64
     n_pins = len(rows)
-    pins = Pins(np.asarray(cyc.tendons if cyc is not None else [], dtype=i64),
-                np.asarray(cyc.stiffness if cyc is not None else [], dtype=f64),
-                np.asarray(cyc.damping if cyc is not None else [], dtype=f64),
-                np.asarray(cyc.clearance if cyc is not None else [], dtype=f64),
+
+    def joined(name: str, kind) -> np.ndarray:
+        return np.concatenate([np.asarray(getattr(c, name), dtype=kind) for c in contacts] + [np.zeros(0, kind)])
+
+    pins = Pins(joined("tendons", i64), joined("stiffness", f64), joined("damping", f64), joined("clearance", f64),
                 np.array([r[0] for r in rows], dtype=i64),
                 np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
     columns = list(zip(*discs)) if discs else [[]] * 11

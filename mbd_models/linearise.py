@@ -65,10 +65,10 @@ def mass_matrix(mb, qpos: np.ndarray | None = None) -> np.ndarray:
 
 @contextmanager
 def _frozen(mb, qpos: np.ndarray, every_pin: bool = False):
-    """An RV reducer's pin contacts as linear springs at ``qpos`` on its static contact set of t = 0 (or on
-    every pin: the stiffest the twin can be), their coefficients MuJoCo's Jacobians there; the tendon fields are
-    restored afterwards.  Nothing for other trains."""
-    if mb.cycloid is None:
+    """The twin's contacts (an RV reducer's pins) as linear springs at ``qpos`` on their static contact set of t = 0
+    (or all touching: the stiffest the twin can be), their coefficients MuJoCo's Jacobians there; the tendon fields
+    are restored afterwards.  Nothing for a train without contacts."""
+    if not mb.moving_contacts:
         yield
         return
     m = mb.model
@@ -76,7 +76,8 @@ def _frozen(mb, qpos: np.ndarray, every_pin: bool = False):
     try:
         d = mujoco.MjData(m)
         d.qpos[:] = qpos
-        mb.cycloid.refresh(d, np.ones_like(mb.cycloid.contacts) if every_pin else mb.cycloid.contacts)
+        for c in mb.moving_contacts:
+            c.freeze(d, every_pin)
         yield
     finally:
         m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.wrap_prm[:] = saved
@@ -251,11 +252,10 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
             m.actuator_biasprm[mb.actuator["input_shaft_damper"], 2] = 0.0
         q0, v0 = m.qpos0.copy(), ratio * nominal_speeds(mb)
         d = mujoco.MjData(m)
-        if mb.cycloid:  # the pins of t = 0 frozen, undamped, as the needle bearings
-            d.qpos[:] = q0
-            mb.cycloid.refresh(d, mb.cycloid.contacts)
-            m.tendon_damping[mb.cycloid.tendons] = 0.0
-            m.actuator_biasprm[mb.cycloid.needles.ravel(), 2] = 0.0
+        d.qpos[:] = q0
+        for c in mb.moving_contacts:  # the contacts of t = 0 frozen, undamped (an RV reducer's pins and needle bearings)
+            c.freeze(d)
+            c.undamp()
         P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier
         for mid, member in mb.spec.members.items():
             if member.frame == "axis":

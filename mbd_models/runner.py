@@ -13,7 +13,7 @@ Per step (fixed step h, MuJoCo's RK4 integrator):
 * the mesh tendons' world-frame slide coefficients turned to the carrier's current angle
   (:class:`~gearcheck.mbd_models.twin.TurningCoefficients`; the angle-0 values came from ``mj_jac``);
   an RV reducer's pin tendons set to the discs' current poses
-  (:meth:`~gearcheck.mbd_models.cycloid_twin.CycloidTwin.refresh`);
+  (:meth:`~gearcheck.mbd_models.elements.cycloid.CycloidTwin.refresh`);
 * the damping correction, a generalized force J^T g with g = c (de/dt - m): a fixed tendon's
   velocity J qvel misses the part m = (dc/dphi) phi' q of its coefficients turning with the carrier,
   and the transmission error's rate de/dt belongs to the mesh's damping force too, so the mesh
@@ -72,7 +72,7 @@ from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, st
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
-from gearcheck.shared.results import Signal, TimeResult, train_result
+from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
@@ -169,15 +169,16 @@ class _Stepper:
         self.forces = np.empty((n_samples, self.reader.width))
         self.stiffness = np.empty((n_samples, self.n_mesh)) if bodies or self.contacts else None
         self.energy = np.empty((n_samples, 2)) if energy else None
-        self.cycloid = mb.cycloid
-        self.pins = np.empty((n_samples, len(mb.cycloid.tendons))) if mb.cycloid else None
+        self.moving = mb.moving_contacts
+        self.pins = np.empty((n_samples, sum(len(c.tendons) for c in self.moving))) if self.moving else None
         self.j = 0
 
     def refresh(self) -> None:
-        """Turn the mesh tendons' coefficients with their carriers and set the pin tendons to the discs' poses."""
+        """Turn the mesh tendons' coefficients with their carriers and set the contacts' tendons (an RV reducer's
+        pins) to the bodies' poses."""
         self.mb.refresh(self.d.qpos)
-        if self.cycloid is not None:
-            self.cycloid.refresh(self.d)
+        for c in self.moving:
+            c.refresh(self.d)
 
     def set_stage(self, k, u, e, de, pairs=None) -> None:
         """Drive values for the coming stage(s): stiffness, controls, spring lengths, tooth contacts, damping
@@ -200,7 +201,7 @@ class _Stepper:
         if self.energy is not None:
             self.energy[j] = self.d.energy
         if self.pins is not None:
-            self.pins[j] = self.cycloid.pin_forces(self.d)
+            self.pins[j] = np.concatenate([c.pin_forces(self.d) for c in self.moving])
         self.j += 1
 
     def run(self, start: int, stop: int, every: int, values, split) -> None:
@@ -280,13 +281,13 @@ class _LeanStepper(_Stepper):
         cs, coef, rate, base, turned = self.cs, self.coef, self.rate, self.base, self.turned
         dot, multiply, cos, sin = np.dot, np.multiply, math.cos, math.sin
         forward, rk = mujoco.mj_forward, mujoco.mj_RungeKutta
-        pins = None if self.cycloid is None else self.cycloid.refresh
+        refreshes = [c.refresh for c in self.moving]
         for i in range(stop - start):
             if start + i in split:
                 self.split_step(start + i, split[start + i], (start + i) % every == 0)
                 continue
-            if pins is not None:
-                pins(d)
+            for refresh in refreshes:
+                refresh(d)
             phi = qpos[phi_adr]
             cs[0] = cos(phi)
             cs[1] = sin(phi)
@@ -334,7 +335,7 @@ class _CompiledStepper(_Stepper):
             compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n)),
             compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
                             np.ascontiguousarray(reader.slides, dtype=np.int64)),
-            compiled.cycloid_arrays(mb.cycloid, m.nv))
+            compiled.cycloid_arrays(mb.moving_contacts, m.nv))
         self.outputs = compiled.Outputs(self.sensors, self.forces,
                                         np.zeros((0, n)) if self.stiffness is None else self.stiffness,
                                         np.zeros((0, 2)) if self.energy is None else self.energy,
@@ -477,7 +478,7 @@ def simulate_mujoco_many(twins, settings, threads: int | None = None, **options)
     seen, own = set(), []
     for mb in twins:
         if id(mb.model) in seen:
-            if mb.cycloid is not None:
+            if mb.moving_contacts:
                 raise SolverError(f"simulate_mujoco_many: the twin of {mb.spec.name} is given twice; compile it "
                                   "once per run (an RV reducer's pin contacts hold their model)")
             mb = dataclasses.replace(mb, model=copy.copy(mb.model))
@@ -557,28 +558,10 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     if stepper.energy is not None:  # MuJoCo's d.energy is (potential, kinetic)
         raw["energy_potential"] = stepper.energy[:stepper.j, 0]
         raw["energy_kinetic"] = stepper.energy[:stepper.j, 1]
-    pins = None if mb.cycloid is None else stepper.pins[:stepper.j]
-    by_disc = None if pins is None else np.concatenate(
-        [pins[:, g.rows].reshape(len(t), len(g.bodies), -1) for g in mb.cycloid.stages], axis=1)
+    pins = [stepper.pins[:stepper.j, at] for at in mb.moving_slices()]
+    by_disc = np.concatenate([c.per_disc(f) for c, f in zip(mb.moving_contacts, pins)], axis=1) if pins else None
     result = train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force,
                           static.bearing_force, bearing_force, settle, info, raw, by_disc)
-    return result if pins is None else _with_cycloid(result, mb, pins, series, static)
-
-
-def _with_cycloid(result: TimeResult, mb: MbdModel, pins: np.ndarray, series, static: StaticState) -> TimeResult:
-    """``result`` with an RV reducer's every pin contact force ``STAGE.discJ.pinI.force`` (the load
-    distribution) and its needle bearings' forces ``STAGE.crankK.discJ.needle_x.force`` and ``..._y`` (the
-    spring-damper force from the bore to the eccentric, along the bore's axes, which turn with the disc: the
-    carrier's up to the disc's vibration), named as the reference model names their rows; reported, not gated."""
-    cyc = mb.cycloid
-    signals = [Signal(f"{name}.force", "pin_force", "N", f"{name} contact force", False) for name in cyc.names]
-    columns = list(pins.T)
-    for name, actuators in zip(cyc.needle_names, cyc.needles):
-        for axis, actuator in zip("xy", actuators):
-            label = mujoco.mj_id2name(mb.model, mujoco.mjtObj.mjOBJ_ACTUATOR, int(actuator))
-            signals.append(Signal(f"{name}_{axis}.force", "bearing_force", "N", f"{name} force along {axis}", False))
-            columns.append(-series(f"{label}_force")[:, 0])
-    static_values = {f"{name}.force": float(f) for name, f in zip(cyc.names, static.pin_force)}
-    return TimeResult(result.train, result.solver, result.t, result.signals + signals,
-                      np.column_stack([result.values] + columns), result.settle_time, result.info, result.raw,
-                      {**result.static, **static_values})
+    for c, forces, at in zip(mb.moving_contacts, pins, mb.moving_slices()):
+        result = c.with_signals(result, forces, series, static.pin_force[at])
+    return result

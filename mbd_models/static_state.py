@@ -60,7 +60,7 @@ class StaticState:
     bearing_force: np.ndarray  # in gearcheck.shared.results.bearing_names order
     iterations: int
     residual: float
-    contacts: np.ndarray | None = None  # an RV reducer's pins touching at t = 0 (its twin's pin tendons' order)
+    contacts: np.ndarray | None = None  # which of the twin's contacts touch at t = 0 (an RV reducer's pins)
     pin_force: np.ndarray | None = None  # their forces, N
 
 
@@ -125,8 +125,13 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.tendon_damping.copy(), m.wrap_prm.copy())
     t = mb.mesh_tendon
     correction = DampingCorrection(mb, d)
-    touching = None if mb.cycloid is None else np.ones(len(mb.cycloid.tendons), dtype=bool)
+    contacts, slices = mb.moving_contacts, mb.moving_slices()
+    touching = np.ones(sum(len(c.tendons) for c in contacts), dtype=bool) if contacts else None
     gaps = True
+
+    def refresh_contacts(d) -> np.ndarray:
+        """Every contact set to ``touching`` at ``d``'s pose; the compressions."""
+        return np.concatenate([c.refresh(d, touching[at], gaps) for c, at in zip(contacts, slices)])
     try:
         m.tendon_stiffness[t] = mb.excitation.mean_stiffness
         _set_static_drive(mb, d, load_scale)
@@ -136,7 +141,7 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
             d.qpos[:], d.qvel[:] = qpos, qvel
             mb.refresh(d.qpos)
             if touching is not None:
-                mb.cycloid.refresh(d, touching, gaps)
+                refresh_contacts(d)
             correction.apply(None)
             mujoco.mj_forward(m, d)
             return d.qacc - target
@@ -175,11 +180,11 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
                 continue
             # the pins' clearances last: the contact set without them (every pin touching at first) is the
             # loaded half, whence the set with them follows (from all pins in tension, none might touch)
-            for gaps in (False, True) if np.any(mb.cycloid.clearance) else (True,):
+            for gaps in (False, True) if any(np.any(c.clearance) for c in contacts) else (True,):
                 q = newton(q)
                 for rounds in itertools.count():
                     residual(q)
-                    compressed = mb.cycloid.refresh(d, touching, gaps) > 0.0
+                    compressed = refresh_contacts(d) > 0.0
                     if np.array_equal(compressed, touching):
                         break
                     if rounds == len(touching):
@@ -193,7 +198,7 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
         reader.sample(sample[0])
         force, bearing = (f[0] for f in reader.forces(sample))
         qpos, qvel, _ = _nominal(mb, q)
-        pins = None if touching is None else mb.cycloid.pin_forces(d)
+        pins = None if touching is None else np.concatenate([c.pin_forces(d) for c in contacts])
         return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res, touching, pins)
     finally:
         m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.wrap_prm[:] = saved

@@ -16,7 +16,7 @@ The coefficients of the world-frame slides (central members and the carrier) dep
 carrier's angle; :class:`TurningCoefficients` keeps their angle-0 values so that the runner can turn
 them every step.
 
-An RV reducer's cycloid-pin stage (:mod:`gearcheck.mbd_models.cycloid_twin`) adds the splines between planets
+An RV reducer's cycloid-pin stage (:mod:`gearcheck.mbd_models.elements.cycloid`) adds the splines between planets
 and crankshafts, its needle bearings and one pin tendon per pin and disc, whose coefficients of t = 0 come
 from MuJoCo's Jacobians likewise; its pins touching at t = 0, which the linearisation takes, are those of the
 twin's own static equilibrium (:func:`gearcheck.mbd_models.static_state.static_state`), solved here once.
@@ -35,9 +35,8 @@ from gearcheck.train.kinematics import Kinematics, kinematics
 from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
-from gearcheck.mbd_models.cycloid_twin import CycloidTwin
+from gearcheck.mbd_models.elements import ELEMENTS
 from gearcheck.mbd_models.elements.base import TendonValues
-from gearcheck.mbd_models.elements.cycloid import pin_joints, pin_list, pin_tendon
 from gearcheck.mbd_models.elements.mesh import mesh_joints
 from gearcheck.mbd_models.mjcf_builder import document, header
 from gearcheck.mbd_models.mjcf_text import member_axes
@@ -103,7 +102,7 @@ class MbdModel:
     actuator: dict[str, int]
     sensor: dict[str, tuple[int, int]]  # name -> (address, dimension)
     turning: TurningCoefficients
-    cycloid: CycloidTwin | None = None  # an RV reducer's pin contacts and needle bearings
+    moving_contacts: tuple = ()  # contacts whose tendons follow the bodies every step (an RV reducer's pins)
 
     @property
     def omega_max(self) -> float:
@@ -112,6 +111,11 @@ class MbdModel:
     @property
     def default_step(self) -> float:
         return stepping.default_step(self.limits, self.excitation.frequency)
+
+    def moving_slices(self) -> list[slice]:
+        """Where each of :attr:`moving_contacts`' tendons lie in arrays over all of them, in their order."""
+        stops = np.cumsum([len(c.tendons) for c in self.moving_contacts], dtype=int)
+        return [slice(int(stop) - len(c.tendons), int(stop)) for c, stop in zip(self.moving_contacts, stops)]
 
     def refresh(self, qpos: np.ndarray) -> None:
         """Turn the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
@@ -220,19 +224,18 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     model.tendon_damping[:len(spec.meshes)] = damping
 
     mb = _indices(spec, kin, exc, model)
-    pins = pin_list(spec)
-    if pins:  # the pin contacts of t = 0, as MuJoCo's own Jacobians give them
-        mb.cycloid = CycloidTwin(spec, model)
-        mb.cycloid.refresh(data)
-        for (_, disc, i), t in zip(pins, mb.cycloid.tendons):
-            values.coefficients[pin_tendon(disc, i)] = [(name, float(model.wrap_prm[model.tendon_adr[t] + w]))
-                                                        for w, name in enumerate(pin_joints(spec, disc))]
+    kinds = dict.fromkeys(part.element for part in spec.parts)
+    mb.moving_contacts = tuple(c for c in (ELEMENTS[kind].contacts(spec, model) for kind in kinds) if c is not None)
+    for c in mb.moving_contacts:  # the contacts of t = 0, as MuJoCo's own Jacobians give them
+        c.refresh(data)
+        values.coefficients.update(c.written()[0])
     mb.limits = linearise.step_limits(mb)
     model.opt.timestep = mb.default_step
-    if mb.cycloid:
-        mb.cycloid.contacts = static_state(mb).contacts
-        for (_, disc, i), t in zip(pins, mb.cycloid.tendons):
-            values.band[pin_tendon(disc, i)] = tuple(model.tendon_lengthspring[t])
+    if mb.moving_contacts:  # which touch at t = 0: those of the twin's own static equilibrium
+        touching = static_state(mb).contacts
+        for c, at in zip(mb.moving_contacts, mb.moving_slices()):
+            c.contacts = touching[at]
+            values.band.update(c.written()[1])
     stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
     mb.xml = document(spec, values, model.opt.timestep, header(spec, stiffness_label))
     return mb

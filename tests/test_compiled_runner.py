@@ -87,7 +87,7 @@ def test_the_compiled_loop_repeats_the_python_loop(twins, name):
     slow = simulate_mujoco(mb, settings, record_energy=True, engine="python")
     assert fast.info.engine == "mujoco-compiled" and slow.info.engine == "mujoco-python"
     assert fast.info.rhs_calls == slow.info.rhs_calls >= 4 * fast.info.steps  # 4 a sub-step: split steps count more
-    round_off = 10 * ROUND_OFF if mb.cycloid else ROUND_OFF
+    round_off = 10 * ROUND_OFF if mb.moving_contacts else ROUND_OFF
     assert difference(slow, fast) < round_off
     assert fast.raw.keys() == slow.raw.keys()
     for key in ("energy_kinetic", "energy_potential"):

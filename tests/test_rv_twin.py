@@ -56,7 +56,7 @@ def test_frequencies_match_lumped(name):
     spec = variant(name)
     lumped = build_model(spec)
     mb = compile_train(spec)
-    assert [n for n, on in zip(mb.cycloid.names, mb.cycloid.contacts) if on] == [
+    assert [n for n, on in zip(mb.moving_contacts[0].names, mb.moving_contacts[0].contacts) if on] == [
         r.name for r in lumped.rows if r.kind == "contact"]
     a, b = modes(lumped), linearise.modes(mb)
     assert len(a) == len(b) and a.types == b.types and a.multiplicity == b.multiplicity
@@ -70,7 +70,7 @@ def test_the_rigid_mechanism_turns_without_strain(twin):
     """On the rigid mechanism's nominal motion (the description's speeds), over three eccentric turns, every needle
     bearing's deflection and every pin's compression is rounding, and so is every pin tendon's length held over
     the step that follows (the RK4 stages see no strain either)."""
-    m, d, cyc = twin.model, mujoco.MjData(twin.model), twin.cycloid
+    m, d, cyc = twin.model, mujoco.MjData(twin.model), twin.moving_contacts[0]
     speeds, h = nominal_speeds(twin), twin.default_step
     turn = 2 * np.pi / abs(twin.kin.speeds["rv.crank1"] - twin.kin.speeds["rv.carrier"])
     worst = 0.0
@@ -127,8 +127,8 @@ def test_static_state_meets_lumped_in_the_linear_limit(scale):
     mb = compile_train(spec)
     st = static_state(mb)
     rows = dict(zip(lumped.row_names, lumped.row_forces))
-    pins = np.array([rows[n] for n in mb.cycloid.names if n in rows])
-    assert [n for n, on in zip(mb.cycloid.names, st.contacts) if on] == [n for n in mb.cycloid.names if n in rows]
+    pins = np.array([rows[n] for n in mb.moving_contacts[0].names if n in rows])
+    assert [n for n, on in zip(mb.moving_contacts[0].names, st.contacts) if on] == [n for n in mb.moving_contacts[0].names if n in rows]
     assert np.abs(st.pin_force[st.contacts] - pins).max() < 0.02 * scale * pins.max()
     np.testing.assert_allclose(st.mesh_force, lumped.mesh_force, rtol=1e-3 * scale)
     np.testing.assert_allclose(st.bearing_force[1::2], [rows[f"rv.crank{k}.bearing_tangential"] for k in (1, 2, 3)],
@@ -159,6 +159,6 @@ def test_mjcf_of_an_rv_reducer(twin):
     for j in (1, 2):
         assert m.body_parentid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"rv_disc{j}")] == 0
     assert m.nbody == 1 + len(spec.members)
-    assert len(twin.cycloid.tendons) == 80 and twin.cycloid.needles.shape == (6, 2)
+    assert len(twin.moving_contacts[0].tendons) == 80 and twin.moving_contacts[0].needles.shape == (6, 2)
     assert all(m.site_bodyid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, f"rv_pin{i}")] == 0 for i in (1, 40))
     assert 'refsite="rv_disc2_bore3"' in twin.xml and 'springlength="' in twin.xml

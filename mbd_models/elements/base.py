@@ -59,3 +59,13 @@ class Element:
     def reach(self, part) -> list[float]:
         """Radii the front camera must take in."""
         return []
+
+    def contacts(self, spec, model):
+        """The kind's moving contacts at run time in the compiled ``model``, once for all its parts: an object whose
+        tendons follow the bodies, set before every step, or None (the kind has none).  It gives ``tendons``,
+        ``contacts`` (the static contact set of t = 0), ``clearance``, ``refresh(d, touching=None, gaps=True)``
+        (the coefficients at ``d``'s pose; returns the compressions), ``pin_forces(d)``, ``freeze(d, every)`` and
+        ``undamp()`` (the linearisation), ``written()`` (what the file writes), ``per_disc(forces)`` and
+        ``with_signals(result, forces, series, static_forces)`` (its result signals).  The cycloid element's
+        ``CycloidTwin`` is the one there is."""
+        return None

@@ -36,6 +36,7 @@ def run_pool(run, pending, workers: int, finished) -> None:
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload([run.__module__])
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init)
+    _closed_pipes_raise()
     try:
         run_futures(pool, run, pending, finished, start=_workers_starting)
     except BaseException:
@@ -48,6 +49,16 @@ def run_pool(run, pending, workers: int, finished) -> None:
             process.join(timeout=10)
         raise
     pool.shutdown()
+
+
+def _closed_pipes_raise() -> None:
+    """From the pool's start to the end of the process, a write to a closed pipe raises (Python's own default)
+    instead of ending the process: the command line ends on SIGPIPE when its output is closed (``gearcheck ... |
+    head``), but the pool's pipes to its fork server, resource tracker and workers close under it at Ctrl-C, also
+    while the process exits (it died of SIGPIPE after printing that it was interrupted, in half the runs of
+    tests/test_sweep_interrupt.py), and multiprocessing handles that."""
+    with contextlib.suppress(ValueError):  # not the main thread: its disposition is the main thread's to set
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
 
 
 @contextlib.contextmanager

@@ -253,7 +253,7 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
         q0, v0 = m.qpos0.copy(), ratio * nominal_speeds(mb)
         d = mujoco.MjData(m)
         d.qpos[:] = q0
-        for c in mb.moving_contacts:  # the contacts of t = 0 frozen, undamped (an RV reducer's pins and needle bearings)
+        for c in mb.moving_contacts:  # the contacts of t = 0 frozen, undamped (an RV reducer's pins, needles)
             c.freeze(d)
             c.undamp()
         P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier

@@ -54,7 +54,8 @@ def test_every_import_contract_holds(tree):
 @pytest.mark.parametrize("planted_in, planted, contract", [
     # three imports deep: train.excitation -> lumped.assembly; the twin reaches it through mbd_models.twin
     ("gearcheck/train/excitation.py", "import gearcheck.lumped.assembly", "The second derivation stays independent"),
-    ("gearcheck/lumped/static.py", "from gearcheck.mbd_models import forces", "The second derivation stays independent"),
+    ("gearcheck/lumped/static.py", "from gearcheck.mbd_models import forces",
+     "The second derivation stays independent"),
     ("gearcheck/shared/units.py", "import gearcheck.compare.engine.metrics", "Imports run one way"),
     ("gearcheck/compare/engine/align.py", "from gearcheck.compare.studies import sweep", "compare's rooms"),
     ("gearcheck/train/geometry.py", "from gearcheck.train import spec", "No import cycles"),  # spec imports geometry

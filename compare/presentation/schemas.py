@@ -1,8 +1,7 @@
 """The published JSON Schemas (draft 2020-12) of gearcheck's files: ``report.schema.json``
 (:func:`gearcheck.compare.presentation.report.report_schema`) and ``train.schema.json``
-(:func:`gearcheck.train.json_schema.train_schema`).  ``python -m gearcheck.compare.presentation.schemas DIR`` writes them
-into DIR; the repository ships them in ``schemas/``, and the tests keep those current.
-"""
+(:func:`gearcheck.train.json_schema.train_schema`).  ``python -m gearcheck.compare.presentation.schemas DIR`` writes
+them into DIR; the repository ships them in ``schemas/``, and the tests keep those current."""
 
 from __future__ import annotations
 

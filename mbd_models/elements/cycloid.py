@@ -194,7 +194,8 @@ class Cycloid(Element):
             for axis, gear in (("x", "1 0 0 0 0 0"), ("y", "0 1 0 0 0 0")):
                 lines.append(f'    <general name="{needle_actuator(crank, disc, axis)}" '
                              f'site="{eccentric_site(crank, j)}" refsite="{bore_site(disc, k)}" gear="{gear}" '
-                             f'gainprm="0" biastype="affine" biasprm="{vec(0, -n.radial_stiffness, -n.radial_damping)}" '
+                             f'gainprm="0" biastype="affine" '
+                             f'biasprm="{vec(0, -n.radial_stiffness, -n.radial_damping)}" '
                              'ctrllimited="false" forcelimited="false"/>')
         return lines
 

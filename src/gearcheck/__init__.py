@@ -9,7 +9,8 @@ The front door:
 
 * :class:`Train` -- a session: one train, its lumped model and MuJoCo twin built once, every study below a
   method (``modes``, ``simulate``, ``crosscheck``, ``campbell``, ``mac``, ``harmonic_response``, ``ste``,
-  ``relief_sweep``, ``sweep``, ``animate``, ``view``, ``mjcf``, ``describe``, ``pin_loads``, ``stiffness``); every result draws itself with ``plot()`` (a matplotlib
+  ``relief_sweep``, ``sweep``, ``animate``, ``view``, ``mjcf``, ``describe``, ``pin_loads``, ``stiffness``);
+  every result draws itself with ``plot()`` (a matplotlib
   Figure, no pyplot) and a DataFrame carries its columns' units in ``attrs["units"]``;
 * :func:`load` -- a train (preset name, train file, or TrainSpec), validated; :func:`load_text` one from TOML text,
   :func:`preset_text` a preset's text, :func:`edited` a preset with its text edited (pattern, replacement);

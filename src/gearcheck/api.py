@@ -29,8 +29,8 @@ from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 
-__all__ = ["SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model", "harmonic_response",
-           "load", "mjcf", "mode_pairing", "pin_loads",
+__all__ = ["SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model",
+           "harmonic_response", "load", "mjcf", "mode_pairing", "pin_loads",
            "modes", "presets", "sensitivity", "simulate", "sweep", "write_report"]
 
 

@@ -155,15 +155,10 @@ def common_period(frequencies) -> float | None:
 
 
 def central_radius(spec, member: str) -> float:
-    """Pitch radius of a central gear, carrier radius of a carrier, an RV reducer's rolling-circle radius of
-    a cycloid disc and pin-circle radius of a pin wheel."""
-    m = spec.members[member]
-    if m.kind == "carrier":
-        return spec.stage_of(member).carrier_radius
-    if m.kind in ("disc", "pin_wheel"):
-        g = spec.stage_of(member).cycloid.geometry
-        return g.rolling_radius if m.kind == "disc" else g.pin_circle_radius
-    return next(iter(m.gears.values())).pitch_radius
+    """Where a member's rotation is read as a tangential motion (:attr:`~gearcheck.train.spec.Member.
+    reference_radius`: a central gear's pitch radius, a carrier's pin circle, a cycloid disc's rolling circle, a
+    pin wheel's pin circle)."""
+    return spec.members[member].reference_radius
 
 
 def round_off_floor(spec, kin, omega_max: float, duration: float) -> dict[str, float]:

@@ -206,7 +206,7 @@ def train_signals(spec) -> list[Signal]:
 
 def disc_names(spec) -> list[str]:
     """An RV reducer's cycloid discs, stage by stage (the order of :func:`train_result`'s pin forces)."""
-    return [d for stage in spec.stages if stage.cycloid for d in stage.cycloid.discs]
+    return [mid for mid, member in spec.members.items() if member.frame == "eccentric"]
 
 
 def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflection, mesh_force, mesh_stiffness,

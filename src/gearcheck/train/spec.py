@@ -75,6 +75,10 @@ class Member:
     angle: float = 0.0  # planets: angle psi_n on the carrier circle
     radius: float = 0.0  # planets: carrier radius (position of the centre)
     axial: bool = False  # slides along its stage's axis (every member of a helical stage)
+    reference_radius: float = 0.0  # where its rotation is read as a tangential motion (see below)
+
+    # reference_radius: a gear's pitch radius (a compound planet's first gear), a carrier's pin circle, a crankshaft's
+    # eccentricity, a cycloid disc's rolling circle and a pin wheel's pin circle
 
     @property
     def is_planet(self) -> bool:
@@ -688,12 +692,12 @@ def _stage_members(st: dict, centrals: dict, planet_gears: dict, angles, carrier
         mid = f"{name}.{key}"
         members[mid] = Member(mid, name, "ring" if gear.internal else "sun",
                               *_body(raw, gear.base_radius, f"{path}.{key}", fail, gear),
-                              support=_support(raw["support"]), gears={key: gear})
+                              support=_support(raw["support"]), gears={key: gear}, reference_radius=gear.pitch_radius)
     carrier_raw = st["carrier"]
     carrier_id = f"{name}.carrier"
     members[carrier_id] = Member(carrier_id, name, "carrier",
                                  *_body(carrier_raw, carrier_radius, f"{path}.carrier", fail),
-                                 support=_support(carrier_raw["support"]))
+                                 support=_support(carrier_raw["support"]), reference_radius=carrier_radius)
     first_planet_gear = next(iter(planet_gears.values()))
     planet_mass, planet_inertia = _body(planet_raw, first_planet_gear.base_radius, f"{path}.planet", fail,
                                         first_planet_gear)
@@ -701,7 +705,7 @@ def _stage_members(st: dict, centrals: dict, planet_gears: dict, angles, carrier
         pid = f"{name}.planet{k + 1}"
         members[pid] = Member(pid, name, "planet", planet_mass, planet_inertia,
                               bearing=None if rv else _support(planet_raw["bearing"]), gears=dict(planet_gears),
-                              angle=psi, radius=carrier_radius)
+                              angle=psi, radius=carrier_radius, reference_radius=first_planet_gear.pitch_radius)
     return members
 
 
@@ -765,18 +769,18 @@ def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path:
         cranks.append(cid)
         members[cid] = Member(cid, name, "crank", crank["mass"], crank["inertia"],
                               bearing=Support(crank["bearing"]["radial_stiffness"], crank["bearing"]["radial_damping"]),
-                              angle=psi, radius=carrier_radius)
+                              angle=psi, radius=carrier_radius, reference_radius=geometry.eccentricity)
     discs = []
     for j in range(n_discs):
         did = f"{name}.disc{j + 1}"
         discs.append(did)
-        members[did] = Member(did, name, "disc", cyc["mass"], cyc["inertia"])
+        members[did] = Member(did, name, "disc", cyc["mass"], cyc["inertia"], reference_radius=geometry.rolling_radius)
     wheel = None
     if st["pin_wheel"] is not None:
         wheel = f"{name}.pin_wheel"
         raw = st["pin_wheel"]
         members[wheel] = Member(wheel, name, "pin_wheel", raw["mass"], raw["inertia"],
-                                support=_support(raw["support"]))
+                                support=_support(raw["support"]), reference_radius=geometry.pin_circle_radius)
     spline = crank["spline"]
     contact = cyc["contact"]
     return CycloidStage(

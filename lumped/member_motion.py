@@ -29,10 +29,10 @@ def member_motion(spec, kin, dofs, t, q, v, qdd, rotating_frame_terms: bool = Tr
         acc[:, j, 1] = qdd[:, iv] + 2 * omega * v[:, iu] - omega**2 * q[:, iv]
         acc[:, j, 2] = qdd[:, ith]
         angle[:, j] = kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
-        if member.kind == "disc":  # its nominal orbit e(phi) at the crank's absolute speed w_H
-            cyc = spec.stage_of(mid).cycloid
-            w_h = kin.speeds[cyc.cranks[0]]
-            phi = cyc.phases[cyc.discs.index(mid)] + (w_h - kin.speeds[carrier]) * t
-            acc[:, j, 0] -= cyc.geometry.eccentricity * w_h**2 * np.cos(phi)
-            acc[:, j, 1] -= cyc.geometry.eccentricity * w_h**2 * np.sin(phi)
+        if member.eccentric:  # its nominal orbit e(phi) at the crank's absolute speed w_H
+            ecc = member.eccentric
+            w_h = kin.speeds[ecc.crank]
+            phi = ecc.phase + (w_h - kin.speeds[carrier]) * t
+            acc[:, j, 0] -= ecc.eccentricity * w_h**2 * np.cos(phi)
+            acc[:, j, 1] -= ecc.eccentricity * w_h**2 * np.sin(phi)
     return acc, angle

@@ -215,12 +215,10 @@ def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np
     n = mb.model.nv
     S, dS, ddS = np.eye(n), np.zeros((n, n)), np.zeros((n, n))
     for mid, member in mb.spec.members.items():
-        if member.frame != "eccentric":
+        if member.eccentric is None:
             continue
-        stage = mb.spec.stage_of(mid)
-        cyc = stage.cycloid
-        e, psi = cyc.geometry.eccentricity, cyc.phases[cyc.discs.index(mid)]
-        rate = speed_ratio * (mb.kin.speeds[cyc.cranks[0]] - mb.kin.speeds[stage.carrier])
+        e, psi = member.eccentric.eccentricity, member.eccentric.phase
+        rate = speed_ratio * (mb.kin.speeds[member.eccentric.crank] - mb.kin.speeds[f"{member.stage}.carrier"])
         i = np.ix_(mb.dadr[mid], mb.dadr[mid])
         for out, scale, angle in ((S, 1.0, psi), (dS, rate, psi + 0.5 * np.pi), (ddS, rate**2, psi + np.pi)):
             c, s = np.cos(angle), np.sin(angle)  # d/dpsi (cos, sin) = (cos, sin) of psi + pi/2
@@ -297,9 +295,8 @@ def _disc_curvature(mb, force: np.ndarray) -> np.ndarray:
     orbit atan2(t, e + r) (own hinge: minus that) have the second derivatives 1/e in t^2 and -1/e^2 in r t."""
     K = np.zeros((mb.model.nv, mb.model.nv))
     for mid, member in mb.spec.members.items():
-        if member.frame == "eccentric":
-            cyc = mb.spec.stage_of(mid).cycloid
-            e, psi = cyc.geometry.eccentricity, cyc.phases[cyc.discs.index(mid)]
+        if member.eccentric is not None:
+            e, psi = member.eccentric.eccentricity, member.eccentric.phase
             orbit, radial, own = force[list(mb.dadr[mid])]
             axes = np.array([[np.cos(psi), np.sin(psi)], [-np.sin(psi), np.cos(psi)]])  # rows e_r, e_t
             curvature = np.array([[0.0, (orbit - own) / e**2], [(orbit - own) / e**2, -radial / e]])

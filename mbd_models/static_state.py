@@ -73,8 +73,8 @@ def nominal_speeds(mb) -> np.ndarray:
     for mid, member in spec.members.items():
         ix, _, ir = mb.dadr[mid]
         omega = kin.speeds[f"{member.stage}.carrier"]
-        if member.frame == "eccentric":
-            orbit = kin.speeds[spec.stage_of(mid).cycloid.cranks[0]]
+        if member.eccentric is not None:
+            orbit = kin.speeds[member.eccentric.crank]
             qvel[ix], qvel[ir] = orbit, kin.speeds[mid] - orbit
         else:
             qvel[ir] = kin.speeds[mid] - (omega if member.orbits else 0.0)

@@ -48,6 +48,16 @@ class Support:
     axial_damping: float = 0.0
 
 
+@dataclass(frozen=True)
+class Eccentric:
+    """The eccentric that carries a member on it (a cycloid disc): the crankshaft it turns with, its angle from
+    the carrier's x axis at t = 0 (in the carrier's frame) and its eccentricity."""
+
+    crank: str
+    phase: float
+    eccentricity: float
+
+
 # Where a member's two translations are measured, by the frame its centre is carried in: "axis", on the stage's
 # axis (sun, ring, carrier, pin wheel), along the axes that turn with the stage's carrier; "pin", on a pin of
 # the carrier (planets, crankshafts), along the carrier's radial and tangential axes at the pin; "eccentric", on
@@ -76,6 +86,7 @@ class Member:
     radius: float = 0.0  # planets: carrier radius (position of the centre)
     axial: bool = False  # slides along its stage's axis (every member of a helical stage)
     reference_radius: float = 0.0  # where its rotation is read as a tangential motion (see below)
+    eccentric: Eccentric | None = None  # on an eccentric (frame "eccentric"): the one that carries it
 
     # reference_radius: a gear's pitch radius (a compound planet's first gear), a carrier's pin circle, a crankshaft's
     # eccentricity, a cycloid disc's rolling circle and a pin wheel's pin circle
@@ -774,7 +785,8 @@ def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path:
     for j in range(n_discs):
         did = f"{name}.disc{j + 1}"
         discs.append(did)
-        members[did] = Member(did, name, "disc", cyc["mass"], cyc["inertia"], reference_radius=geometry.rolling_radius)
+        members[did] = Member(did, name, "disc", cyc["mass"], cyc["inertia"], reference_radius=geometry.rolling_radius,
+                              eccentric=Eccentric(cranks[0], phases[j], geometry.eccentricity))
     wheel = None
     if st["pin_wheel"] is not None:
         wheel = f"{name}.pin_wheel"

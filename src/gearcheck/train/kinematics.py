@@ -51,40 +51,11 @@ def _torsional_rows(spec):
         row[index[stage.carrier]] -= stage.carrier_radius * float(e_t @ loa.direction)
         rows.append(row)
         labels.append(mesh.id)
-    for c in spec.couplings:
-        row = np.zeros(len(index))
-        row[index[c.a]], row[index[c.b]] = 1.0, -1.0
-        rows.append(row)
-        labels.append(c.name)
-    for stage in spec.stages:
-        if stage.cycloid:
-            for row, label in _cycloid_rows(stage, index):
-                rows.append(row)
-                labels.append(label)
+    for part in spec.parts:  # the other parts' rigid constraints (couplings, an RV reducer's cycloid stage)
+        for row, label in part.speed_rows(spec, index):
+            rows.append(row)
+            labels.append(label)
     return np.array(rows), labels, index
-
-
-def _cycloid_rows(stage, index):
-    """An RV reducer's rigid constraints: each planet turns with its crank; each disc translates relative to
-    the carrier (its eccentric bores on several cranks lock its rotation to the carrier's); and the disc rolls
-    on the pins (one tooth fewer): w_H - w_w + Z_c (w_d - w_w) = 0, w_H the crank's absolute speed, w_d the
-    disc's and w_w the pin wheel's (0 when it is fixed)."""
-    cyc = stage.cycloid
-    wheel = cyc.pin_wheel
-    for planet, crank in zip(stage.planets, cyc.cranks):
-        row = np.zeros(len(index))
-        row[index[planet]], row[index[crank]] = 1.0, -1.0
-        yield row, f"{crank}.spline"
-        row = np.zeros(len(index))
-        row[index[crank]] += 1.0
-        row[index[cyc.discs[0]]] += cyc.geometry.lobes
-        if wheel:
-            row[index[wheel]] -= 1.0 + cyc.geometry.lobes
-        yield row, f"{crank}.pins"
-    for disc in cyc.discs:
-        row = np.zeros(len(index))
-        row[index[disc]], row[index[stage.carrier]] = 1.0, -1.0
-        yield row, f"{disc}.orbit"
 
 
 def kinematics(spec) -> Kinematics:
@@ -141,11 +112,8 @@ def kinematics(spec) -> Kinematics:
         psi = spec.members[mesh.planet].angle
         phase[mesh.id] = (math.copysign(1.0, rel) * z * psi / (2 * math.pi) + _sun_ring_offset(spec, mesh)) % 1.0
 
-    for stage in spec.stages:
-        if stage.cycloid:  # the contact pattern moves on by one pin per pin pitch of the eccentric's turn
-            cyc = stage.cycloid
-            wheel = speeds[cyc.pin_wheel] if cyc.pin_wheel else 0.0
-            freq[stage.name + ".pins"] = cyc.geometry.pins * abs(speeds[cyc.cranks[0]] - wheel) / (2 * math.pi)
+    for part in spec.parts:  # the other parts' periodic contacts (an RV reducer's pins)
+        freq.update(part.frequencies(speeds))
 
     ratio = spec.operating.input_speed / w_out
     t_in = -t_out / ratio if load > 0 else 0.0

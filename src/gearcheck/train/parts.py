@@ -14,8 +14,22 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 
+class Part:
+    """What every part gives the train's nominal kinematics (:mod:`gearcheck.train.kinematics`); by default
+    nothing."""
+
+    def speed_rows(self, spec, index: dict) -> list:
+        """(row, label) of each rigid constraint on the members' absolute speeds (``index``: member id ->
+        column) that the part imposes: row . w = 0."""
+        return []
+
+    def frequencies(self, speeds: dict) -> dict[str, float]:
+        """Frequencies (Hz) of the part's periodic contacts at the members' nominal ``speeds`` (rad/s), named."""
+        return {}
+
+
 @dataclass(frozen=True)
-class SupportPart:
+class SupportPart(Part):
     """A central member on the housing: radial springs along both translations, torsion, and axial."""
 
     element: ClassVar[str] = "support"
@@ -25,7 +39,7 @@ class SupportPart:
 
 
 @dataclass(frozen=True)
-class BearingPart:
+class BearingPart(Part):
     """A member on a pin of its carrier (planet, crankshaft): isotropic in the plane, and axial."""
 
     element: ClassVar[str] = "bearing"
@@ -36,7 +50,7 @@ class BearingPart:
 
 
 @dataclass(frozen=True)
-class SplinePart:
+class SplinePart(Part):
     """An RV reducer's planet on its crankshaft, both at the same pin: bending and torsion."""
 
     element: ClassVar[str] = "spline"
@@ -46,7 +60,7 @@ class SplinePart:
 
 
 @dataclass(frozen=True)
-class DrivePart:
+class DrivePart(Part):
     """The drive: torques on the input and output members and, when the input is driven by angle, the input
     shaft, a torsional spring-damper between the input member and the drive's reference angle."""
 

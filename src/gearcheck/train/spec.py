@@ -22,7 +22,7 @@ from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, palmgren_s
 from gearcheck.train.files import read_text, read_toml
 from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
 from gearcheck.train.mesh_stiffness import MODELS
-from gearcheck.train.parts import train_parts
+from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.schema import Context, parse_measurements
 from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
 
@@ -119,7 +119,7 @@ class Member:
 
 
 @dataclass(frozen=True)
-class MeshSpec:
+class MeshSpec(Part):
     """A central gear meshing with one planet gear."""
 
     element: ClassVar[str] = "mesh"
@@ -148,7 +148,7 @@ class MeshSpec:
 
 
 @dataclass(frozen=True)
-class Coupling:
+class Coupling(Part):
     """Central members of two stages joined in torsion and, with a radial stiffness, in both translations."""
 
     element: ClassVar[str] = "coupling"
@@ -160,6 +160,12 @@ class Coupling:
     torsional_damping: float
     radial_stiffness: float
     radial_damping: float
+
+    def speed_rows(self, spec, index: dict) -> list:
+        """Rigid in torsion: both members turn together."""
+        row = np.zeros(len(index))
+        row[index[self.a]], row[index[self.b]] = 1.0, -1.0
+        return [(row, self.name)]
 
 
 @dataclass(frozen=True)
@@ -185,7 +191,7 @@ class Operating:
 
 
 @dataclass(frozen=True)
-class CycloidStage:
+class CycloidStage(Part):
     """An RV reducer's cycloid-pin stage on a planetary stage's carrier: one crankshaft per planet, splined to
     it and borne in the carrier; one eccentric per disc on every crankshaft; discs that orbit on the
     eccentrics and mesh with the pin wheel's pins (Yang, Chen & Wang 2018; geometry in
@@ -203,6 +209,33 @@ class CycloidStage:
     contact_stiffness: float | None  # N/m per pin contact; None: Palmgren's law at the rated load
     contact_damping: float
     clearance: float  # m
+
+    def speed_rows(self, spec, index: dict) -> list:
+        """An RV reducer's rigid constraints: each planet turns with its crank; each disc translates relative to
+        the carrier (its eccentric bores on several cranks lock its rotation to the carrier's); and the disc rolls
+        on the pins (one tooth fewer): w_H - w_w + Z_c (w_d - w_w) = 0, w_H the crank's absolute speed, w_d the
+        disc's and w_w the pin wheel's (0 when it is fixed)."""
+        stage, out = spec.stage_of(self.cranks[0]), []
+        for planet, crank in zip(stage.planets, self.cranks):
+            row = np.zeros(len(index))
+            row[index[planet]], row[index[crank]] = 1.0, -1.0
+            out.append((row, f"{crank}.spline"))
+            row = np.zeros(len(index))
+            row[index[crank]] += 1.0
+            row[index[self.discs[0]]] += self.geometry.lobes
+            if self.pin_wheel:
+                row[index[self.pin_wheel]] -= 1.0 + self.geometry.lobes
+            out.append((row, f"{crank}.pins"))
+        for disc in self.discs:
+            row = np.zeros(len(index))
+            row[index[disc]], row[index[stage.carrier]] = 1.0, -1.0
+            out.append((row, f"{disc}.orbit"))
+        return out
+
+    def frequencies(self, speeds: dict) -> dict[str, float]:
+        """The pin pass: the contact pattern moves on by one pin per pin pitch of the eccentric's turn."""
+        wheel = speeds[self.pin_wheel] if self.pin_wheel else 0.0
+        return {f"{self.stage}.pins": self.geometry.pins * abs(speeds[self.cranks[0]] - wheel) / (2 * math.pi)}
 
     def pin_stiffness(self, output_torque: float) -> float:
         """The stiffness of one pin contact: as given, or Palmgren's line contact linearised at the largest

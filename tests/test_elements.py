@@ -23,7 +23,7 @@ from gearcheck.mbd_models.mjcf_text import fixed, member_joints
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.elements import Registry
 from gearcheck.shared.errors import GearcheckError
-from gearcheck.train.parts import train_parts
+from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.spec import TrainSpec
 
 
@@ -68,8 +68,9 @@ def test_a_members_degrees_of_freedom_are_defined_once(name):
 
 
 @dataclass(frozen=True)
-class TorsionPart:
-    """The description: a torsional spring between the rotations of two members on the stage axis."""
+class TorsionPart(Part):
+    """The description: a torsional spring between the rotations of two members on the stage axis (elastic: no
+    rigid speed constraint, no periodic contact, Part's defaults)."""
 
     element: ClassVar[str] = "test-torsion"
     a: str

@@ -48,8 +48,9 @@ class Element:
         """``member``'s visual geoms when the part draws it (None: the builder's gears and plates)."""
         return None
 
-    def bodies(self, part, spec, z_stage: float, visuals: bool, geoms, springs: dict) -> list[str]:
-        """Bodies of the world the part adds after its stage's carrier (``geoms(member)``: a member's visuals)."""
+    def bodies(self, part, spec, z_stage: float, visuals: bool, inner, springs: dict) -> list[str]:
+        """Bodies of the world the part adds after its stage's carrier (``inner(member)``: a member's sites and
+        visual geoms; ``springs``: every part's springs on the members' joints)."""
         return []
 
     def bore(self, part, stage) -> float:

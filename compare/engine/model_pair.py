@@ -33,7 +33,7 @@ from gearcheck.train.published_parameters import LABELS
 from gearcheck.train.published_parameters import MODELS as PUBLISHED_MODELS
 
 MODELS = ("general",) + PUBLISHED_MODELS
-AGAINST = {"lumped": LumpedSide, "mujoco": MujocoSide}  # what a user's model is checked against
+SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}  # the built-in sides, what a user's model is checked against
 USER = "user"  # the model the train file registers (train.user_model)
 GENERAL_DURATION = 0.1  # s, default simulated time of a train
 PUBLISHED_DURATION = 0.02  # s, of the 4-DOF models' start-stop transient
@@ -117,9 +117,9 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     is checked against, ``"lumped"`` or ``"mujoco"``; ``results``, ``columns``, ``modes``: another solver's
     results as the user's model (:class:`~gearcheck.compare.engine.recorded.RecordedSide`); ``sides``: the
     built-in sides already built (a callable ``"lumped"``/``"mujoco"`` -> side, a session's), else built here."""
-    if against not in AGAINST:
-        raise GearcheckError(f"against={against!r}: choose {' or '.join(AGAINST)}")
-    built = sides or (lambda solver: AGAINST[solver](spec))
+    if against not in SOLVERS:
+        raise GearcheckError(f"against={against!r}: choose {' or '.join(SOLVERS)}")
+    built = sides or (lambda solver: SOLVERS[solver](spec))
     named = model if isinstance(model, str) else None
     if results is not None:
         if named != "general":

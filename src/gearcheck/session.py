@@ -15,7 +15,7 @@ from pathlib import Path
 from gearcheck.compare.engine.comparison import CrosscheckResult
 from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing, pair_modes
-from gearcheck.compare.engine.model_pair import resolve_model
+from gearcheck.compare.engine.model_pair import SOLVERS, resolve_model
 from gearcheck.compare.studies.campbell import CampbellResult, campbell
 from gearcheck.compare.studies.sensitivity import lattice
 from gearcheck.lumped import time_solver
@@ -33,9 +33,6 @@ from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
 from gearcheck.train.loader import load_train
 from gearcheck.train.spec import TrainSpec
-
-SOLVERS = {"lumped": LumpedSide, "mujoco": MujocoSide}
-
 
 class Train:
     """A train (a preset name, the path of a train file, or a TrainSpec) at its operating point, or at ``speed``
@@ -108,9 +105,7 @@ class Train:
     def mac(self, model=None, against: str = "lumped") -> ModePairing:
         """The two solvers' mode shapes paired by the modal assurance criterion (Allemang & Brown 1982); with
         ``model`` (a user's), that model's against ``against``.  See :func:`gearcheck.mode_pairing`."""
-        if model is None:
-            return pair_modes(self.spec.name, self.lumped, self.mujoco)
-        pair = resolve_model(self.spec, model, against)
+        pair = resolve_model(self.spec, "general" if model is None else model, against, sides=self.side)
         return pair_modes(self.spec.name, pair.reference, pair.test)
 
     def harmonic_response(self, method: str = "harmonic balance", orders=None):

@@ -269,6 +269,9 @@ def test_describe_and_stiffness_from_the_front_door():
     fig = train.stiffness(cycles=2)
     first = [m for m in train.spec.meshes if m.planet_index == 0]
     assert len(fig.axes) == len(first)
+    for bad in (0, -1, 101, "2", 2.5, True):
+        with pytest.raises(gearcheck.GearcheckError, match=r"^cycles=.*: a whole number of mesh cycles from 1 to 100$"):
+            train.stiffness(cycles=bad)
     x, k = fig.axes[0].lines[0].get_data()
     assert x[-1] == 2.0 and np.isclose(np.mean(k[:-1]), train.lumped.model.excitation.mean_stiffness[0] / 1e9,
                                        rtol=1e-3)

@@ -34,6 +34,9 @@ from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
 from gearcheck.train.loader import load_train
 from gearcheck.train.spec import TrainSpec
 
+MAX_STIFFNESS_CYCLES = 100  # a stiffness repeats every mesh cycle: more shows nothing new (2000 points a cycle)
+
+
 class Train:
     """A train (a preset name, the path of a train file, or a TrainSpec) at its operating point, or at ``speed``
     (rpm, replacing the train's), with its lumped model and MuJoCo twin built once, on first use."""
@@ -168,10 +171,12 @@ class Train:
         return pin_loads(self.lumped.model, times, span=span, samples=samples, stage=stage)
 
     def stiffness(self, cycles: int = 2):
-        """A Figure of every central gear's mesh stiffness with its first planet over ``cycles`` mesh cycles, beside
-        its mean (the model the train file names)."""
+        """A Figure of every central gear's mesh stiffness with its first planet over ``cycles`` mesh cycles (1 to
+        ``MAX_STIFFNESS_CYCLES``), beside its mean (the model the train file names)."""
         from gearcheck.compare.presentation.plots import mesh_stiffness_figure
 
+        if isinstance(cycles, bool) or not isinstance(cycles, int) or not 1 <= cycles <= MAX_STIFFNESS_CYCLES:
+            raise GearcheckError(f"cycles={cycles!r}: a whole number of mesh cycles from 1 to {MAX_STIFFNESS_CYCLES}")
         return mesh_stiffness_figure(self.spec, cycles)
 
     def view(self, slow_motion: float = 100.0, magnify: float = 1000.0) -> None:

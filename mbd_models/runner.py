@@ -169,15 +169,15 @@ class _Stepper:
         self.forces = np.empty((n_samples, self.reader.width))
         self.stiffness = np.empty((n_samples, self.n_mesh)) if bodies or self.contacts else None
         self.energy = np.empty((n_samples, 2)) if energy else None
-        self.moving = mb.moving_contacts
-        self.pins = np.empty((n_samples, sum(len(c.tendons) for c in self.moving))) if self.moving else None
+        self.moving = list(zip(mb.moving_contacts, mb.moving_slices()))  # each with its columns in ``pins``
+        self.pins = np.empty((n_samples, sum(len(c.tendons) for c in mb.moving_contacts))) if self.moving else None
         self.j = 0
 
     def refresh(self) -> None:
         """Turn the mesh tendons' coefficients with their carriers and set the contacts' tendons (an RV reducer's
         pins) to the bodies' poses."""
         self.mb.refresh(self.d.qpos)
-        for c in self.moving:
+        for c, _ in self.moving:
             c.refresh(self.d)
 
     def set_stage(self, k, u, e, de, pairs=None) -> None:
@@ -201,7 +201,8 @@ class _Stepper:
         if self.energy is not None:
             self.energy[j] = self.d.energy
         if self.pins is not None:
-            self.pins[j] = np.concatenate([c.pin_forces(self.d) for c in self.moving])
+            for c, at in self.moving:
+                self.pins[j, at] = c.pin_forces(self.d)
         self.j += 1
 
     def run(self, start: int, stop: int, every: int, values, split) -> None:
@@ -281,7 +282,7 @@ class _LeanStepper(_Stepper):
         cs, coef, rate, base, turned = self.cs, self.coef, self.rate, self.base, self.turned
         dot, multiply, cos, sin = np.dot, np.multiply, math.cos, math.sin
         forward, rk = mujoco.mj_forward, mujoco.mj_RungeKutta
-        refreshes = [c.refresh for c in self.moving]
+        refreshes = [c.refresh for c, _ in self.moving]
         for i in range(stop - start):
             if start + i in split:
                 self.split_step(start + i, split[start + i], (start + i) % every == 0)

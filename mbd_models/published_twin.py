@@ -45,6 +45,7 @@ from gearcheck.shared.modal import ModalResult, modal_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import transient_step
+from gearcheck.mbd_models.twin import rows_combined
 
 FD_STEP = 1e-6
 CONTACT_BODIES = {"e": ("planet", None), "b": ("planet", "ring_b")}
@@ -106,7 +107,7 @@ def _coefficients(model: mujoco.MjModel, p: PaperParameters, y1: str) -> dict:
                 continue
             jacp = np.zeros((3, model.nv))
             mujoco.mj_jac(model, data, jacp, None, point, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body))
-            row += sign * (d @ jacp)
+            row += sign * rows_combined(d, jacp)
         out[mesh] = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, int(model.dof_jntid[i])): float(row[i])
                      for i in range(model.nv) if abs(row[i]) > 1e-15}
     return out

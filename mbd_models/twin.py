@@ -159,13 +159,26 @@ def mesh_jacobian_row(spec: TrainSpec, kin: Kinematics, model: mujoco.MjModel, d
     jx = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_x")
     jy = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_y")
     origin = data.xpos[carrier] - np.array([data.qpos[model.jnt_qposadr[jx]], data.qpos[model.jnt_qposadr[jy]], 0.0])
-    point = origin + R @ np.array([loa.pitch_point[0], loa.pitch_point[1], 0.0])
-    direction = R @ np.array([loa.direction[0], loa.direction[1], loa.axial])
+    point = origin + rows_combined((loa.pitch_point[0], loa.pitch_point[1], 0.0), R.T)
+    direction = rows_combined((loa.direction[0], loa.direction[1], loa.axial), R.T)
     jac_c = np.zeros((3, model.nv))
     jac_p = np.zeros((3, model.nv))
     mujoco.mj_jac(model, data, jac_c, None, point, central)
     mujoco.mj_jac(model, data, jac_p, None, point, planet_body)
-    return direction @ (jac_c - jac_p)
+    return rows_combined(direction, jac_c - jac_p)
+
+
+def rows_combined(weights, rows: np.ndarray) -> np.ndarray:
+    """sum_i weights[i] rows[i], added in index order.
+
+    Written out rather than as a matrix product: BLAS picks its kernel (and with it the order of the
+    additions and the use of fused multiply-adds) by processor and environment, and the coefficients
+    written into the MJCF must come out the same to the last bit on every machine.
+    """
+    total = weights[0] * rows[0]
+    for weight, row in zip(weights[1:], rows[1:]):
+        total = total + weight * row
+    return total
 
 
 def _mesh_damping(spec, mesh, model, row, k_mean) -> float:

@@ -153,7 +153,7 @@ def mesh_force_error(run, reference) -> float:
 def equal_accuracy(name: str, duration: float, every: int = 16):
     model = build_model(load_train(name))
     h = default_step(model)
-    reference = simulate(model, RunSettings(duration, h / 16, output_dt=every * h), drive="stages")
+    reference = simulate(model, RunSettings(duration, h / 16, output_dt=every * h))
     rk4 = simulate(model, RunSettings(duration, h, output_dt=every * h))
     target = mesh_force_error(rk4, reference)
     chosen = None

@@ -180,13 +180,13 @@ def _newton(P: _PeriodMap, z: np.ndarray, tolerance: float, linear: bool, name: 
     return z, residual, MAX_ITERATIONS  # pragma: no cover (the loop returns)
 
 
-def periodic_steady_state(model, dt: float | None = None, drive: str = "steps", tolerance: float = 1e-10,
+def periodic_steady_state(model, dt: float | None = None, tolerance: float = 1e-10,
                           y0=None, method: str = "anderson", max_mesh_periods: int = MAX_MESH_PERIODS
                           ) -> PeriodicSteadyState:
     """The T-periodic steady state of ``model`` (see the module docstring), T from :func:`common_period`.
 
     dt: the RK4 step, made a whole fraction of T (default: :func:`~gearcheck.lumped.time_solver.default_step`,
-    rounded down to one); drive: as :func:`~gearcheck.lumped.time_solver.simulate`'s; tolerance: on the residual
+    rounded down to one); tolerance: on the residual
     max |y(T) - y0| (v over omega_max) over the largest |y0|; y0: the first guess (default: the static state);
     method: "anderson" (falls back to Newton where it has not converged in ``MAX_ANDERSON_RUNS`` runs) or "newton";
     max_mesh_periods: the longest common period sought (:func:`common_period`).
@@ -207,7 +207,7 @@ def periodic_steady_state(model, dt: float | None = None, drive: str = "steps", 
     q0, v0 = initial_state(model) if y0 is None else y0
     y = np.concatenate([q0, v0])
     scale = float(np.max(np.abs(w * y))) or 1e-6
-    run, sub_steps = stepper(model, h, steps, drive)
+    run, sub_steps = stepper(model, h, steps)
     P = _PeriodMap(run, w, scale)
     z, residual, iterations = w * y / scale, math.inf, 0
     if method == "anderson":

@@ -10,13 +10,11 @@ f the backlash dead zone.  The start is the static deflection under the mean loa
 
 Time step: :mod:`gearcheck.shared.stepping` (the rule the MuJoCo runner follows too), from the
 highest natural frequency of this model with every mesh at its cycle-maximum stiffness.
-The drive is sampled at t + h (eps, 1/2, 1 - eps) (:data:`~gearcheck.shared.stepping.STAGE_OFFSETS`).
-By default (``drive="steps"``) RK4's first stage sees x(t + eps) and the other three
-(4 x(t + h/2) + x(t + h - eps))/5, exactly as the MuJoCo runner drives its model
-(:func:`~gearcheck.shared.stepping.per_step_drive`): exact for drives linear over a step.  A step
-inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as
-the MuJoCo runner does), so the stiffness is constant over every sub-step and RK4 keeps its order.
-``drive="stages"`` is the textbook RK4 with the drive at each stage's own time.
+The drive is sampled at each RK4 stage's own time, t + h (eps, 1/2, 1/2, 1 - eps)
+(:data:`~gearcheck.shared.stepping.STAGE_OFFSETS`), as the MuJoCo runner drives its stages: the
+textbook RK4, fourth order for a drive smooth over the step.  A step inside which a mesh stiffness
+jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as the MuJoCo runner does), so
+the stiffness is smooth over every sub-step and RK4 keeps its order.
 
 The RK4 steps run compiled (:mod:`gearcheck.lumped.compiled_steps`), a chunk of steps at a time: Python samples
 the chunk's drive (and the rows of the turning elements at the stage times), vectorised, then checks the
@@ -40,7 +38,7 @@ from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
+from gearcheck.shared.stepping import STAGE_OFFSETS
 
 CHUNK = 20000  # steps between divergence checks and progress reports
 CHUNK_BYTES = 16 * 2**20  # at most this much drive per chunk (the tooth pairs take a lot per step)
@@ -147,20 +145,17 @@ def mechanical_energy(model, q, v) -> np.ndarray:
 
 
 def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e-8, atol: float = 1e-14, y0=None,
-             progress=None, drive: str = "steps") -> TimeResult:
+             progress=None) -> TimeResult:
     """Integrate ``model`` as ``settings`` ask.
 
     method: "rk4" (compiled steps, :mod:`gearcheck.lumped.compiled_steps`), "rk4-stages" (the same RK4 stage by
     stage in Python: the reference the compiled steps are tested against) or
     one of scipy's adaptive methods, whose largest step is then ``settings.dt``.
-    drive: "steps" (default, like-for-like with the MuJoCo runner) or "stages" (see the module doc).
     The step defaults to :func:`default_step` and is checked against the stability limit.
     y0: optional (q, v) instead of the static start.  progress: callable(fraction).
     """
     if method not in ("rk4", "rk4-stages") + ADAPTIVE_METHODS:
         raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
-    if drive not in ("steps", "stages"):
-        raise SolverError(f"drive must be 'steps' or 'stages', not {drive!r}")
     limits = step_limits(model)
     dt = stepping.default_step(limits, model.excitation.frequency) if settings.dt is None else settings.dt
     what = f"lumped model of {model.spec.name}"
@@ -178,7 +173,7 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     started = clock.perf_counter()
     if method in ("rk4", "rk4-stages"):
         t_out, q_out, v_out, sub_steps = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway,
-                                              method == "rk4-stages", drive)
+                                              method == "rk4-stages")
         engine, stages, calls = "numba-rk4" if method == "rk4" else "python-rk4", 4, 4 * sub_steps
     else:
         t_out, q_out, v_out, calls = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
@@ -186,16 +181,16 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
         engine, stages = f"scipy-{method}", None
     wall = clock.perf_counter() - started
     info = RunInfo(engine, n_steps, stages, calls, wall, {
-        "method": method, "drive": drive if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
+        "method": method, "drive": "stages" if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
         "rhs_evaluations": calls if stages is None else 4 * n_steps, "wall_time_s": wall,  # as reports state them
         "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms})
     return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
-def _chunk(sys, h, start, stop, drive) -> Chunk:
-    """The (sub-)steps of steps start..stop-1 and their drive (:class:`~gearcheck.lumped.compiled_steps.Chunk`): a
-    step inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`); the
-    drive held per step when ``drive == "steps"``."""
+def _chunk(sys, h, start, stop) -> Chunk:
+    """The (sub-)steps of steps start..stop-1 and their drive at their stage times
+    (:class:`~gearcheck.lumped.compiled_steps.Chunk`): a step inside which a mesh stiffness jumps is split there
+    (:func:`~gearcheck.shared.stepping.split_steps`)."""
     steps = np.arange(start, stop)
     lengths = np.full(steps.size, h)
     sample = (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
@@ -217,13 +212,7 @@ def _chunk(sys, h, start, stop, drive) -> Chunk:
             begins[r], lengths[r] = a, length
             sample[r] = a[:, None] + length[:, None] * np.array(STAGE_OFFSETS)[None, :]
     times = begins[:, None] + np.array([0.0, 0.5, 1.0])[None, :] * lengths[:, None]
-    k, e, de, tin, tout, pairs = sys.drive(sample)
-    if drive == "steps":  # stages 2-4 all see the step's weighted drive (as MuJoCo's model fields)
-        k, tin, tout = (per_step_drive(x) for x in (k, tin, tout))
-        if sys.exc.has_transmission_error:  # else zeros
-            e, de = per_step_drive(e), per_step_drive(de)
-        pairs = None if pairs is None else per_step_pairs(pairs)
-    return Chunk(lengths, ends, times, k, e, de, tin, tout, pairs)
+    return Chunk(lengths, ends, times, *sys.drive(sample))
 
 
 def _chunk_steps(sys) -> int:
@@ -234,7 +223,7 @@ def _chunk_steps(sys) -> int:
     return int(max(64, min(CHUNK, CHUNK_BYTES // per_step)))
 
 
-def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, drive="steps"):
+def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False):
     """Fixed-step RK4 over n_steps, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
     samples and its last state for divergence.  The compiled steps (:func:`~gearcheck.lumped.compiled_steps.
     rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python.  Returns the
@@ -250,7 +239,7 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
     chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
-        steps = _chunk(sys, h, start, stop, drive)
+        steps = _chunk(sys, h, start, stop)
         sub_steps += steps.lengths.size
         out = Output(start, every, q_out[j:], v_out[j:])
         written = _python_steps(sys, q, v, steps, out) if stage_by_stage else sys.compiled_steps(q, v, steps, out)
@@ -262,13 +251,13 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
     return t_out[:j], q_out[:j], v_out[:j], sub_steps
 
 
-def stepper(model, dt: float, n_steps: int, drive: str = "steps"):
+def stepper(model, dt: float, n_steps: int):
     """(a function (q, v) -> (q, v) at t = n_steps dt, from (q, v) at t = 0, by the compiled RK4 steps of
     :func:`simulate` (same drive sampling and splits), the sub-steps it takes); the drive is sampled once, for every
     call (a shooting method's many runs over one period)."""
     sys = _System(model)
     chunk = _chunk_steps(sys)
-    chunks = [(start, _chunk(sys, dt, start, min(start + chunk, n_steps), drive)) for start in range(0, n_steps, chunk)]
+    chunks = [(start, _chunk(sys, dt, start, min(start + chunk, n_steps))) for start in range(0, n_steps, chunk)]
     none = np.empty((0, model.n))
 
     def run(q, v):

@@ -1,16 +1,19 @@
 """The MuJoCo runner's step loop compiled: MuJoCo's own C functions called from a numba kernel, no Python per step.
 
 :func:`run_steps` does, step for step, what :class:`gearcheck.mbd_models.runner._Stepper` does in Python (the
-same operations in the same order): turn the mesh tendons' world-frame slide coefficients with their carriers
-(``wrap_prm``), drive stage 1 (mesh stiffness, controls, spring lengths of a transmission error and a backlash,
-the relieved meshes' tooth pairs in contact, the damping correction J^T g into ``qfrc_applied``),
-``mj_forward``, sample, drive stages 2-4, ``mj_RungeKutta``; a step inside which a mesh stiffness jumps as RK4
-sub-steps ended there (MuJoCo's ``opt.timestep`` set to each one's length).  The drive itself -- the excitation
-functions of the train, sampled at every stage -- is computed beforehand in arrays, a chunk of steps at a time,
-by the runner.  Every force law stays MuJoCo's: the kernel only writes the model fields and the data that the
-Python loop writes, and calls ``mj_forward``, ``mj_RungeKutta`` and ``mj_passive`` (the force reader's probes) on
-the compiled model through its C library (``ctypes``), with the GIL released, so several twins run at once in
-threads (:func:`gearcheck.mbd_models.runner.simulate_mujoco_many`).
+same operations in the same order): classical RK4, the stage loop of MuJoCo's ``mj_RungeKutta`` written out so
+that every stage gets its own drive.  At each of the four stages, from that stage's own state, it turns the mesh
+tendons' world-frame slide coefficients with their carriers (``wrap_prm``), sets an RV reducer's pin tendons to
+the discs' poses, drives the stage (mesh stiffness, controls, spring lengths of a transmission error and a
+backlash, the relieved meshes' tooth pairs in contact, the damping correction J^T g into ``qfrc_applied``) with
+the excitation at the stage's time (t, t + h/2, t + h/2, t + h), and calls ``mj_forward`` (``mj_forwardSkip``
+without sensors after the first, as ``mj_RungeKutta`` does); the state then advances by RK4's weights
+(``mj_integratePos`` for the positions).  A step inside which a mesh stiffness jumps is taken as RK4 sub-steps
+ended there.  The drive itself -- the excitation functions of the train at every stage time -- is computed
+beforehand in arrays, a chunk of steps at a time, by the runner.  Every force law stays MuJoCo's: the kernel only
+writes the model fields and the data that the Python loop writes, and calls MuJoCo's C functions on the compiled
+model through its C library (``ctypes``), with the GIL released, so several twins run at once in threads
+(:func:`gearcheck.mbd_models.runner.simulate_mujoco_many`).
 
 The kernel is compiled on first use and cached by numba next to this file.
 """
@@ -30,7 +33,8 @@ import numpy as np
 from gearcheck.mbd_models.elements.cycloid import PIN_BAND
 
 _LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
-_OPTION_DOUBLES_BEFORE_GRAVITY = 7  # mjOption: timestep, impratio, 4 tolerances, sleep_tolerance, then gravity[3]
+STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's stage times t, t + h/2, t + h
+STAGE_ADVANCE = (0.5, 0.5, 1.0)  # stage i + 1 starts from the step's start advanced by this times h along stage i
 
 
 class _MuJoCoC:
@@ -45,8 +49,11 @@ class _MuJoCoC:
         pair = [ctypes.c_void_p, ctypes.c_void_p]
         self.forward = lib.mj_forward
         self.forward.argtypes, self.forward.restype = pair, None
-        self.runge_kutta = lib.mj_RungeKutta
-        self.runge_kutta.argtypes, self.runge_kutta.restype = pair + [ctypes.c_int], None
+        self.forward_skip = lib.mj_forwardSkip  # (m, d, skipstage, skipsensor)
+        self.forward_skip.argtypes, self.forward_skip.restype = pair + [ctypes.c_int, ctypes.c_int], None
+        self.integrate_pos = lib.mj_integratePos  # (m, qpos, qvel, dt)
+        self.integrate_pos.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double]
+        self.integrate_pos.restype = None
         self.passive = lib.mj_passive
         self.passive.argtypes, self.passive.restype = pair, None
         self.kinematics = lib.mj_kinematics
@@ -79,20 +86,6 @@ def unavailable() -> str | None:
     return _C_ERROR
 
 
-def timestep_view(m: mujoco.MjModel) -> np.ndarray:
-    """A one-element array that is ``m.opt.timestep`` itself (the kernel sets a split step's sub-steps there):
-    found from ``opt.gravity``'s address and the layout of ``mjOption``, and checked by writing through it."""
-    gravity = m.opt.gravity.__array_interface__["data"][0]
-    view = np.ctypeslib.as_array((ctypes.c_double * 1).from_address(gravity - 8 * _OPTION_DOUBLES_BEFORE_GRAVITY))
-    saved = m.opt.timestep
-    view[0] = 0.5 * saved + 1e-300
-    ok = m.opt.timestep == view[0]
-    m.opt.timestep = saved
-    if not ok or view[0] != saved:
-        raise OSError("this MuJoCo's mjOption layout is not the one gearcheck's compiled runner knows")
-    return view
-
-
 # ---------------------------------------------------------------------------------------------- the kernel's groups
 class Pointers(NamedTuple):
     """Addresses of the mjModel, the mjData, and the force reader's mesh probe and joints-only probe (mjModels)."""
@@ -104,12 +97,11 @@ class Pointers(NamedTuple):
 
 
 class ModelViews(NamedTuple):
-    """Views of the model fields the loop writes (``timestep``: :func:`timestep_view`; the probe's mesh fields)."""
+    """Views of the model fields the loop writes (the probe's: its mesh fields)."""
 
     tendon_stiffness: np.ndarray
     tendon_lengthspring: np.ndarray
     wrap_prm: np.ndarray
-    timestep: np.ndarray
     probe_stiffness: np.ndarray
     probe_lengthspring: np.ndarray
     tendon_damping: np.ndarray
@@ -120,6 +112,9 @@ class DataViews(NamedTuple):
 
     qpos: np.ndarray
     qvel: np.ndarray
+    act: np.ndarray
+    qacc: np.ndarray
+    act_dot: np.ndarray
     ctrl: np.ndarray
     qfrc_applied: np.ndarray
     sensordata: np.ndarray
@@ -220,20 +215,16 @@ class Cycloid(NamedTuple):
 
 
 class Drive(NamedTuple):
-    """The drive of stage 1 and of stages 2-4 (as :meth:`gearcheck.mbd_models.runner._Drive.steps` gives them), a
-    row per (sub-)step: mesh stiffness, controls, transmission error and its rate, the relieved meshes' tooth
-    pairs; the absent ones empty along their last axes."""
+    """The drive at each (sub-)step's stage times (axis 1: t, t + h/2, t + h, as
+    :meth:`gearcheck.mbd_models.runner._Drive.steps` gives it), a row per (sub-)step: mesh stiffness, controls,
+    transmission error and its rate, the relieved meshes' tooth pairs; the absent ones empty along their last
+    axes."""
 
-    k1: np.ndarray
-    k2: np.ndarray
-    u1: np.ndarray
-    u2: np.ndarray
-    e1: np.ndarray
-    e2: np.ndarray
-    de1: np.ndarray
-    de2: np.ndarray
-    p1: np.ndarray
-    p2: np.ndarray
+    k: np.ndarray
+    u: np.ndarray
+    e: np.ndarray
+    de: np.ndarray
+    pairs: np.ndarray
 
 
 class Split(NamedTuple):
@@ -244,6 +235,27 @@ class Split(NamedTuple):
     count: np.ndarray
     lengths: np.ndarray
     drive: Drive
+
+
+class Stages(NamedTuple):
+    """RK4's work space: the state at the step's start (``qpos0``, ``qvel0``, ``act0``), each stage's derivatives
+    (``qvel``, ``qacc``, ``act_dot``, one row per stage) and their weighted sums (``velocity``, ``acceleration``,
+    ``activation``)."""
+
+    qpos0: np.ndarray
+    qvel0: np.ndarray
+    act0: np.ndarray
+    qvel: np.ndarray
+    qacc: np.ndarray
+    act_dot: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    activation: np.ndarray
+
+    @classmethod
+    def of(cls, m: mujoco.MjModel) -> "Stages":
+        return cls(np.zeros(m.nq), np.zeros(m.nv), np.zeros(m.na), np.zeros((4, m.nv)), np.zeros((4, m.nv)),
+                   np.zeros((4, m.na)), np.zeros(m.nv), np.zeros(m.nv), np.zeros(m.na))
 
 
 class Flags(NamedTuple):
@@ -464,49 +476,89 @@ def _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid):
             pin_forces[j, p] = stiffness[t] * max(compression, 0.0) + damping[t] * ten_velocity[t]
 
 
-@numba.njit(nogil=True, cache=True)
-def run_steps(forward, runge_kutta, passive, kinematics, com_pos, jac, pointers, model, data, turning, contacts,
-              work, reader, cycloid, drive, split, flags, outputs, h, start, stop, every, j):
-    """Steps start..stop-1 of one twin, sampling those that begin on a multiple of ``every`` into rows j.. of
-    ``outputs``; returns the next row.  MuJoCo's C functions, then the twin in the groups above: ``drive`` one row
-    per step, ``split`` the split steps' sub-steps."""
-    wrap_prm, timestep = model.wrap_prm, model.timestep
-    qpos = data.qpos
-    wraps, base, carrier_qadr = turning.wraps, turning.base, turning.carrier_qadr
-    coef = work.coef
-    k1, k2, u1, u2, e1, e2, de1, de2, p1, p2 = drive
-    first, count, lengths = split.first, split.count, split.lengths
-    sk1, sk2, su1, su2, se1, se2, sde1, sde2, sp1, sp2 = split.drive
-    has_te, has_pairs, has_pins = flags.transmission_error, flags.tooth_pairs, flags.pin_contacts
+@numba.njit(cache=True)
+def _drive_stage(s, r, drive, kinematics, com_pos, jac, pointers, model, data, turning, contacts, work, cycloid,
+                 flags):
+    """Everything a stage sets from its own state: the pin tendons, the turned coefficients, the drive of row ``r``
+    at stage time ``s``."""
+    if flags.pin_contacts:
+        _pins(kinematics, com_pos, jac, pointers.model, pointers.data, model, data, cycloid)
+    _refresh(data.qpos, model.wrap_prm, turning.wraps, turning.base, turning.carrier_qadr, work.coef)
+    _set_stage(drive.k[r, s], drive.u[r, s], drive.e[r, s], drive.de[r, s], drive.pairs[r, s],
+               flags.transmission_error, flags.tooth_pairs, model, data, turning, contacts, work)
+
+
+@numba.njit(cache=True)
+def _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, r, h, flags, outputs,
+         sample, j):
+    """One RK4 (sub-)step of length h with the drive of row ``r`` at its stage times, MuJoCo's ``mj_RungeKutta``
+    written out (the same sums in the same order) with each stage driven from its own state; the first stage
+    sampled into row j when ``sample``.  Returns the next row."""
+    forward, forward_skip, integrate_pos, passive, kinematics, com_pos, jac = c
     m, d = pointers.model, pointers.data
+    qpos, qvel, act, qacc, act_dot = data.qpos, data.qvel, data.act, data.qacc, data.act_dot
+    qpos0, qvel0, act0, V, A, AD, velocity, acceleration, activation = stages
+    qpos0[:] = qpos
+    qvel0[:] = qvel
+    act0[:] = act
+    for stage in range(4):
+        if stage > 0:
+            a = STAGE_ADVANCE[stage - 1]
+            qpos[:] = qpos0
+            for i in range(qvel.size):
+                velocity[i] = V[stage - 1, i] * a
+            integrate_pos(m, qpos.ctypes.data, velocity.ctypes.data, h)
+            for i in range(qvel.size):
+                qvel[i] = qvel0[i] + A[stage - 1, i] * a * h
+            for i in range(act.size):
+                act[i] = act0[i] + AD[stage - 1, i] * a * h
+        _drive_stage(STAGE_TIMES[stage], r, drive, kinematics, com_pos, jac, pointers, model, data, turning,
+                     contacts, work, cycloid, flags)
+        if stage == 0:
+            forward(m, d)
+            if sample:
+                _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid)
+                j += 1
+        else:
+            forward_skip(m, d, 0, 1)  # mjSTAGE_NONE, no sensors
+        V[stage, :] = qvel
+        A[stage, :] = qacc
+        AD[stage, :] = act_dot
+    velocity[:] = 0.0
+    acceleration[:] = 0.0
+    activation[:] = 0.0
+    for stage in range(4):
+        weight = 1.0 / 6.0 if stage == 0 or stage == 3 else 1.0 / 3.0
+        for i in range(qvel.size):
+            velocity[i] += V[stage, i] * weight
+            acceleration[i] += A[stage, i] * weight
+        for i in range(act.size):
+            activation[i] += AD[stage, i] * weight
+    for i in range(act.size):
+        act[i] = act0[i] + activation[i] * h
+    for i in range(qvel.size):
+        qvel[i] = qvel0[i] + acceleration[i] * h
+    qpos[:] = qpos0
+    integrate_pos(m, qpos.ctypes.data, velocity.ctypes.data, h)
+    return j
+
+
+@numba.njit(nogil=True, cache=True)
+def run_steps(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, split, flags,
+              outputs, h, start, stop, every, j):
+    """Steps start..stop-1 of one twin, sampling those that begin on a multiple of ``every`` into rows j.. of
+    ``outputs``; returns the next row.  ``c``: MuJoCo's C functions (forward, forward_skip, integrate_pos, passive,
+    kinematics, com_pos, jac); then the twin in the groups above: ``drive`` one row per step, ``split`` the split
+    steps' sub-steps."""
+    first, count, lengths = split.first, split.count, split.lengths
     for step in range(start, stop):
         i = step - start
         sample = step % every == 0
         if count[i] > 0:
             for s in range(first[i], first[i] + count[i]):
-                timestep[0] = lengths[s]
-                if has_pins:
-                    _pins(kinematics, com_pos, jac, m, d, model, data, cycloid)
-                _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef)
-                _set_stage(sk1[s], su1[s], se1[s], sde1[s], sp1[s], has_te, has_pairs, model, data, turning,
-                           contacts, work)
-                forward(m, d)
-                if sample and s == first[i]:
-                    _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid)
-                    j += 1
-                _set_stage(sk2[s], su2[s], se2[s], sde2[s], sp2[s], has_te, has_pairs, model, data, turning,
-                           contacts, work)
-                runge_kutta(m, d, 4)
-            timestep[0] = h
+                j = _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, split.drive, s,
+                         lengths[s], flags, outputs, sample and s == first[i], j)
             continue
-        if has_pins:
-            _pins(kinematics, com_pos, jac, m, d, model, data, cycloid)
-        _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef)
-        _set_stage(k1[i], u1[i], e1[i], de1[i], p1[i], has_te, has_pairs, model, data, turning, contacts, work)
-        forward(m, d)
-        if sample:
-            _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid)
-            j += 1
-        _set_stage(k2[i], u2[i], e2[i], de2[i], p2[i], has_te, has_pairs, model, data, turning, contacts, work)
-        runge_kutta(m, d, 4)
+        j = _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, i, h, flags,
+                 outputs, sample, j)
     return j

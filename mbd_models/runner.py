@@ -1,6 +1,6 @@
 """The MuJoCo runner: the train really turning, every mesh's stiffness driven every step.
 
-Per step (fixed step h, MuJoCo's RK4 integrator):
+At every stage of every RK4 step (fixed step h), from the stage's own state and at its own time:
 
 * mesh stiffness k(t) from :meth:`gearcheck.train.excitation.Excitation.stiffness` (the nominal
   clock, as the lumped solver) into ``m.tendon_stiffness``; a static transmission error
@@ -23,14 +23,14 @@ Integrator: RK4, because the mesh springs make the model stiff and no MuJoCo
 integrator except ``discrete`` treats spring stiffness implicitly: Euler and
 implicitfast are stable only for h < 2/omega_max and first-order accurate, RK4 is
 stable to 2.83/omega_max and fourth-order accurate, so it matches the lumped RK4
-solution with the same step.  MuJoCo holds model fields and controls constant over a
-step, so the runner calls ``mj_forward`` itself with the excitation at t_n (RK4's
-first stage, which also gives the outputs at t_n) and then ``mj_RungeKutta`` with the
-excitation at the weighted time of the remaining stages, (4 x(t+h/2) + x(t+h))/5:
-the stage weights of RK4 (2/6, 2/6, 1/6) then integrate a linear-in-time drive
-exactly over the step.  A step inside which a mesh stiffness jumps (on the nominal clock) is
-split there into sub-steps, MuJoCo's timestep set to each one's length, as the lumped solver
-does (:func:`gearcheck.shared.stepping.split_steps`): the stiffness is constant over every
+solution with the same step.  MuJoCo's ``mj_RungeKutta`` holds model fields and controls
+constant over its step, which costs the order wherever they move (a time-varying stiffness
+or transmission error: order 2; the coefficients turning with a carrier and the damping
+correction: order 1).  The runner therefore takes RK4's four stages itself, as
+``mj_RungeKutta`` does (the same sums in the same order, ``mj_forward`` per stage), with
+the fields above set at each stage (t, t + h/2, t + h/2, t + h).  A step inside which a mesh
+stiffness jumps (on the nominal clock) is split there into sub-steps, as the lumped solver
+does (:func:`gearcheck.shared.stepping.split_steps`): the stiffness is smooth over every
 sub-step and RK4 keeps its fourth order.
 
 Time step: from MuJoCo's own linearisation with every mesh at its cycle-maximum stiffness, damping
@@ -49,8 +49,7 @@ needle bearings' forces from their actuators.
 
 Engines: the loop above runs in C by default (:mod:`gearcheck.mbd_models.compiled`: the same model writes and
 MuJoCo calls from a numba kernel, the drive computed in arrays a chunk of steps at a time; equal to the Python
-loop to round-off, and about 1.1-1.2 times a bare ``mj_step``); ``engine="python"`` keeps it in Python (the lean
-single-carrier stepper or the general one), and the "bodies" stiffness clock always does.
+loop to round-off); ``engine="python"`` keeps it in Python, and the "bodies" stiffness clock always does.
 :func:`simulate_mujoco_many` runs several twins at once in threads.
 """
 
@@ -75,7 +74,7 @@ from gearcheck.shared.errors import SolverError
 from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive, per_step_pairs
+from gearcheck.shared.stepping import STAGE_OFFSETS
 
 CHUNK = 10000
 
@@ -113,11 +112,9 @@ class _Drive:
         return self.exc.stiffness(t), self.controls(t), e, de, pairs
 
     def steps(self, t0: np.ndarray, h):
-        """For steps starting at t0: each of (k, u, e, de, pairs) as (stage-1 rows, stages-2..4 rows), sampled
-        at t0 + h STAGE_OFFSETS and weighted as the lumped RK4 drives its steps (h one step, or one per row)."""
-        *values, pairs = self.at(t0[:, None] + np.reshape(h, (-1, 1)) * np.array(STAGE_OFFSETS)[None, :])
-        out = [(None, None) if x is None else tuple(per_step_drive(x)[:, :2].swapaxes(0, 1)) for x in values]
-        return out + [(None, None) if pairs is None else tuple(per_step_pairs(pairs)[:, :2].swapaxes(0, 1))]
+        """(k, u, e, de, pairs) for steps starting at t0 (h one step length, or one per row), each with time along
+        axes (0, 1): the step, its stage times t0 + h STAGE_OFFSETS (t, t + h/2, t + h)."""
+        return self.at(t0[:, None] + np.reshape(h, (-1, 1)) * np.array(STAGE_OFFSETS)[None, :])
 
 
 class _ToothContacts:
@@ -151,9 +148,11 @@ class _ToothContacts:
 
 
 class _Stepper:
-    """Steps one twin: turn the coefficients, drive stage 1, ``mj_forward`` (and sample), drive stages
-    2-4, ``mj_RungeKutta``.  Samples go into preallocated rows: sensordata, the force reader's
-    generalized forces, and optionally the stiffness used and MuJoCo's energy."""
+    """Steps one twin by classical RK4, MuJoCo's ``mj_RungeKutta`` written out so that each of its four stages is
+    driven from its own state at its own time: turn the coefficients, set the stage (drive, tooth contacts,
+    damping correction), ``mj_forward`` (sampled at a step's first stage; ``mj_forwardSkip`` without sensors at
+    the others), then the state advanced by RK4's weights.  Samples go into preallocated rows: sensordata, the
+    force reader's generalized forces, and optionally the stiffness used and MuJoCo's energy."""
 
     def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool):
         m = mb.model
@@ -173,16 +172,15 @@ class _Stepper:
         self.pins = np.empty((n_samples, sum(len(c.tendons) for c in mb.moving_contacts))) if self.moving else None
         self.j = 0
 
-    def refresh(self) -> None:
-        """Turn the mesh tendons' coefficients with their carriers and set the contacts' tendons (an RV reducer's
-        pins) to the bodies' poses."""
+    def set_stage(self, k, u, e, de, pairs=None) -> None:
+        """Everything a stage sets from its own state: the mesh tendons' coefficients turned with their carriers,
+        the contacts' tendons (an RV reducer's pins) at the bodies' poses, the drive (stiffness -- from the bodies'
+        angles on the "bodies" clock --, controls, spring lengths, tooth contacts) and the damping correction."""
         self.mb.refresh(self.d.qpos)
         for c, _ in self.moving:
             c.refresh(self.d)
-
-    def set_stage(self, k, u, e, de, pairs=None) -> None:
-        """Drive values for the coming stage(s): stiffness, controls, spring lengths, tooth contacts, damping
-        correction."""
+        if self.clock is not None:
+            k = _body_stiffness(self.mb, self.clock, self.d.qpos)
         self.m.tendon_stiffness[:self.n_mesh] = k
         self.d.ctrl[:] = u
         if e is not None:
@@ -206,127 +204,84 @@ class _Stepper:
         self.j += 1
 
     def run(self, start: int, stop: int, every: int, values, split) -> None:
-        """Steps start..stop-1, sampling the steps that begin on a multiple of ``every``; the steps in
-        ``split`` (:func:`gearcheck.shared.stepping.split_steps`) end sub-steps at their stiffness jumps."""
-        (k1, k2), (u1, u2), (e1, e2), (de1, de2), (p1, p2) = values
-        m, d = self.m, self.d
-
-        def row(x, i):
-            return None if x is None else x[i]
-
+        """Steps start..stop-1 with the drive ``values`` (:meth:`_Drive.steps`), sampling the steps that begin on a
+        multiple of ``every``; the steps in ``split`` (:func:`gearcheck.shared.stepping.split_steps`) are taken as
+        RK4 sub-steps ended at their stiffness jumps, the drive sampled over each as over a whole step."""
         for i in range(stop - start):
-            if start + i in split:
-                self.split_step(start + i, split[start + i], (start + i) % every == 0)
+            step = start + i
+            sample = step % every == 0
+            if step not in split:
+                self.rk4(self.h, [None if x is None else x[i] for x in values], sample)
                 continue
-            self.refresh()
-            if self.clock is not None:
-                k_now, k_later = _body_stiffness(self.mb, self.clock, d.qpos, d.qvel, self.h)
-            else:
-                k_now, k_later = k1[i], k2[i]
-            self.set_stage(k_now, u1[i], row(e1, i), row(de1, i), row(p1, i))
-            mujoco.mj_forward(m, d)
-            if (start + i) % every == 0:
-                self.sample()
-            self.set_stage(k_later, u2[i], row(e2, i), row(de2, i), row(p2, i))
-            mujoco.mj_RungeKutta(m, d, 4)
+            starts, lengths = stepping.sub_steps(step * self.h, self.h, split[step])
+            for n, (rows, length) in enumerate(zip(zip(*(_rows(x) for x in self.drive.steps(starts, lengths))),
+                                                   lengths)):
+                self.rk4(length, rows, sample and n == 0)
 
-    def split_step(self, step: int, inner, sample: bool) -> None:
-        """Step ``step`` as RK4 sub-steps ended at the times ``inner``: MuJoCo's timestep set to each
-        sub-step's length, the drive sampled over it as over a whole step."""
+    def rk4(self, h: float, drive, sample: bool) -> None:
+        """One RK4 (sub-)step of length h, ``drive`` (k, u, e, de, pairs) at its stage times t, t + h/2, t + h."""
         m, d = self.m, self.d
-        for j, (a, length) in enumerate(zip(*stepping.sub_steps(step * self.h, self.h, inner))):
-            m.opt.timestep = length
-            first, later = zip(*self.drive.steps(np.array([a]), length))
-            self.refresh()
-            self.set_stage(*(None if x is None else x[0] for x in first))
-            mujoco.mj_forward(m, d)
-            if sample and j == 0:
-                self.sample()
-            self.set_stage(*(None if x is None else x[0] for x in later))
-            mujoco.mj_RungeKutta(m, d, 4)
-        m.opt.timestep = self.h
+        qpos0, qvel0, act0 = d.qpos.copy(), d.qvel.copy(), d.act.copy()
+        rates = []
+        for stage, s in enumerate(compiled.STAGE_TIMES):
+            if stage:
+                velocity, acceleration, activation = rates[-1]
+                a = compiled.STAGE_ADVANCE[stage - 1]
+                d.qpos[:] = qpos0
+                mujoco.mj_integratePos(m, d.qpos, velocity * a, h)
+                d.qvel[:] = qvel0 + acceleration * a * h
+                d.act[:] = act0 + activation * a * h
+            self.set_stage(*(None if x is None else x[s] for x in drive))
+            if stage:
+                mujoco.mj_forwardSkip(m, d, mujoco.mjtStage.mjSTAGE_NONE, 1)
+            else:
+                mujoco.mj_forward(m, d)
+                if sample:
+                    self.sample()
+            rates.append((d.qvel.copy(), d.qacc.copy(), d.act_dot.copy()))
+        velocity, acceleration, activation = (sum(rate[x] * w for rate, w in zip(rates, RK4_WEIGHTS))
+                                              for x in range(3))
+        d.act[:] = act0 + activation * h
+        d.qvel[:] = qvel0 + acceleration * h
+        d.qpos[:] = qpos0
+        mujoco.mj_integratePos(m, d.qpos, velocity, h)
 
     def finish(self, t_end: float) -> None:
         """Sample the final state (the drive of the step that would start there)."""
-        self.refresh()
-        k, u, e, de, pairs = self.drive.at(np.array([t_end + STAGE_OFFSETS[0] * self.h]))
-        if self.clock is not None:
-            k = _body_stiffness(self.mb, self.clock, self.d.qpos, self.d.qvel, self.h)[0][None]
-        self.set_stage(*(None if x is None else x[0] for x in (k, u, e, de, pairs)))
+        values = self.drive.at(np.array([t_end + STAGE_OFFSETS[0] * self.h]))
+        self.set_stage(*(None if x is None else x[0] for x in values))
         mujoco.mj_forward(self.m, self.d)
         self.sample()
 
 
-class _LeanStepper(_Stepper):
-    """The same contract for the common case (one carrier, no transmission error, the nominal clock,
-    no energy), kept lean: per step one cos/sin pair turns every coefficient and gives their
-    derivatives, and the damping correction is written out in that single-carrier form (an RV reducer's
-    pin tendons set to the discs' poses as in the general stepper)."""
+RK4_WEIGHTS = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
 
-    def __init__(self, *args):
-        super().__init__(*args)
-        tc = self.mb.turning
-        self.base = tc.base
-        self.turned = np.concatenate([-tc.base[len(tc.wraps) // 2:], tc.base[:len(tc.wraps) // 2]])
-        self.cs = np.zeros(2)
-        self.coef = np.zeros(len(tc.wraps))
-        self.rate = np.zeros(len(tc.wraps))
 
-    def run(self, start, stop, every, values, split) -> None:
-        (k1, k2), (u1, u2), _, _, _ = values
-        m, d, n = self.m, self.d, self.n_mesh
-        tc, corr = self.mb.turning, self.correction
-        prm, J, c_wrap, applied = m.wrap_prm, corr.J, corr.c_wrap, d.qfrc_applied
-        stiff, ctrl, qpos, qvel = m.tendon_stiffness, d.ctrl, d.qpos, d.qvel
-        wraps, rows, dofs, slides, phi_adr = tc.wraps, tc.tendon, tc.slide_dof, tc.slide_qadr, tc.single
-        cs, coef, rate, base, turned = self.cs, self.coef, self.rate, self.base, self.turned
-        dot, multiply, cos, sin = np.dot, np.multiply, math.cos, math.sin
-        forward, rk = mujoco.mj_forward, mujoco.mj_RungeKutta
-        refreshes = [c.refresh for c, _ in self.moving]
-        for i in range(stop - start):
-            if start + i in split:
-                self.split_step(start + i, split[start + i], (start + i) % every == 0)
-                continue
-            for refresh in refreshes:
-                refresh(d)
-            phi = qpos[phi_adr]
-            cs[0] = cos(phi)
-            cs[1] = sin(phi)
-            dot(base, cs, out=coef)
-            prm[wraps] = coef
-            J[rows, dofs] = coef
-            dot(turned, cs, out=rate)
-            multiply(rate, qpos[slides], out=rate)
-            dot(dot(c_wrap, rate) * -qvel[phi_adr], J, out=applied)
-            stiff[:n] = k1[i]
-            ctrl[:] = u1[i]
-            forward(m, d)
-            if (start + i) % every == 0:
-                self.sample()
-            stiff[:n] = k2[i]
-            ctrl[:] = u2[i]
-            rk(m, d, 4)
+def _rows(x):
+    """The rows of an optional drive array (None: None for every row)."""
+    return iter(lambda: None, 0) if x is None else x
 
 
 class _CompiledStepper(_Stepper):
-    """The general stepper's contract with its step loop compiled (:func:`gearcheck.mbd_models.compiled.run_steps`):
-    the drive of a chunk of steps (and of its split steps' sub-steps) computed here in arrays, then every step
-    in C, an RV reducer's pin tendons set to the discs' poses there too.  Not for the "bodies" stiffness clock
-    (its stiffness models are Python functions of the bodies' angles)."""
+    """The stepper's contract with its step loop compiled (:func:`gearcheck.mbd_models.compiled.run_steps`): the
+    drive of a chunk of steps (and of its split steps' sub-steps) computed here in arrays, then every step in C.
+    Not for the "bodies" stiffness clock (its stiffness models are Python functions of the bodies' angles)."""
 
     def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool):
         super().__init__(mb, d, h, n_samples, bodies, energy)
         m, n, tc, reader = self.m, self.n_mesh, mb.turning, self.reader
-        self.c = compiled.library()
+        lib = compiled.library()
+        self.c = (lib.forward, lib.forward_skip, lib.integrate_pos, lib.passive, lib.kinematics, lib.com_pos, lib.jac)
         c = self.contacts
         none = np.zeros(0, dtype=np.int64)
         self.twin = (  # the kernel's groups of this twin, as run_steps takes them after the C functions
             compiled.Pointers(m._address, d._address, reader.probe._address, reader.joints_only._address),
-            compiled.ModelViews(m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm, compiled.timestep_view(m),
+            compiled.ModelViews(m.tendon_stiffness, m.tendon_lengthspring, m.wrap_prm,
                                 reader.probe.tendon_stiffness[:n], reader.probe.tendon_lengthspring[:n],
                                 m.tendon_damping),
-            compiled.DataViews(d.qpos, d.qvel, d.ctrl, d.qfrc_applied, d.sensordata, d.qfrc_spring, d.qfrc_damper,
-                               d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length, d.ten_velocity),
+            compiled.DataViews(d.qpos, d.qvel, d.act, d.qacc, d.act_dot, d.ctrl, d.qfrc_applied, d.sensordata,
+                               d.qfrc_spring, d.qfrc_damper, d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length,
+                               d.ten_velocity),
             compiled.Turning(*(np.ascontiguousarray(x) for x in (
                 tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
                 mb.half_backlash))),
@@ -336,7 +291,8 @@ class _CompiledStepper(_Stepper):
             compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n)),
             compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
                             np.ascontiguousarray(reader.slides, dtype=np.int64)),
-            compiled.cycloid_arrays(mb.moving_contacts, m.nv))
+            compiled.cycloid_arrays(mb.moving_contacts, m.nv),
+            compiled.Stages.of(m))
         self.outputs = compiled.Outputs(self.sensors, self.forces,
                                         np.zeros((0, n)) if self.stiffness is None else self.stiffness,
                                         np.zeros((0, 2)) if self.energy is None else self.energy,
@@ -347,11 +303,9 @@ class _CompiledStepper(_Stepper):
     def _arrays(self, values, rows: int) -> compiled.Drive:
         """(k, u, e, de, pairs) of :meth:`_Drive.steps` as contiguous arrays, the absent ones empty along their last
         axes."""
-        n = self.n_mesh
-        empty = (np.zeros((rows, n)), np.zeros((rows, self.m.nu)), np.zeros((rows, 0)), np.zeros((rows, 0)),
-                 np.zeros((rows, 0, 0, 2)))
-        return compiled.Drive(*(np.ascontiguousarray(y) if y is not None else blank
-                                for (first, later), blank in zip(values, empty) for y in (first, later)))
+        empty = (np.zeros((rows, 3, self.n_mesh)), np.zeros((rows, 3, self.m.nu)), np.zeros((rows, 3, 0)),
+                 np.zeros((rows, 3, 0)), np.zeros((rows, 3, 0, 0, 2)))
+        return compiled.Drive(*(blank if x is None else np.ascontiguousarray(x) for x, blank in zip(values, empty)))
 
     def run(self, start, stop, every, values, split) -> None:
         rows = stop - start
@@ -363,11 +317,8 @@ class _CompiledStepper(_Stepper):
             starts += list(a)
             lengths += list(length)
         lengths = np.array(lengths, dtype=float)
-        sub = (self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size
-               else [(None, None)] * 5)
-        c = self.c
-        self.j = compiled.run_steps(c.forward, c.runge_kutta, c.passive, c.kinematics, c.com_pos, c.jac, *self.twin,
-                                    self._arrays(values, rows),
+        sub = self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size else [None] * 5
+        self.j = compiled.run_steps(self.c, *self.twin, self._arrays(values, rows),
                                     compiled.Split(first, count, lengths, self._arrays(sub, lengths.size)),
                                     self.flags, self.outputs, self.h, start, stop, every, self.j)
 
@@ -422,14 +373,12 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     d = mujoco.MjData(m)
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy(), m.opt.enableflags,
              m.opt.timestep, m.opt.integrator, m.tendon_damping.copy())
-    m.opt.timestep = dt  # mj_RungeKutta steps by the model's own timestep
+    m.opt.timestep = dt  # the step a viewer would take; the steppers take theirs explicitly
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if record_energy:
         m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     d.qpos[:], d.qvel[:] = qpos0, qvel0
-    lean = (mb.turning.single is not None and not mb.excitation.has_transmission_error
-            and not mb.excitation.relieved.size and stiffness_clock == "nominal" and not record_energy)
-    kind = _CompiledStepper if use_compiled else _LeanStepper if lean else _Stepper
+    kind = _CompiledStepper if use_compiled else _Stepper
     stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
     sub_steps = n_steps
@@ -506,23 +455,16 @@ def _body_clock(mb: MbdModel):
     for mesh in spec.meshes:
         carrier = spec.stage_of(mesh.planet).carrier
         rel = kin.speeds[mesh.central] - kin.speeds[carrier]
-        rows.append((mb.qadr[mesh.central][2], mb.qadr[carrier][2], mb.dadr[mesh.central][2], mb.dadr[carrier][2],
+        rows.append((mb.qadr[mesh.central][2], mb.qadr[carrier][2],
                      math.copysign(1.0, rel) * mesh.central_gear.teeth / (2 * math.pi)))
-    qc, qk, vc, vk, gain = (np.array(x) for x in zip(*rows))
-    return qc, qk, vc, vk, gain
+    return tuple(np.array(x) for x in zip(*rows))
 
 
-def _body_stiffness(mb: MbdModel, info, qpos, qvel, h):
-    """k from the mesh position of the MuJoCo bodies: xi = sign z (theta_central - theta_carrier)/2pi - phase;
-    (now, the weighted stage 2-4 value over the coming step)."""
-    qc, qk, vc, vk, gain = info
+def _body_stiffness(mb: MbdModel, info, qpos) -> np.ndarray:
+    """k from the mesh position of the MuJoCo bodies: xi = sign z (theta_central - theta_carrier)/2pi - phase."""
+    qc, qk, gain = info
     xi = gain * (qpos[qc] - qpos[qk]) - mb.excitation.phase
-    rate = gain * (qvel[vc] - qvel[vk])
-    models = mb.excitation.models
-    k_now = np.array([mdl(x) for mdl, x in zip(models, xi)], dtype=float)
-    k_mid = np.array([mdl(x) for mdl, x in zip(models, xi + 0.5 * h * rate)], dtype=float)
-    k_end = np.array([mdl(x) for mdl, x in zip(models, xi + h * rate)], dtype=float)
-    return k_now, stepping.STEP_WEIGHTS[0] * k_mid + stepping.STEP_WEIGHTS[1] * k_end
+    return np.array([model(x) for model, x in zip(mb.excitation.models, xi)], dtype=float)
 
 
 # --------------------------------------------------------------------------- result

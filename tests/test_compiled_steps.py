@@ -81,7 +81,7 @@ def test_chunks_hold_a_bounded_drive():
     assert time_solver._chunk_steps(plain) == time_solver.CHUNK
     steps = time_solver._chunk_steps(relief)
     assert steps < time_solver.CHUNK
-    chunk = time_solver._chunk(relief, 1e-6, 0, steps, "steps")
+    chunk = time_solver._chunk(relief, 1e-6, 0, steps)
     assert sum(x.nbytes for x in (chunk.k, chunk.e, chunk.de, chunk.tin, chunk.tout, chunk.pairs)) <= \
         time_solver.CHUNK_BYTES
 

@@ -114,10 +114,11 @@ def test_every_spectral_line_is_flagged_against_its_tolerance(failing, hub):
         md = (out / "report.md").read_text()
         assert "A line is flagged fail when its relative amplitude error exceeds its quantity's NRMSE tolerance" in md
         assert "advisory" in md
-    flagged = [s for q in hub[1]["quantities"] for s in q["spectrum"] if s["status"] == "fail"]
-    assert flagged and hub[0].verdict != "FAIL"  # advisory: lines beyond tolerance do not fail the verdict
-    spectral = tables((hub[2] / "report.md").read_text())["Spectral lines (Hann-windowed amplitude)"]
-    assert spectral[1][-1] == "fail" and 'class="fail"' in (hub[2] / "report.html").read_text()
+        for q in result.quantities:  # advisory: a quantity passes or fails on its NRMSE alone, whatever its lines
+            if q.status in ("pass", "fail"):
+                assert (q.status == "fail") == (q.metrics["nrmse"] > q.tolerance)
+    spectral = tables((failing[2] / "report.md").read_text())["Spectral lines (Hann-windowed amplitude)"]
+    assert spectral[1][-1] == "fail" and 'class="fail"' in (failing[2] / "report.html").read_text()
 
 
 def test_a_failing_quantity_gets_its_plot(failing, hub):

@@ -115,11 +115,9 @@ def mujoco_run(spec, model, settings, **options):
 RK4_STEPPERS = {  # name: (the engine it reports, run, options)
     "numba-rk4": ("numba-rk4", lumped_run, {}),
     "python-rk4": ("python-rk4", lumped_run, {"method": "rk4-stages"}),
-    "python-rk4, drive at the stages": ("python-rk4", lumped_run, {"method": "rk4-stages", "drive": "stages"}),
     "linear-rk4": ("linear-rk4", linear_run, {}),
     "mujoco-compiled": ("mujoco-compiled", mujoco_run, {"engine": "compiled"}),
-    "mujoco-python, lean": ("mujoco-python", mujoco_run, {"engine": "python"}),
-    "mujoco-python, general": ("mujoco-python", mujoco_run, {"engine": "python", "record_energy": True}),
+    "mujoco-python": ("mujoco-python", mujoco_run, {"engine": "python"}),
 }
 
 

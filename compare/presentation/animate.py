@@ -26,7 +26,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
-from gearcheck.mbd_models.runner import _LeanStepper, _Stepper, static_state
+from gearcheck.mbd_models.runner import _Stepper, static_state
 from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
@@ -133,9 +133,7 @@ class TwinPlayer:
         start = self.static if spec.operating.ramp == 0 else static_state(mb, 0.0)
         self.data = mujoco.MjData(mb.model)
         self.data.qpos[:], self.data.qvel[:] = start.qpos, start.qvel
-        lean = (mb.turning.single is not None and not mb.excitation.has_transmission_error
-                and not mb.excitation.relieved.size)
-        self.stepper = (_LeanStepper if lean else _Stepper)(mb, self.data, self.dt, n_frames, False, False)
+        self.stepper = _Stepper(mb, self.data, self.dt, n_frames, False, False)
         self.step = 0
         self.qpos: list[np.ndarray] = []
 

@@ -31,12 +31,6 @@ midpoint, just before t + h.  A stiffness switch that falls on a step boundary i
 on the same side by every mesh, whatever the round-off in its phase (planets with equal
 phases stay identical, so the symmetry that mesh phasing relies on survives)."""
 
-STEP_WEIGHTS = (4.0 / 5.0, 1.0 / 5.0)
-"""Per-step drive (MuJoCo holds model fields and controls constant over a step after its first
-RK4 stage): stage 1 sees x(t), stages 2-4 see (4 x(t + h/2) + x(t + h))/5.  With RK4's stage
-weights (2, 2, 1)/6 this integrates a drive linear in time over the step exactly; a stiffness
-switch inside a step is then seen as a weighted mean, the same in both solvers."""
-
 
 def split_steps(h: float, start: int, stop: int, switches) -> dict[int, np.ndarray]:
     """The steps among start..stop-1 (step i spans [i h, (i + 1) h]) inside which the drive jumps, each with
@@ -152,30 +146,6 @@ def check_step(dt, limits: StepLimits, mesh_frequencies, model: str) -> None:
             f"dt < {limits.stable:.4g} s (highest natural frequency {limits.omega_max / (2 * math.pi):.6g} Hz with "
             f"the meshes at maximum stiffness, and its damping); use dt <= "
             f"{default_step(limits, mesh_frequencies):.4g} s (the default) or at most {limit:.4g} s")
-
-
-def per_step_drive(x: np.ndarray) -> np.ndarray:
-    """Drive samples (steps, 3 stage times, ...) at :data:`STAGE_OFFSETS` -> stage 1 unchanged, stages
-    2-4 the weighted mean :data:`STEP_WEIGHTS` (what a solver that holds its drive over a step sees)."""
-    out = x.copy()
-    out[:, 1] = out[:, 2] = STEP_WEIGHTS[0] * x[:, 1] + STEP_WEIGHTS[1] * x[:, 2]
-    return out
-
-
-def per_step_pairs(pairs: np.ndarray) -> np.ndarray:
-    """:func:`per_step_drive` of tooth-pair contacts, (steps, 3 stage times, ..., 2) holding each pair's
-    stiffness k and gap e (inf out of contact): stages 2-4 get the weighted stiffness and the gap that keeps
-    the weighted force, sum_w w k_w (delta - e_w) = (sum_w w k_w)(delta - e), over the times the pair is in
-    contact."""
-    out = pairs.copy()
-    k = [STEP_WEIGHTS[i] * pairs[:, s, ..., 0] for i, s in enumerate((1, 2))]
-    e = [np.where(np.isfinite(pairs[:, s, ..., 1]), pairs[:, s, ..., 1], 0.0) for s in (1, 2)]
-    stiffness = k[0] + k[1]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        gap = np.where(stiffness > 0, (k[0] * e[0] + k[1] * e[1]) / stiffness, np.inf)
-    out[:, 1, ..., 0] = out[:, 2, ..., 0] = stiffness
-    out[:, 1, ..., 1] = out[:, 2, ..., 1] = gap
-    return out
 
 
 TRANSIENT_POINTS_PER_PERIOD = 40.0

@@ -22,16 +22,22 @@ massless.  ``VISUALS = False`` writes the bodies bare (the same dynamics, to the
 
 Every number is written with full precision (the shortest repr that round-trips), angles in
 radian, so the text is deterministic and lossless (:mod:`gearcheck.mbd_models.mjcf_text`).
+
+The text is written once, by :func:`document`, as a :class:`~gearcheck.mbd_models.mjcf_text.Template`: the numbers
+that are not the description's (the step, the meshes' stiffness and damping, the tendons' coefficients from
+MuJoCo's Jacobians, the pins' spring lengths) are slots, filled for the compile and again, with the compiled twin's
+numbers, for the file.
 """
 
 from __future__ import annotations
 
 from gearcheck.mbd_models import gear_visuals
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import TendonValues
 from gearcheck.mbd_models.mjcf_text import (
     RGBA,
+    TIMESTEP,
     VISUAL,
+    Template,
     central_body,
     gear_z,
     marker,
@@ -39,6 +45,7 @@ from gearcheck.mbd_models.mjcf_text import (
     num,
     pin_body,
     plate,
+    slot,
     vec,
 )
 from gearcheck.train.spec import TrainSpec
@@ -171,22 +178,22 @@ def _sensors(spec: TrainSpec) -> list[str]:
 # --------------------------------------------------------------------------- document
 
 
-def document(spec: TrainSpec, values: TendonValues, timestep: float, header: list[str]) -> str:
-    """The whole MJCF text: ``header`` comment, compiler, option and headlight, the gears' visual meshes (when
-    ``VISUALS``), bodies, the parts' tendons (``values``: the numbers known once compiled), actuators and
+def document(spec: TrainSpec, header: list[str]) -> Template:
+    """The whole MJCF text, once: ``header`` comment, compiler, option (the step a slot) and headlight, the gears'
+    visual meshes (when ``VISUALS``), bodies, the parts' tendons (their late numbers slots), actuators and
     sensors."""
     lines = ["<!--"] + [f"  {h}" for h in header] + ["-->", f'<mujoco model="{spec.name}">',
              '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-             f'  <option timestep="{num(timestep)}" integrator="RK4" gravity="0 0 0">',
+             f'  <option timestep="{slot(TIMESTEP)}" integrator="RK4" gravity="0 0 0">',
              '    <flag contact="disable"/>', "  </option>",
              '  <visual><map znear="0.001"/><headlight ambient="0.4 0.4 0.4" diffuse="0.6 0.6 0.6"/></visual>']
     lines += (_assets(spec) if VISUALS else []) + _worldbody(spec, VISUALS)
-    tendons = _hook(spec, "tendons", spec, values)
+    tendons = _hook(spec, "tendons", spec)
     if tendons:
         lines += ["  <tendon>"] + tendons + ["  </tendon>"]
     lines += ["  <actuator>"] + _hook(spec, "actuators", spec) + ["  </actuator>"]
     lines += _sensors(spec) + ["</mujoco>"]
-    return "\n".join(lines) + "\n"
+    return Template("\n".join(lines) + "\n")
 
 
 HEADER = [

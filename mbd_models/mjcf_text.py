@@ -3,11 +3,19 @@
 Every number is written with full precision (the shortest repr that round-trips), angles in radian, so the text
 is deterministic and lossless.  A member's joints realise its degrees of freedom
 (:attr:`gearcheck.train.spec.Member.dofs`) by the frame that carries it (:data:`AXES`).
+
+A few numbers of the text are not the description's: the meshes' stiffness (the argument of
+:func:`gearcheck.mbd_models.twin.compile_train`) and what is known only once the twin is compiled (the tendons'
+coefficients from MuJoCo's Jacobians, the meshes' damping, the pins' spring lengths, the default step).  Where an
+element writes one of those it writes :data:`LATE`, and the text holds a slot for it (:func:`slot`): the text is
+written once, as a :class:`Template`, and filled from :class:`LateValues`, with placeholders for the compile and
+with the compiled twin's numbers for the file.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 RGBA = {
     "sun": "0.95 0.6 0.1 1",
@@ -50,6 +58,73 @@ def vec(*xs) -> str:
     return " ".join(num(x) for x in xs)
 
 
+# --------------------------------------------------------------------------- numbers known once compiled
+
+
+class _Late:
+    def __repr__(self) -> str:
+        return "LATE"
+
+
+LATE = _Late()  # a number that the text takes from compile_train, not from the description: written as a slot
+SLOT = "\0"  # brackets a slot's key in the rendered text (XML cannot hold it, so no text is ever taken for a slot)
+KEY = "\1"  # separates the parts of a slot's key (field, tendon, joint): XML cannot hold it either
+TIMESTEP, STIFFNESS, COEF, DAMPING, SPRINGLENGTH = "timestep", "stiffness", "coef", "damping", "springlength"
+
+
+def slot(*key: str) -> str:
+    """The slot of a late number in the text: its field (:data:`TIMESTEP`, :data:`STIFFNESS`, :data:`COEF`,
+    :data:`DAMPING`, :data:`SPRINGLENGTH`), then the tendon's name and, for a coefficient, the joint's."""
+    return SLOT + KEY.join(key) + SLOT
+
+
+def _number(x, *key: str) -> str:
+    return slot(*key) if x is LATE else num(x)
+
+
+@dataclass
+class LateValues:
+    """The numbers that fill a :class:`Template`'s slots: the step, and by tendon name the stiffness, the joint
+    coefficients [(joint, coefficient)], the damping and the spring length (dead band).  A tendon's coefficients
+    are 0 until given, and then every one of its joints must have one; no damping is 0 (no attribute), no spring
+    length (0, 0)."""
+
+    timestep: float
+    stiffness: dict = field(default_factory=dict)
+    coefficients: dict = field(default_factory=dict)
+    damping: dict = field(default_factory=dict)
+    band: dict = field(default_factory=dict)
+
+    def text(self, name: str, tendon: str = "", joint: str = "") -> str:
+        """What the text writes in the slot of key (``name``, ``tendon``, ``joint``)."""
+        if name == TIMESTEP:
+            return num(self.timestep)
+        if name == STIFFNESS:
+            return num(self.stiffness[tendon])
+        if name == COEF:
+            coefs = self.coefficients.get(tendon)
+            return num(dict(coefs)[joint] if coefs else 0.0)
+        if name == DAMPING:
+            c = self.damping.get(tendon, 0.0)
+            return f' damping="{num(c)}"' if c else ""
+        if name == SPRINGLENGTH:
+            return vec(*self.band.get(tendon, (0.0, 0.0)))
+        raise KeyError(f"no late number {name!r} in the MJCF text")
+
+
+class Template:
+    """MJCF text written once, with a slot for every late number: :meth:`fill` writes the text they make."""
+
+    def __init__(self, text: str):
+        self.pieces = text.split(SLOT)  # text, key, text, ..., text
+        self.keys = [tuple(key.split(KEY)) for key in self.pieces[1::2]]
+
+    def fill(self, values: LateValues) -> str:
+        pieces = self.pieces.copy()
+        pieces[1::2] = [values.text(*key) for key in self.keys]
+        return "".join(pieces)
+
+
 def joint(name: str, kind: str, axis, stiffness: float = 0.0, damping: float = 0.0, pos=(0.0, 0.0, 0.0)) -> str:
     attrs = [f'name="{name}"', f'type="{kind}"', f'axis="{vec(*axis)}"', f'pos="{vec(*pos)}"']
     if stiffness:
@@ -82,12 +157,17 @@ def marker(member, r: float, z: float, size: float) -> str:
 
 def fixed(name: str, coefs: list[tuple[str, float]], stiffness: float, damping: float,
           springlength: tuple[float, float] = (0.0, 0.0)) -> list[str]:
-    """A ``<fixed>`` tendon: length sum coef q_joint, spring-damper with a dead band ``springlength``."""
-    attrs = [f'name="{name}"', f'stiffness="{num(stiffness)}"', f'springlength="{vec(*springlength)}"']
-    if damping:
+    """A ``<fixed>`` tendon: length sum coef q_joint, spring-damper with a dead band ``springlength``.  Any of the
+    numbers (a coefficient, the stiffness, the damping, the spring length) may be :data:`LATE`: a slot under the
+    tendon's name (and the joint's) that :class:`LateValues` fills."""
+    attrs = [f'name="{name}"', f'stiffness="{_number(stiffness, STIFFNESS, name)}"',
+             f'springlength="{slot(SPRINGLENGTH, name) if springlength is LATE else vec(*springlength)}"']
+    if damping is LATE:
+        attrs[-1] += slot(DAMPING, name)  # the attribute itself: written only where the damping is not 0
+    elif damping:
         attrs.append(f'damping="{num(damping)}"')
     lines = [f"    <fixed {' '.join(attrs)}>"]
-    lines += [f'      <joint joint="{j}" coef="{num(c)}"/>' for j, c in coefs]
+    lines += [f'      <joint joint="{j}" coef="{_number(c, COEF, name, j)}"/>' for j, c in coefs]
     lines.append("    </fixed>")
     return lines
 

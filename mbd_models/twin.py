@@ -6,7 +6,7 @@ MuJoCo itself, d . (Jp_central(p) - Jp_planet(p)): the translation Jacobians (``
 of the two bodies at the pitch point p, projected on the line of action d of the train
 description (:func:`gearcheck.train.line_of_action.line_of_action`, given in the carrier frame and
 placed in the world with the carrier body's pose), and written into the compiled model's
-``wrap_prm`` and into the text.  The mesh damping c = 2 zeta sqrt(k_mean m_eq),
+``wrap_prm`` and into the text's slots (below).  The mesh damping c = 2 zeta sqrt(k_mean m_eq),
 m_eq = 1/(r_A^2/I_A + r_B^2/I_B), takes r_A, r_B from those coefficients on the two gears' hinges
 and I from the compiled bodies.  Last, the default step comes from MuJoCo's own linearisation
 (:mod:`gearcheck.mbd_models.linearise`) and is written into the model and the text, so the file
@@ -20,6 +20,29 @@ An RV reducer's cycloid-pin stage (:mod:`gearcheck.mbd_models.elements.cycloid`)
 and crankshafts, its needle bearings and one pin tendon per pin and disc, whose coefficients of t = 0 come
 from MuJoCo's Jacobians likewise; its pins touching at t = 0, which the linearisation takes, are those of the
 twin's own static equilibrium (:func:`gearcheck.mbd_models.static_state.static_state`), solved here once.
+
+One pass.  The text is written once (:func:`~gearcheck.mbd_models.mjcf_builder.document`), as a
+:class:`~gearcheck.mbd_models.mjcf_text.Template` whose late numbers -- the step, the meshes' stiffness, damping
+and coefficients, the pins' coefficients and spring lengths -- are slots.  Filled with placeholders (coefficients
+0, no mesh damping, ``PLACEHOLDER_STEP``) it is compiled, once; the numbers found above go into the compiled model
+and into :class:`~gearcheck.mbd_models.mjcf_text.LateValues`, and the file is the same template filled with them.
+The file compiled anew gives the twin's model to the bit but for ``tendon_invweight0``, which MuJoCo derives from
+the coefficients at compile time for tendon limits, friction loss and equalities (the twin has none)
+(``tests/test_twin_text.py``).  Until this design the text was rendered twice, the second time only to write those
+numbers; medians of 15 compiles (ms, a shared 2-core machine):
+
+    preset               compile_train  of it, writing the text   MuJoCo's compile
+                         before  after  before (2 x)  after (1 x + 2 fills)
+    demo-3p               19.4   15.0   4.1 + 4.1     4.3 + 0.1       3.6
+    demo-4p               20.9   16.1   4.2 + 4.2     4.4 + 0.1       3.7
+    double-planet         51.4   36.9  15.3 + 15.4   15.9 + 0.2      12.1
+    helical-planetary     47.0   36.9  13.5 + 13.5   14.7 + 0.2      11.7
+    hub-drive             44.0   34.3  10.4 + 11.0   11.1 + 0.3       8.4
+    rv-reducer            75.8   70.9   5.1 + 5.4     5.4 + 0.5       5.0  (static state 46)
+
+MuJoCo's own ``MjSpec`` would make the model the one description, but its ``to_xml`` (MuJoCo 4.0.0) cannot write
+the file: it drops the comments, reorders attributes and writes every number to 6 significant digits (the step
+3.3560532813411436e-06 as 3.35605e-06), so the file would neither match ``xml/`` nor hold the twin's numbers.
 """
 
 from __future__ import annotations
@@ -36,10 +59,9 @@ from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import TendonValues
 from gearcheck.mbd_models.elements.mesh import mesh_joints
 from gearcheck.mbd_models.mjcf_builder import document, header
-from gearcheck.mbd_models.mjcf_text import member_axes
+from gearcheck.mbd_models.mjcf_text import LateValues, member_axes
 from gearcheck.mbd_models.static_state import static_state
 from gearcheck.shared import stepping
 
@@ -217,8 +239,10 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     exc = Excitation(spec, kin)
     k = _stiffness_values(spec, exc, stiffness)
     joints = [mesh_joints(spec, mesh) for mesh in spec.meshes]
-    values = TendonValues(stiffness={mesh.label: value for mesh, value in zip(spec.meshes, k)})
-    model = mujoco.MjModel.from_xml_string(document(spec, values, PLACEHOLDER_STEP, []))
+    stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
+    text = document(spec, header(spec, stiffness_label))  # written once; its late numbers are slots
+    values = LateValues(PLACEHOLDER_STEP, stiffness={mesh.label: value for mesh, value in zip(spec.meshes, k)})
+    model = mujoco.MjModel.from_xml_string(text.fill(values))  # coefficients 0, no mesh damping, a placeholder step
 
     # MuJoCo's own coefficients at the reference configuration, into the compiled model
     data = mujoco.MjData(model)
@@ -249,8 +273,8 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
         for c, at in zip(mb.moving_contacts, mb.moving_slices()):
             c.contacts = touching[at]
             values.band.update(c.written()[1])
-    stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
-    mb.xml = document(spec, values, model.opt.timestep, header(spec, stiffness_label))
+    values.timestep = model.opt.timestep
+    mb.xml = text.fill(values)
     return mb
 
 

@@ -86,7 +86,7 @@ def torsion_row(part, build) -> Contribution:
 
 @MUJOCO.register("test-torsion")
 class Torsion(Element):
-    def tendons(self, part, spec, values) -> list[str]:
+    def tendons(self, part, spec) -> list[str]:
         a, b = spec.members[part.a].label, spec.members[part.b].label
         return fixed(f"{a}_{b}_torsion", [(f"{a}_rz", 1.0), (f"{b}_rz", -1.0)], part.stiffness, 0.0)
 

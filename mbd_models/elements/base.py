@@ -3,18 +3,6 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-
-
-@dataclass
-class TendonValues:
-    """The numbers of the tendons that are known only once the model is compiled, by tendon name: their joint
-    coefficients [(joint, coefficient)], stiffness, damping and spring length (dead band)."""
-
-    coefficients: dict = field(default_factory=dict)
-    stiffness: dict = field(default_factory=dict)
-    damping: dict = field(default_factory=dict)
-    band: dict = field(default_factory=dict)
 
 
 class Element:
@@ -24,7 +12,9 @@ class Element:
         """{(member id, joint suffix): (stiffness, damping)} the part puts on its members' joints."""
         return {}
 
-    def tendons(self, part, spec, values: TendonValues) -> list[str]:
+    def tendons(self, part, spec) -> list[str]:
+        """The part's tendons; a number known only once the twin is compiled is
+        :data:`~gearcheck.mbd_models.mjcf_text.LATE` (see :func:`~gearcheck.mbd_models.mjcf_text.fixed`)."""
         return []
 
     def actuators(self, part, spec) -> list[str]:

@@ -4,13 +4,13 @@
 from __future__ import annotations
 
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import Element, TendonValues
+from gearcheck.mbd_models.elements.base import Element
 from gearcheck.mbd_models.mjcf_text import ROTATION, fixed, member_axes
 
 
 @ELEMENTS.register("coupling")
 class Coupling(Element):
-    def tendons(self, c, spec, values: TendonValues) -> list[str]:
+    def tendons(self, c, spec) -> list[str]:
         a, b = spec.members[c.a].label, spec.members[c.b].label
         lines = fixed(f"coupling_{c.name}_torsion", [(f"{a}_{ROTATION}", 1.0), (f"{b}_{ROTATION}", -1.0)],
                       c.torsional_stiffness, c.torsional_damping)

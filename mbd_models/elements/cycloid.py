@@ -38,8 +38,9 @@ import numpy as np
 
 from gearcheck.mbd_models import gear_visuals
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import Element, TendonValues
+from gearcheck.mbd_models.elements.base import Element
 from gearcheck.mbd_models.mjcf_text import (
+    LATE,
     RGBA,
     VISUAL,
     central_body,
@@ -170,18 +171,17 @@ class Cycloid(Element):
                                         [])
         return lines + [f"    {line}" for line in _pins(spec, cyc, z_stage, visuals)]
 
-    def tendons(self, cyc, spec, values: TendonValues) -> list[str]:
+    def tendons(self, cyc, spec) -> list[str]:
         """One fixed tendon per pin and disc (:func:`pin_list` order): its length is the pin's compression plus
         its spring length's upper edge; the dead band from there down by ``PIN_BAND`` makes it compression only.
-        No damping here: the runner turns the contact damping on while the pin touches."""
+        Its coefficients and spring length are late numbers (those of t = 0, :meth:`CycloidTwin.written`).  No
+        damping here: the runner turns the contact damping on while the pin touches."""
         lines = []
         k = cyc.pin_stiffness(spec.operating.output_torque)
         for disc in cyc.discs:
             disc = spec.members[disc]
             for i in range(cyc.geometry.pins):
-                name = pin_tendon(disc, i)
-                coefs = values.coefficients.get(name) or [(j, 0.0) for j in pin_joints(spec, disc)]
-                lines += fixed(name, coefs, k, 0.0, values.band.get(name, (0.0, 0.0)))
+                lines += fixed(pin_tendon(disc, i), [(j, LATE) for j in pin_joints(spec, disc)], k, 0.0, LATE)
         return lines
 
     def actuators(self, cyc, spec) -> list[str]:

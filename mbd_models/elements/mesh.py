@@ -1,14 +1,15 @@
 """A gear mesh: a ``<fixed>`` tendon over the joints that move its pitch point (the central member's and the
 carrier's slides and hinges, the planet's slides and hinge, and their axial slides in a helical stage), whose
-length is the mesh deflection.  Its coefficients are not written from a formula here: they are given, taken by
-:func:`gearcheck.mbd_models.twin.compile_train` from MuJoCo's own Jacobians.  A backlash b = backlash/2 is the
+length is the mesh deflection.  Its coefficients are not written from a formula here: they are late numbers, taken
+by :func:`gearcheck.mbd_models.twin.compile_train` from MuJoCo's own Jacobians, as are its damping (from them and
+the compiled inertias) and its stiffness (compile_train's argument).  A backlash b = backlash/2 is the
 two-valued spring length "-b b" (a dead band)."""
 
 from __future__ import annotations
 
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import Element, TendonValues
-from gearcheck.mbd_models.mjcf_text import fixed, member_joints
+from gearcheck.mbd_models.elements.base import Element
+from gearcheck.mbd_models.mjcf_text import LATE, fixed, member_joints
 
 
 def mesh_joints(spec, mesh) -> list[str]:
@@ -20,10 +21,9 @@ def mesh_joints(spec, mesh) -> list[str]:
 
 @ELEMENTS.register("mesh")
 class Mesh(Element):
-    def tendons(self, mesh, spec, values: TendonValues) -> list[str]:
-        coefs = values.coefficients.get(mesh.label) or [(j, 0.0) for j in mesh_joints(spec, mesh)]
+    def tendons(self, mesh, spec) -> list[str]:
         b = 0.5 * mesh.backlash
-        return fixed(mesh.label, coefs, values.stiffness[mesh.label], values.damping.get(mesh.label, 0.0), (-b, b))
+        return fixed(mesh.label, [(j, LATE) for j in mesh_joints(spec, mesh)], LATE, LATE, (-b, b))
 
     def sensors(self, mesh, spec) -> list[str]:
         return [f'    <tendonpos name="{mesh.label}_deflection" tendon="{mesh.label}"/>',

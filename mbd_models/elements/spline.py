@@ -4,13 +4,13 @@ carrier) and hinges."""
 from __future__ import annotations
 
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import Element, TendonValues
+from gearcheck.mbd_models.elements.base import Element
 from gearcheck.mbd_models.mjcf_text import ROTATION, fixed, member_axes
 
 
 @ELEMENTS.register("spline")
 class Spline(Element):
-    def tendons(self, part, spec, values: TendonValues) -> list[str]:
+    def tendons(self, part, spec) -> list[str]:
         s = part.spline
         p, c = spec.members[part.planet].label, spec.members[part.crank].label
         radial, tangential = member_axes(spec.members[part.crank])

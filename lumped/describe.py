@@ -1,13 +1,13 @@
 """Derived quantities of a train, as ``gearcheck show`` prints them: ratio, speeds, gear geometry
 (helix angles), contact ratios (transverse and face), operating pressure angles, mesh frequencies and phases, loaded
-flanks, mesh stiffness and damping; an RV reducer's cycloid-pin stage."""
+flanks, mesh stiffness and damping; what the other parts show of themselves (an RV reducer's cycloid-pin stage:
+:meth:`gearcheck.train.parts.Part.describe`)."""
 
 from __future__ import annotations
 
 import math
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.train.cycloid import min_curvature_radius
 from gearcheck.shared.units import rad_s_to_rpm
 
 
@@ -34,8 +34,12 @@ def describe(spec) -> dict:
                 "helix_angle_deg": math.degrees(g.helix_angle), "normal_module_m": g.normal_module}
                 for mid in stage.centrals + stage.planets[:1] for g in spec.members[mid].gears.values()},
         })
-        if stage.cycloid:
-            out["stages"][-1]["cycloid"] = _cycloid(model, stage)
+    stages = {entry["name"]: entry for entry in out["stages"]}
+    touching = {r.name for r in model.rows if r.kind == "contact"}
+    for part in spec.parts:
+        shown = part.describe(spec, kin, touching)
+        if shown:
+            stages[part.stage][part.element] = shown
     for j, mesh in enumerate(spec.meshes):
         g = mesh.geometry
         out["meshes"].append({
@@ -48,21 +52,6 @@ def describe(spec) -> dict:
             "stiffness_model": mesh.stiffness["model"],
         })
     return out
-
-
-def _cycloid(model, stage) -> dict:
-    """An RV reducer's cycloid-pin stage: geometry, its margins, the pin-pass frequency, the contacts."""
-    cyc, g = stage.cycloid, stage.cycloid.geometry
-    touching = [r.name for r in model.rows if r.kind == "contact" and r.name.startswith(f"{stage.name}.disc")]
-    return {
-        "discs": len(cyc.discs), "cranks": len(cyc.cranks), "lobes": g.lobes, "pins": g.pins,
-        "eccentricity_m": g.eccentricity, "pin_circle_radius_m": g.pin_circle_radius, "pin_radius_m": g.pin_radius,
-        "K1": g.K1, "min_curvature_radius_m": min_curvature_radius(g),
-        "eccentric_phases_deg": [math.degrees(a) for a in cyc.phases],
-        "pin_frequency_hz": model.kin.mesh_frequency[f"{stage.name}.pins"],
-        "pin_stiffness_n_per_m": cyc.pin_stiffness(model.spec.operating.output_torque),
-        "pins_touching_at_rest": len(touching), "clearance_m": cyc.clearance,
-    }
 
 
 def _gear_label(member, gear) -> str:

@@ -86,8 +86,7 @@ def _check_linear(model: LumpedModel) -> None:
         reasons.append("a torque that varies")
     if any(not isinstance(e, CycloidRows) for e in model.turning):
         reasons.append("a radial coupling between frames that turn apart")
-    if any(s.cycloid.clearance > 0 for s in spec.stages if s.cycloid):
-        reasons.append("pin clearance")
+    reasons.extend(dict.fromkeys(zone for part in spec.parts for zone in part.dead_zones()))  # each named once
     if reasons:
         raise SolverError(f"{spec.name}: the harmonic methods solve a linear problem with constant load; this train "
                           f"has {', '.join(reasons)}: use time marching")

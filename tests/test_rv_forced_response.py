@@ -103,9 +103,11 @@ def test_the_fourier_series_method_misses_the_mean(slow_eccentric):
     assert abs(fs / static[:, i].mean() - 1.0) > 0.1
 
 
-def test_trains_the_harmonic_methods_cannot_hold_are_refused():
-    """Backlash is a contact nonlinearity: one line naming it."""
-    model = build_model(edited("demo-3p", [(r"^damping = \{ ratio = 0.05 \}",
-                                            "damping = { ratio = 0.05 }\nbacklash_um = 100.0")]))
-    with pytest.raises(SolverError, match="backlash"):
-        parametric_problem(model)
+@pytest.mark.parametrize("train, edit, reason", [
+    ("demo-3p", (r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nbacklash_um = 100.0"), "backlash"),
+    ("rv-reducer", (r"^contact = \{ (.*) \}$", r"contact = { \1, clearance_um = 3.0 }"), "has pin clearance:")])
+def test_trains_the_harmonic_methods_cannot_hold_are_refused(train, edit, reason):
+    """Backlash and the pins' clearance (a dead zone the part names) are contact nonlinearities: one line naming
+    each."""
+    with pytest.raises(SolverError, match=reason):
+        parametric_problem(build_model(edited(train, [edit])))

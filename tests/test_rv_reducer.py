@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from gearcheck.lumped import time_solver
-from gearcheck.lumped.assembly import build_model, frozen_at
+from gearcheck.lumped.assembly import build_model, contact_sets, frozen_at
+from gearcheck.lumped.describe import describe
 from gearcheck.train.loader import load_train
 from gearcheck.lumped.modal import modes
 from gearcheck.lumped.static import static_solution
@@ -62,6 +63,16 @@ def test_pin_contacts_take_the_load_on_one_side(model):
     for disc in range(2):  # a pin on the eccentric's line (arm 0) may be pressed by the disc's translation
         signs = np.sign(arms[disc][touching[disc] & (np.abs(arms[disc]) > 1e-9 * np.abs(arms).max())])
         assert len(np.unique(signs)) == 1
+
+
+def test_show_prints_the_cycloid_pin_stage_as_its_part_describes_it(model):
+    """``gearcheck show`` asks every part what it shows: the cycloid-pin stage, under its stage, with the pin pass
+    of the kinematics, the pins' stiffness that the model takes and how many pins touch in its static contact set."""
+    shown = describe(model.spec)["stages"][0]["cycloid"]
+    assert (shown["discs"], shown["cranks"], shown["pins"], shown["clearance_m"]) == (2, 3, 40, 0.0)
+    assert shown["pin_frequency_hz"] == model.kin.mesh_frequency["rv.pins"]
+    assert shown["pin_stiffness_n_per_m"] == model.turning[-1].pin_stiffness
+    assert shown["pins_touching_at_rest"] == contact_sets(model)[0].sum() > 0
 
 
 def test_frozen_configurations_turn_with_the_eccentric(model):

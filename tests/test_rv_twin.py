@@ -107,7 +107,7 @@ def test_no_load_run_deflects_only_under_the_orbit_loads():
                                  (r'model = "rectangular"', 'model = "constant"')], "no load")
     mb = compile_train(spec)
     result = simulate_mujoco(mb, RunSettings(duration=0.01, output_dt=20 * mb.default_step))
-    cyc = spec.stages[0].cycloid
+    cyc = spec.cycloids[0]
     orbit = spec.members["rv.disc1"].mass * cyc.geometry.eccentricity * mb.kin.speeds["rv.crank1"] ** 2
     needles = np.column_stack([result[n] for n in result.names("bearing_force") if ".needle_" in n])
     pins = np.column_stack([result[n] for n in result.names("pin_force") if n.endswith(".force") and ".pin" in n])

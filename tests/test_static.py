@@ -31,10 +31,10 @@ def rigid_turn(model):
         if member.orbits:
             turn[model.dofs(mid, "tangential")] = member.radius * model.kin.speeds[f"{member.stage}.carrier"]
         if member.kind == "disc":
-            cyc = model.spec.stage_of(mid).cycloid
-            phi, w_h = cyc.phases[cyc.discs.index(mid)], model.kin.speeds[cyc.cranks[0]]
-            turn[model.dofs(mid, "x")] = -cyc.geometry.eccentricity * w_h * np.sin(phi)
-            turn[model.dofs(mid, "y")] = cyc.geometry.eccentricity * w_h * np.cos(phi)
+            ecc = member.eccentric
+            phi, w_h = ecc.phase, model.kin.speeds[ecc.crank]
+            turn[model.dofs(mid, "x")] = -ecc.eccentricity * w_h * np.sin(phi)
+            turn[model.dofs(mid, "y")] = ecc.eccentricity * w_h * np.cos(phi)
     return turn
 
 

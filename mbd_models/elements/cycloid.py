@@ -100,22 +100,16 @@ def profile_mesh(stage) -> str:
 
 
 def pin_list(spec) -> list[tuple]:
-    """(stage, disc member, pin index) of every pin contact, in the order of their tendons."""
-    return [(stage, spec.members[disc], i) for stage in spec.stages if stage.cycloid
-            for disc in stage.cycloid.discs for i in range(stage.cycloid.geometry.pins)]
+    """(cycloid-pin stage, disc member, pin index) of every pin contact, in the order of their tendons."""
+    return [(cyc, spec.members[disc], i) for cyc in spec.cycloids for disc in cyc.discs
+            for i in range(cyc.geometry.pins)]
 
 
-def pin_joints(spec, disc) -> list[str]:
+def pin_joints(spec, cyc, disc) -> list[str]:
     """The joints that move a pin contact: the disc's and the pin wheel's (when it is a body)."""
-    wheel = spec.stage_of(disc.id).cycloid.pin_wheel
+    wheel = cyc.pin_wheel
     joints = [f"{disc.label}_{a}" for a in member_joints(disc)]
     return joints + ([f"{spec.members[wheel].label}_{a}" for a in member_joints(spec.members[wheel])] if wheel else [])
-
-
-def needle_list(spec) -> list[tuple]:
-    """(stage, crank member, disc member, eccentric j, crank k) of every needle bearing."""
-    return [(stage, spec.members[crank], spec.members[disc], j, k) for stage in spec.stages if stage.cycloid
-            for j, disc in enumerate(stage.cycloid.discs) for k, crank in enumerate(stage.cycloid.cranks)]
 
 
 @ELEMENTS.register("cycloid")
@@ -181,7 +175,7 @@ class Cycloid(Element):
         for disc in cyc.discs:
             disc = spec.members[disc]
             for i in range(cyc.geometry.pins):
-                lines += fixed(pin_tendon(disc, i), [(j, LATE) for j in pin_joints(spec, disc)], k, 0.0, LATE)
+                lines += fixed(pin_tendon(disc, i), [(j, LATE) for j in pin_joints(spec, cyc, disc)], k, 0.0, LATE)
         return lines
 
     def actuators(self, cyc, spec) -> list[str]:
@@ -209,6 +203,7 @@ class Cycloid(Element):
 
 
 def _needles(spec, cyc) -> list[tuple]:
+    """(crank member, disc member, eccentric j, crank k) of every needle bearing of ``cyc``."""
     return [(spec.members[crank], spec.members[disc], j, k) for j, disc in enumerate(cyc.discs)
             for k, crank in enumerate(cyc.cranks)]
 
@@ -299,18 +294,16 @@ class CycloidTwin:
         self.names = [f"{disc.id}.pin{i + 1}" for _, disc, i in pins]
         self.tendons = np.array([mujoco.mj_name2id(m, T, pin_tendon(disc, i)) for _, disc, i in pins], dtype=int)
         torque = spec.operating.output_torque
-        self.stiffness = np.array([stage.cycloid.pin_stiffness(torque) for stage, _, _ in pins])
-        self.damping = np.array([stage.cycloid.contact_damping for stage, _, _ in pins])
-        self.clearance = np.array([stage.cycloid.clearance for stage, _, _ in pins])
+        self.stiffness = np.array([cyc.pin_stiffness(torque) for cyc, _, _ in pins])
+        self.damping = np.array([cyc.contact_damping for cyc, _, _ in pins])
+        self.clearance = np.array([cyc.clearance for cyc, _, _ in pins])
         self.stages = []
         row = 0
-        for stage in spec.stages:
-            cyc = stage.cycloid
-            if not cyc:
-                continue
-            g, discs = cyc.geometry, [spec.members[disc] for disc in cyc.discs]
+        for cyc in spec.cycloids:
+            stage, g, discs = spec.stage_of(cyc.cranks[0]), cyc.geometry, [spec.members[disc] for disc in cyc.discs]
             rows = slice(row, row + g.pins * len(discs))
-            joints = np.array([[mujoco.mj_name2id(m, J, name) for name in pin_joints(spec, disc)] for disc in discs])
+            joints = np.array([[mujoco.mj_name2id(m, J, name) for name in pin_joints(spec, cyc, disc)]
+                               for disc in discs])
             tendons = self.tendons[rows].reshape(len(discs), g.pins)
             wraps = m.tendon_adr[tendons][..., None] + np.arange(joints.shape[1])
             assert np.array_equal(m.wrap_objid[wraps], np.broadcast_to(joints[:, None, :], wraps.shape))
@@ -321,10 +314,10 @@ class CycloidTwin:
                 np.array([mujoco.mj_name2id(m, S, pin_site(stage, i)) for i in range(g.pins)]),
                 m.jnt_dofadr[joints], m.jnt_qposadr[joints], wraps, np.empty((len(discs), 2, joints.shape[1]))))
             row = rows.stop
-        needles = needle_list(spec)
-        self.needle_names = [f"{crank.id}.{disc.id.split('.')[-1]}.needle" for _, crank, disc, _, _ in needles]
+        needles = [needle for cyc in spec.cycloids for needle in _needles(spec, cyc)]
+        self.needle_names = [f"{crank.id}.{disc.id.split('.')[-1]}.needle" for crank, disc, _, _ in needles]
         self.needles = np.array([[mujoco.mj_name2id(m, A, needle_actuator(crank, disc, axis)) for axis in "xy"]
-                                 for _, crank, disc, _, _ in needles], dtype=int)
+                                 for crank, disc, _, _ in needles], dtype=int)
         self.contacts = np.ones(len(self.tendons), dtype=bool)  # the static contact set at t = 0, once solved
         self._jac = np.zeros((3, m.nv))
         n = len(self.tendons)
@@ -393,9 +386,9 @@ class CycloidTwin:
         tendon name (what the model's file writes)."""
         m, spec = self.model, self.spec
         coefficients, bands = {}, {}
-        for (_, disc, i), t in zip(pin_list(spec), self.tendons):
+        for (cyc, disc, i), t in zip(pin_list(spec), self.tendons):
             coefficients[pin_tendon(disc, i)] = [(name, float(m.wrap_prm[m.tendon_adr[t] + w]))
-                                                 for w, name in enumerate(pin_joints(spec, disc))]
+                                                 for w, name in enumerate(pin_joints(spec, cyc, disc))]
             bands[pin_tendon(disc, i)] = tuple(m.tendon_lengthspring[t])
         return coefficients, bands
 

@@ -5,7 +5,8 @@
 on the housing, bearings of the members on carrier pins, interstage couplings, splines, the drive and the
 cycloid-pin stages.  The meshes (:class:`~gearcheck.train.spec.MeshSpec`), couplings
 (:class:`~gearcheck.train.spec.Coupling`) and cycloid-pin stages (:class:`~gearcheck.train.spec.CycloidStage`)
-are parts as the train file describes them; the others are written here from the members that carry them.
+are parts as the train file describes them (:class:`~gearcheck.train.spec.TrainSpec` holds them); the others
+are written here from the members that carry them, the splines from the cycloid-pin stages.
 """
 
 from __future__ import annotations
@@ -15,8 +16,8 @@ from typing import ClassVar
 
 
 class Part:
-    """What every part gives the train's nominal kinematics (:mod:`gearcheck.train.kinematics`); by default
-    nothing."""
+    """What every part gives the train's nominal kinematics (:mod:`gearcheck.train.kinematics`), the harmonic
+    methods and ``gearcheck show``; by default nothing."""
 
     def speed_rows(self, spec, index: dict) -> list:
         """(row, label) of each rigid constraint on the members' absolute speeds (``index``: member id ->
@@ -25,6 +26,17 @@ class Part:
 
     def frequencies(self, speeds: dict) -> dict[str, float]:
         """Frequencies (Hz) of the part's periodic contacts at the members' nominal ``speeds`` (rad/s), named."""
+        return {}
+
+    def dead_zones(self) -> list[str]:
+        """The part's clearances that its contacts cross before they touch (a load that depends on the contact
+        set), named."""
+        return []
+
+    def describe(self, spec, kin, touching: set[str]) -> dict:
+        """What ``gearcheck show`` prints of the part, in its stage (``stage``) under its kind: derived from
+        ``spec``, its kinematics ``kin`` and the names of the contacts ``touching`` at rest in the reference
+        model."""
         return {}
 
 
@@ -74,12 +86,10 @@ class DrivePart(Part):
 def train_parts(spec) -> tuple:
     """Every part of ``spec`` (a :class:`~gearcheck.train.spec.TrainSpec`), in build order."""
     supports = [SupportPart(mid, m.support, m.axial) for mid, m in spec.members.items() if m.support is not None]
-    bearings = [BearingPart(mid, stage.carrier, spec.members[mid].bearing, spec.members[mid].axial)
-                for stage in spec.stages for mid in stage.planets + (stage.cycloid.cranks if stage.cycloid else ())
-                if spec.members[mid].bearing is not None]
-    splines = [SplinePart(planet, crank, stage.cycloid.spline) for stage in spec.stages if stage.cycloid
-               for planet, crank in zip(stage.planets, stage.cycloid.cranks)]
+    bearings = [BearingPart(mid, spec.stage_of(mid).carrier, m.bearing, m.axial) for mid, m in spec.members.items()
+                if m.bearing is not None]
+    splines = [SplinePart(planet, crank, cyc.spline) for cyc in spec.cycloids
+               for planet, crank in zip(spec.stage_of(cyc.cranks[0]).planets, cyc.cranks)]
     op = spec.operating
     drive = DrivePart(spec.input, spec.output, op.input_shaft_stiffness, op.input_shaft_damping)
-    cycloids = [stage.cycloid for stage in spec.stages if stage.cycloid]
-    return (*spec.meshes, *supports, *bearings, *spec.couplings, *splines, drive, *cycloids)
+    return (*spec.meshes, *supports, *bearings, *spec.couplings, *splines, drive, *spec.cycloids)

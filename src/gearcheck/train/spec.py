@@ -2,9 +2,9 @@
 
 This is the single source both models are built from.  It holds the members (sun,
 ring, carrier, planets of every stage), their gears, supports and bearings, the
-meshes with their operating geometry, the interstage couplings and the operating
-point, all in SI units.  Every geometric rule of a planetary stage is checked here
-with an error that names the file and the field.
+meshes with their operating geometry, the interstage couplings, an RV reducer's
+cycloid-pin stages and the operating point, all in SI units.  Every geometric rule
+of a planetary stage is checked here with an error that names the file and the field.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, palmgren_stiffness
+from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, min_curvature_radius, palmgren_stiffness
 from gearcheck.train.files import read_text, read_toml
 from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
 from gearcheck.train.mesh_stiffness import MODELS
@@ -237,6 +237,25 @@ class CycloidStage(Part):
         wheel = speeds[self.pin_wheel] if self.pin_wheel else 0.0
         return {f"{self.stage}.pins": self.geometry.pins * abs(speeds[self.cranks[0]] - wheel) / (2 * math.pi)}
 
+    def dead_zones(self) -> list[str]:
+        """The pins' clearance, when there is one."""
+        return ["pin clearance"] if self.clearance > 0 else []
+
+    def describe(self, spec, kin, touching: set[str]) -> dict:
+        """Its geometry and margins, the pin-pass frequency, the pin contacts' stiffness, how many touch at rest
+        and the clearance."""
+        g = self.geometry
+        return {
+            "discs": len(self.discs), "cranks": len(self.cranks), "lobes": g.lobes, "pins": g.pins,
+            "eccentricity_m": g.eccentricity, "pin_circle_radius_m": g.pin_circle_radius, "pin_radius_m": g.pin_radius,
+            "K1": g.K1, "min_curvature_radius_m": min_curvature_radius(g),
+            "eccentric_phases_deg": [math.degrees(a) for a in self.phases],
+            "pin_frequency_hz": kin.mesh_frequency[f"{self.stage}.pins"],
+            "pin_stiffness_n_per_m": self.pin_stiffness(spec.operating.output_torque),
+            "pins_touching_at_rest": sum(name.startswith(f"{self.stage}.disc") for name in touching),
+            "clearance_m": self.clearance,
+        }
+
     def pin_stiffness(self, output_torque: float) -> float:
         """The stiffness of one pin contact: as given, or Palmgren's line contact linearised at the largest
         pin force F_max = 4 T_c / (Z_p r_c) of a rigid disc carrying T_c about its centre: its share of the
@@ -259,7 +278,6 @@ class Stage:
     planets: tuple[str, ...]
     carrier: str
     helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
-    cycloid: CycloidStage | None = None  # an RV reducer's second stage on this carrier
 
 
 @dataclass(frozen=True)
@@ -277,6 +295,7 @@ class TrainSpec:
     stages: tuple[Stage, ...]
     meshes: tuple[MeshSpec, ...]
     couplings: tuple[Coupling, ...]
+    cycloids: tuple[CycloidStage, ...]  # an RV reducer's second stage, on its first stage's carrier
     operating: Operating
     text_hash: str = ""
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
@@ -308,6 +327,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     members: dict[str, Member] = {}
     stages: list[Stage] = []
     meshes: list[MeshSpec] = []
+    cycloids: list[CycloidStage] = []
     names = [s["name"] for s in data["stages"]]
     for i, name in enumerate(names):
         if names.index(name) != i:
@@ -315,10 +335,11 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
 
     for i, st in enumerate(data["stages"]):
         path = f"stages[{i}]"
-        stage_members, stage, stage_meshes = _build_stage(st, path, fail)
+        stage_members, stage, stage_meshes, stage_cycloids = _build_stage(st, path, fail)
         members.update(stage_members)
         stages.append(stage)
         meshes.extend(stage_meshes)
+        cycloids.extend(stage_cycloids)
 
     train = data["train"]
     for key in ("input", "output"):
@@ -364,11 +385,10 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     profile = _torque_profile(op["torque_csv"], source, fail) if op["torque_csv"] is not None else None
     if op["input_torque"] is not None and op["output_torque"] is not None:
         raise fail("operating.input_torque", "give input_torque or output_torque, not both")
-    for i, stage in enumerate(stages):
-        if stage.cycloid and stage.cycloid.contact_stiffness is None and not (op["output_torque"]
-                                                                              or op["input_torque"]):
-            raise fail(f"stages[{i}].cycloid.contact.stiffness", "missing: give it, or a load (operating."
-                                                                 "output_torque) to linearise Palmgren's law at")
+    for cyc in cycloids:
+        if cyc.contact_stiffness is None and not (op["output_torque"] or op["input_torque"]):
+            raise fail(f"stages[{names.index(cyc.stage)}].cycloid.contact.stiffness",
+                       "missing: give it, or a load (operating.output_torque) to linearise Palmgren's law at")
     operating = Operating(op["input_speed"], op["output_torque"] or 0.0, op["input_shaft_stiffness"],
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
                           op["input_torque"])
@@ -376,8 +396,8 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
-        stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), operating=operating,
-        text_hash=text_hash, references=tuple(train["references"]),
+        stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), cycloids=tuple(cycloids),
+        operating=operating, text_hash=text_hash, references=tuple(train["references"]),
         measurements=tuple(_measurements(data, source, fail)),
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
         user_model=_user_model(train["user_model"], source),
@@ -577,7 +597,8 @@ def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:
 
 
 def _build_stage(st: dict, path: str, fail):
-    """A stage's members, its :class:`Stage` and its meshes, every geometric rule checked."""
+    """A stage's members, its :class:`Stage`, its meshes and its cycloid-pin stage (an RV reducer's; none
+    otherwise), every geometric rule checked."""
     name, n = st["name"], st["planets"]
     planet_gears = _planet_gears(st, path, fail)
     centrals = _central_gears(st, planet_gears, path, fail)
@@ -590,7 +611,7 @@ def _build_stage(st: dict, path: str, fail):
     _check_collision(planet_gears, angles, carrier_radius, path, fail)
     members = _stage_members(st, centrals, planet_gears, angles, carrier_radius, rv, path, fail)
     planet_ids = tuple(f"{name}.planet{k + 1}" for k in range(n))
-    cycloid = _cycloid_stage(st, members, angles, carrier_radius, path, fail) if rv else None
+    cycloids = (_cycloid_stage(st, members, angles, carrier_radius, path, fail),) if rv else ()
     meshes = _stage_meshes(st, centrals, planet_gears, geoms, planet_ids, path, fail)
     helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
     if helical:
@@ -600,8 +621,8 @@ def _build_stage(st: dict, path: str, fail):
     if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
         members = {mid: replace(m, axial=True) for mid, m in members.items()}
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
-                  f"{name}.carrier", helical, cycloid)
-    return members, stage, meshes
+                  f"{name}.carrier", helical)
+    return members, stage, meshes, cycloids
 
 
 def _planet_gears(st: dict, path: str, fail) -> dict[str, Gear]:

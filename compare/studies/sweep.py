@@ -282,7 +282,7 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
 
 
 def _check_run_options(duration, harmonics, integration_check, refine) -> None:
-    """Refuse a run setting of a sweep's points that is not a number of its range (or, for the check, a bool)."""
+    """Refuse a setting of every point's runs that is out of its range (the integration check: not a bool)."""
     if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
         raise GearcheckError(f"duration={duration!r}: needs a positive number of seconds")
     if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
@@ -317,8 +317,9 @@ def _varied_fields(document: dict, fields, distributions, samples) -> tuple[dict
 
 
 def _checked_speeds(speeds, varied: list) -> list[float] | None:
-    """``speeds`` (rpm) as floats, each one a train can turn at; None: the file's own speed.  The input speed is
-    swept by them alone, not also as a varied field of ``varied``."""
+    """``speeds`` (rpm) as floats, each a positive number of rpm no larger than any train turns at (whether this
+    train can is :func:`_check_speed_ends`'s); None: the file's own speed.  The input speed is swept by them alone,
+    not also as a varied field of ``varied``."""
     if speeds is None:
         return None
     speeds = [checked_rpm(float(s), "every speed of speeds=") for s in speeds]

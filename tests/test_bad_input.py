@@ -318,7 +318,7 @@ OPTIONS = [
     (["sensitivity", "rv-reducer", "--parameter", "stages[0].crank.nothing"],
      "--parameter stages[0].crank.nothing: no such field"),
     (["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--orders", "3", "2"],
-     "--orders 3 2: give 1 non-negative number, one per clock of this train (mesh)"),
+     "--orders (3, 2): give 1 non-negative number, one per clock of this train (mesh)"),
     (["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--coordinate", "sun.x"],
      "--coordinate 'sun.x': not a coordinate of demo-3p"),
     (["sensitivity", "hub-drive", "--parameter", "stages[0].sun.mass"],

@@ -276,7 +276,7 @@ def test_the_api_refuses_what_it_cannot_sweep():
         gearcheck.sweep(gearcheck.load("demo-3p"))
     with pytest.raises(GearcheckError, match="solver=euler: choose"):
         gearcheck.sweep("demo-3p", solver="euler")
-    with pytest.raises(GearcheckError, match="operating.input_speed_rpm is swept by --speeds"):
+    with pytest.raises(GearcheckError, match="operating.input_speed_rpm is swept by speeds=: give it there only"):
         gearcheck.sweep("demo-3p", speeds=[1000], fields={"operating.input_speed_rpm": [1000, 2000]})
 
 

@@ -94,13 +94,14 @@ def test_deterministic_for_a_seed_whatever_the_workers_and_chunks(frame, entries
 
 @pytest.mark.parametrize("laws, fits, message", [
     ({"stages[0].mesh.damping.ratio": "uniform(0.1, 0.05)"}, [FIT],
-     r"distribution of stages\[0\]\.mesh\.damping\.ratio 'uniform\(0.1, 0.05\)': needs low < high"),
+     r"distributions=stages\[0\]\.mesh\.damping\.ratio 'uniform\(0.1, 0.05\)': needs low < high"),
     ({"stages[0].mesh.damping.ratio": "beta(1, 2)"}, [FIT], r"stages\[0\]\.mesh\.damping\.ratio 'beta\(1, 2\)'"),
     ({"stages[0].mesh.damping.ratio": "lognormal(0.05, 0.5)"}, [FIT], r"needs median > 0 and factor > 1"),
-    ({"stages[0].sunn.mass": "uniform(1, 2)"}, [FIT], r"distribution stages\[0\]\.sunn\.mass: no such field"),
-    ({"stages[0].mesh.ste[0].amplitude_um": "uniform(1, 2)"}, [FIT], r"it is also fitted"),
+    ({"stages[0].sunn.mass": "uniform(1, 2)"}, [FIT], r"distributions=stages\[0\]\.sunn\.mass: no such field"),
+    ({"stages[0].mesh.ste[0].amplitude_um": "uniform(1, 2)"}, [FIT], r"it is also fitted \(fits=\)"),
     ({}, [FIT], r"distributions: need at least one"),
-    (LAWS, ["stages[0].mesh.ste[0].amplitude_um=5:1"], r"need 0 < LOW < HIGH"),
+    (LAWS, ["stages[0].mesh.ste[0].amplitude_um=5:1"],
+     r"^fits='stages\[0\]\.mesh\.ste\[0\]\.amplitude_um=5:1': need 0 < LOW < HIGH"),
 ])
 def test_bad_input_is_refused_in_one_line(entries, laws, fits, message):
     with pytest.raises(GearcheckError, match=message) as info:

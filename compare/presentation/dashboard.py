@@ -381,14 +381,48 @@ def _chart(labels: list, commits: list, lines: list, unit: str = "", log: bool =
     values = [v for line in lines for v in line.values if v is not None and math.isfinite(v)]
     levels = [v for v, _ in limits]
     lo, hi, ticks, log = _axis(values + levels, log)
-    x0, x1, y0, y1 = LEFT, WIDTH - RIGHT, TOP, HEIGHT - BOTTOM
-    keys, lx, ly = [], x0, HEIGHT - 12  # the legend, flowed left to right in as many rows as it takes
-    for line in lines if legend else []:
+    x0, x1, y0, y1 = _plot_box()
+    keys, height = _legend_layout(lines if legend else [])
+    x, y = _scales(n, lo, hi, log)
+    out = [f"<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"{height}\" "
+           f"viewBox=\"0 0 {WIDTH} {height}\" role=\"img\" class=\"chart\">",
+           f"<rect x=\"{x0}\" y=\"{y0}\" width=\"{x1 - x0}\" height=\"{y1 - y0}\" fill=\"#fafafa\" stroke=\"#bbb\"/>"]
+    out += _value_ticks(ticks, log, y)
+    out += _commit_labels(labels, x)
+    out += _limit_lines(limits, y)
+    out += _change_guides(lines, labels, commits, x)
+    for line in lines:
+        out += _series(line, commits, x, y)
+    for lx, ly, line in keys:
+        out.append(f"<line x1=\"{lx}\" x2=\"{lx + 18}\" y1=\"{ly}\" y2=\"{ly}\" stroke=\"{line.color}\" "
+                   f"stroke-width=\"2\"/><text x=\"{lx + 22}\" y=\"{ly + 4}\" font-size=\"11\">{_e(line.label)}</text>")
+    if unit and unit != "1":
+        out.append(f"<text x=\"4\" y=\"{y0 - 6}\" font-size=\"10\" fill=\"#555\">{_e(unit)}</text>")
+    return "".join(out) + "</svg>"
+
+
+def _plot_box() -> tuple[int, int, int, int]:
+    """The plotting area of a chart: left, right, top and bottom (SVG units, y down)."""
+    return LEFT, WIDTH - RIGHT, TOP, HEIGHT - BOTTOM
+
+
+def _legend_layout(lines: list) -> tuple[list, int]:
+    """Where each line's legend key goes, [(x, y, line)], flowed left to right in as many rows as it takes below
+    the plot, and the chart's height with them."""
+    x0 = _plot_box()[0]
+    keys, lx, ly = [], x0, HEIGHT - 12
+    for line in lines:
         if lx + 30 + 7 * len(line.label) > WIDTH and lx > x0:
             lx, ly = x0, ly + 16
         keys.append((lx, ly, line))
         lx += 30 + 7 * len(line.label)
-    height = ly + 12
+    return keys, ly + 12
+
+
+def _scales(n: int, lo: float, hi: float, log: bool):
+    """(x, y): a commit's index and a value (from ``lo`` to ``hi``, by decades on a ``log`` axis) as SVG
+    coordinates; a single commit sits in the middle."""
+    x0, x1, y0, y1 = _plot_box()
 
     def x(i):
         return (x0 + x1) / 2 if n == 1 else x0 + (x1 - x0) * i / (n - 1)
@@ -401,62 +435,83 @@ def _chart(labels: list, commits: list, lines: list, unit: str = "", log: bool =
             a, b = lo, hi
         return y1 - (y1 - y0) * (v - a) / (b - a)
 
-    out = [f"<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"{height}\" "
-           f"viewBox=\"0 0 {WIDTH} {height}\" role=\"img\" class=\"chart\">",
-           f"<rect x=\"{x0}\" y=\"{y0}\" width=\"{x1 - x0}\" height=\"{y1 - y0}\" fill=\"#fafafa\" stroke=\"#bbb\"/>"]
-    for t in ticks:
-        out.append(f"<line x1=\"{x0}\" x2=\"{x1}\" y1=\"{_f(y(t))}\" y2=\"{_f(y(t))}\" stroke=\"#e3e3e3\"/>"
-                   f"<text x=\"{x0 - 4}\" y=\"{_f(y(t) + 4)}\" font-size=\"10\" text-anchor=\"end\">"
-                   f"{_e(_tick(t, log))}</text>")
-    step = max(1, math.ceil(n / 8))  # commit labels at most 8 + 1, 60 px apart
+    return x, y
+
+
+def _value_ticks(ticks: list, log: bool, y) -> list[str]:
+    """A grid line and a label at each tick of the value axis."""
+    x0, x1 = _plot_box()[:2]
+    return [f"<line x1=\"{x0}\" x2=\"{x1}\" y1=\"{_f(y(t))}\" y2=\"{_f(y(t))}\" stroke=\"#e3e3e3\"/>"
+            f"<text x=\"{x0 - 4}\" y=\"{_f(y(t) + 4)}\" font-size=\"10\" text-anchor=\"end\">"
+            f"{_e(_tick(t, log))}</text>" for t in ticks]
+
+
+def _commit_labels(labels: list, x) -> list[str]:
+    """The commits' labels under the plot: at most 8 + 1, 60 px apart, the last one always."""
+    n = len(labels)
+    y1 = _plot_box()[3]
+    out = []
+    step = max(1, math.ceil(n / 8))
     for i in range(n):
         if (i % step == 0 and n - 1 - i >= step) or i == n - 1:
             anchor = "end" if i == n - 1 and n > 1 else "middle"
             out.append(f"<text x=\"{_f(x(i))}\" y=\"{y1 + 14}\" font-size=\"10\" text-anchor=\"{anchor}\" "
                        f"font-family=\"monospace\">{_e(labels[i])}</text>")
-    for value, label in limits:
-        out.append(f"<line class=\"limit\" x1=\"{x0}\" x2=\"{x1}\" y1=\"{_f(y(value))}\" y2=\"{_f(y(value))}\" "
-                   f"stroke=\"{TOLERANCE_COLOR}\" stroke-width=\"2\" stroke-dasharray=\"6 3\"/>"
-                   f"<text x=\"{x1 - 4}\" y=\"{_f(y(value) - 4)}\" font-size=\"10\" text-anchor=\"end\" "
-                   f"fill=\"{TOLERANCE_COLOR}\">{_e(label)} {_num(value)}</text>")
-    guides = sorted({i for line in lines for i in line.marks})
-    for i in guides:
+    return out
+
+
+def _limit_lines(limits, y) -> list[str]:
+    """Each limit [(value, label)] as a dashed horizontal line in the tolerance colour, labelled at its right."""
+    x0, x1 = _plot_box()[:2]
+    return [f"<line class=\"limit\" x1=\"{x0}\" x2=\"{x1}\" y1=\"{_f(y(value))}\" y2=\"{_f(y(value))}\" "
+            f"stroke=\"{TOLERANCE_COLOR}\" stroke-width=\"2\" stroke-dasharray=\"6 3\"/>"
+            f"<text x=\"{x1 - 4}\" y=\"{_f(y(value) - 4)}\" font-size=\"10\" text-anchor=\"end\" "
+            f"fill=\"{TOLERANCE_COLOR}\">{_e(label)} {_num(value)}</text>" for value, label in limits]
+
+
+def _change_guides(lines: list, labels: list, commits: list, x) -> list[str]:
+    """A dashed vertical guide, labelled with the short commit id, at every commit where a line has a change
+    point."""
+    x0, x1, y0, y1 = _plot_box()
+    out = []
+    for i in sorted({i for line in lines for i in line.marks}):
         anchor = "end" if x(i) > x1 - 40 else "start" if x(i) < x0 + 40 else "middle"
         out.append(f"<line class=\"change-guide\" x1=\"{_f(x(i))}\" x2=\"{_f(x(i))}\" y1=\"{y0}\" y2=\"{y1}\" "
                    f"stroke=\"{CHANGE_COLOR}\" stroke-dasharray=\"3 3\"/>"
                    f"<text class=\"change-label\" data-commit=\"{_e(commits[i])}\" x=\"{_f(x(i))}\" y=\"{y0 - 6}\" "
                    f"font-size=\"10\" text-anchor=\"{anchor}\" fill=\"{CHANGE_COLOR}\" font-family=\"monospace\">"
                    f"&#9670; {_e(labels[i])}</text>")
-    for line in lines:
-        path, pen = [], "M"
-        for i, v in enumerate(line.values):
-            if v is None or not math.isfinite(v):
-                pen = "M"
-                continue
-            path.append(f"{pen}{_f(x(i))} {_f(y(v))}")
-            pen = "L"
-        out.append(f"<path d=\"{' '.join(path)}\" fill=\"none\" stroke=\"{line.color}\" stroke-width=\"1.6\">"
-                   f"<title>{_e(line.label)}</title></path>")
-        for i, v in enumerate(line.values):
-            if v is None or not math.isfinite(v):
-                continue
-            status = line.statuses[i] if line.statuses else None
-            tip = f"<title>{_e(line.tips[i])}</title>" if line.tips and line.tips[i] else ""
-            if i in line.marks:
-                cx, cy = x(i), y(v)
-                out.append(f"<path class=\"change-point\" data-commit=\"{_e(commits[i])}\" "
-                           f"data-metric=\"{_e(line.metric)}\" d=\"M{_f(cx)} {_f(cy - 7)} L{_f(cx + 7)} {_f(cy)} "
-                           f"L{_f(cx)} {_f(cy + 7)} L{_f(cx - 7)} {_f(cy)} Z\" fill=\"{CHANGE_COLOR}\" "
-                           f"stroke=\"#fff\">{tip}</path>")
-            elif n <= MAX_POINTS or status in ("fail", "unresolved"):
-                fill = STATUS_COLOR.get(status, line.color) if status else line.color
-                out.append(f"<circle cx=\"{_f(x(i))}\" cy=\"{_f(y(v))}\" r=\"3\" fill=\"{fill}\">{tip}</circle>")
-    for lx, ly, line in keys:
-        out.append(f"<line x1=\"{lx}\" x2=\"{lx + 18}\" y1=\"{ly}\" y2=\"{ly}\" stroke=\"{line.color}\" "
-                   f"stroke-width=\"2\"/><text x=\"{lx + 22}\" y=\"{ly + 4}\" font-size=\"11\">{_e(line.label)}</text>")
-    if unit and unit != "1":
-        out.append(f"<text x=\"4\" y=\"{y0 - 6}\" font-size=\"10\" fill=\"#555\">{_e(unit)}</text>")
-    return "".join(out) + "</svg>"
+    return out
+
+
+def _series(line: Line, commits: list, x, y) -> list[str]:
+    """One line: its path (broken where a value is missing), then its points: a diamond at a change point, a dot
+    coloured by its status elsewhere (only failed or unresolved ones above :data:`MAX_POINTS` commits)."""
+    n = len(commits)
+    path, pen = [], "M"
+    for i, v in enumerate(line.values):
+        if v is None or not math.isfinite(v):
+            pen = "M"
+            continue
+        path.append(f"{pen}{_f(x(i))} {_f(y(v))}")
+        pen = "L"
+    out = [f"<path d=\"{' '.join(path)}\" fill=\"none\" stroke=\"{line.color}\" stroke-width=\"1.6\">"
+           f"<title>{_e(line.label)}</title></path>"]
+    for i, v in enumerate(line.values):
+        if v is None or not math.isfinite(v):
+            continue
+        status = line.statuses[i] if line.statuses else None
+        tip = f"<title>{_e(line.tips[i])}</title>" if line.tips and line.tips[i] else ""
+        if i in line.marks:
+            cx, cy = x(i), y(v)
+            out.append(f"<path class=\"change-point\" data-commit=\"{_e(commits[i])}\" "
+                       f"data-metric=\"{_e(line.metric)}\" d=\"M{_f(cx)} {_f(cy - 7)} L{_f(cx + 7)} {_f(cy)} "
+                       f"L{_f(cx)} {_f(cy + 7)} L{_f(cx - 7)} {_f(cy)} Z\" fill=\"{CHANGE_COLOR}\" "
+                       f"stroke=\"#fff\">{tip}</path>")
+        elif n <= MAX_POINTS or status in ("fail", "unresolved"):
+            fill = STATUS_COLOR.get(status, line.color) if status else line.color
+            out.append(f"<circle cx=\"{_f(x(i))}\" cy=\"{_f(y(v))}\" r=\"3\" fill=\"{fill}\">{tip}</circle>")
+    return out
 
 
 def _axis(values: list, log: bool) -> tuple[float, float, list, bool]:

@@ -450,51 +450,30 @@ def pin_loads(loads, index: int = 0, title: str | None = None) -> bytes:
     end) and each
     disc's profile and eccentric; right, the force against the pin's angle from its disc's eccentric over every
     time, beside the rigid-disc share and the classical peak 4 T / (Z_p r_c)."""
-    g = loads.geometry
-    mm = 1e3
     fig = Figure(figsize=(12.0, 5.6), layout="constrained")
     ax, bx = fig.subplots(1, 2, width_ratios=(1.0, 1.25))
-    n_discs = loads.forces.shape[1]
-    # ---- pin circle
-    t = loads.times[index]
-    force, classical = loads.forces[index], loads.classical[index]
-    psi = loads.pin_angles[index]
+    _pin_circle(ax, loads, index)
+    _pin_force_against_angle(bx, loads)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return _png(fig)
+
+
+def _pin_circle(ax, loads, index: int) -> None:
+    """The pin circle at ``times[index]`` (mm, carrier frame): the pins, each disc with its loaded pins' bars and
+    rigid-disc ticks, a force scale bar."""
+    g = loads.geometry
+    mm = 1e3
     scale = 0.45 * g.pin_circle_radius * mm / max(float(loads.forces.max()), float(loads.classical.max()), 1e-300)
     circle = np.linspace(0, 2 * np.pi, 361)
     ax.plot(g.pin_circle_radius * mm * np.cos(circle), g.pin_circle_radius * mm * np.sin(circle), color="0.6",
             lw=0.8, ls="--")
-    for c in psi:
+    for c in loads.pin_angles[index]:
         centre = g.pin_circle_radius * mm * np.array([math.cos(c), math.sin(c)])
         ax.plot(centre[0] + g.pin_radius * mm * np.cos(circle), centre[1] + g.pin_radius * mm * np.sin(circle),
                 color="0.35", lw=0.7)
-    pitch = 2 * np.pi / g.pins
-    base = g.pin_circle_radius * mm + g.pin_radius * mm
-    for j in range(n_discs):
-        colour = DISC_COLOURS[j % len(DISC_COLOURS)]
-        phi = loads.eccentric_angles[index, j]
-        theta = float(conjugate_disc_angle(g, phi, loads.pin_angles[index, 0]))
-        rot = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
-        profile = (disc_profile(g, points_per_lobe=24) @ rot.T + g.eccentricity * np.array([math.cos(phi),
-                                                                                            math.sin(phi)])) * mm
-        ax.plot(np.r_[profile[:, 0], profile[0, 0]], np.r_[profile[:, 1], profile[0, 1]], color=colour, lw=0.6,
-                alpha=0.6)
-        ax.annotate("", xy=(0.55 * g.pin_circle_radius * mm * math.cos(phi),
-                            0.55 * g.pin_circle_radius * mm * math.sin(phi)), xytext=(0, 0),
-                    arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.2})
-        offset = (j - (n_discs - 1) / 2) * pitch / (n_discs + 1)
-        for i in np.nonzero(force[j] > 0)[0]:
-            a = psi[i] + offset
-            u = np.array([math.cos(a), math.sin(a)])
-            tip = base + scale * force[j, i]
-            ax.plot([base * u[0], tip * u[0]], [base * u[1], tip * u[1]], color=colour, lw=4.0,
-                    solid_capstyle="butt")
-        for i in np.nonzero(classical[j] > 0)[0]:
-            a = psi[i] + offset
-            u, w = np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
-            tip = (base + scale * classical[j, i]) * u
-            ax.plot(*np.array([tip - 2.0 * w, tip + 2.0 * w]).T, color="k", lw=0.9)
-        ax.plot([], [], color=colour, lw=4.0, label=f"disc {j + 1}: {int((force[j] > 0).sum())} pins, "
-                                                     f"peak {force[j].max():.0f} N")
+    for j in range(loads.forces.shape[1]):
+        _disc_on_pin_circle(ax, loads, index, j, scale)
     ax.plot([], [], color="k", lw=0.9, label="rigid-disc share (tick)")
     ref = 10 ** math.floor(math.log10(max(float(loads.forces.max()), 1e-300)))
     reach = g.pin_circle_radius * mm + 0.5 * g.pin_circle_radius * mm
@@ -506,14 +485,54 @@ def pin_loads(loads, index: int = 0, title: str | None = None) -> bytes:
     ax.set_ylim(-lim, lim)
     ax.set_xlabel("x (mm), carrier frame")
     ax.set_ylabel("y (mm)")
-    ax.set_title(f"pin forces at t = {t * 1e3:.3f} ms (arrows: eccentrics)", fontsize=10)
+    ax.set_title(f"pin forces at t = {loads.times[index] * 1e3:.3f} ms (arrows: eccentrics)", fontsize=10)
     ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.1), ncol=2, fontsize=7.5, frameon=False)
-    # ---- force against the pin's angle from its eccentric
+
+
+def _disc_on_pin_circle(ax, loads, index: int, j: int, scale: float) -> None:
+    """Disc ``j`` at ``times[index]``: its profile, an arrow along its eccentric, a radial bar of ``scale`` mm/N
+    per loaded pin (side by side with the other discs' within a pitch) and a tick at its rigid-disc share."""
+    g = loads.geometry
+    mm = 1e3
+    n_discs = loads.forces.shape[1]
+    force, classical, psi = loads.forces[index], loads.classical[index], loads.pin_angles[index]
+    base = g.pin_circle_radius * mm + g.pin_radius * mm
+    colour = DISC_COLOURS[j % len(DISC_COLOURS)]
+    phi = loads.eccentric_angles[index, j]
+    theta = float(conjugate_disc_angle(g, phi, loads.pin_angles[index, 0]))
+    rot = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
+    profile = (disc_profile(g, points_per_lobe=24) @ rot.T + g.eccentricity * np.array([math.cos(phi),
+                                                                                        math.sin(phi)])) * mm
+    ax.plot(np.r_[profile[:, 0], profile[0, 0]], np.r_[profile[:, 1], profile[0, 1]], color=colour, lw=0.6,
+            alpha=0.6)
+    ax.annotate("", xy=(0.55 * g.pin_circle_radius * mm * math.cos(phi),
+                        0.55 * g.pin_circle_radius * mm * math.sin(phi)), xytext=(0, 0),
+                arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.2})
+    offset = (j - (n_discs - 1) / 2) * (2 * np.pi / g.pins) / (n_discs + 1)
+    for i in np.nonzero(force[j] > 0)[0]:
+        a = psi[i] + offset
+        u = np.array([math.cos(a), math.sin(a)])
+        tip = base + scale * force[j, i]
+        ax.plot([base * u[0], tip * u[0]], [base * u[1], tip * u[1]], color=colour, lw=4.0,
+                solid_capstyle="butt")
+    for i in np.nonzero(classical[j] > 0)[0]:
+        a = psi[i] + offset
+        u, w = np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
+        tip = (base + scale * classical[j, i]) * u
+        ax.plot(*np.array([tip - 2.0 * w, tip + 2.0 * w]).T, color="k", lw=0.9)
+    ax.plot([], [], color=colour, lw=4.0, label=f"disc {j + 1}: {int((force[j] > 0).sum())} pins, "
+                                                 f"peak {force[j].max():.0f} N")
+
+
+def _pin_force_against_angle(bx, loads) -> None:
+    """Every disc's pin forces at every time against the pin's angle from its disc's eccentric, beside the
+    rigid-disc share and the classical peak 4 T / (Z_p r_c)."""
+    g = loads.geometry
     fine = np.linspace(-np.pi, np.pi, 721)
     wrapped = np.degrees(np.mod(loads.relative_angles + np.pi, 2 * np.pi) - np.pi)  # (-180, 180]: one loaded zone
     k1 = g.K1
     arm = g.rolling_radius * np.sin(fine) / np.sqrt(1 + k1 * k1 - 2 * k1 * np.cos(fine))
-    for j in range(n_discs):
+    for j in range(loads.forces.shape[1]):
         colour = DISC_COLOURS[j % len(DISC_COLOURS)]
         on = loads.forces[:, j, :] > 0
         bx.plot(wrapped[:, j, :][on], loads.forces[:, j, :][on], ls="none",
@@ -535,9 +554,6 @@ def pin_loads(loads, index: int = 0, title: str | None = None) -> bytes:
                  f"4 T/(Z_p r_c) (rigid disc: {rigid.min()}-{rigid.max()} pins)", fontsize=10)
     bx.legend(loc="upper left", fontsize=7.5, frameon=False)
     bx.grid(True, lw=0.3)
-    if title:
-        fig.suptitle(title, fontsize=11)
-    return _png(fig)
 
 
 def sensitivity_map(frame, coordinate: str, title: str) -> bytes:

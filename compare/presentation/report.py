@@ -488,22 +488,98 @@ NULLABLE_STRING, NULLABLE_NUMBER = {"type": ["string", "null"]}, {"type": ["numb
 def report_schema() -> dict:
     """The JSON Schema (draft 2020-12) of ``report.json``, schema ``gearcheck.crosscheck`` version 1, as
     :func:`to_dict` writes it."""
-    ratio, ratio_or_null = _value(RATIO), _value(RATIO, nullable=True)
-    stats = _object({k: {"$ref": "#/$defs/value"} for k in ("mean", "rms", "peak_to_peak", "peak")})
-    measurement = _object({
-        "quantity": STRING, "metric": {"enum": list(MEASUREMENT.fields["metric"].choices)}, "source": STRING,
+    return {
+        "$schema": DRAFT,
+        "title": f"gearcheck cross-check report ({SCHEMA} version {SCHEMA_VERSION})",
+        "description": "report.json of `gearcheck crosscheck`. Numbers with a unit are {value, unit} objects; "
+                       "ratios have unit '1'. 'lumped' and 'mujoco' name the reference and the test side, whatever "
+                       "their solvers ('solvers'). Only 'volatile' changes between runs of the same inputs.",
+        "type": "object",
+        "properties": _report_properties(),
+        "required": ["schema", "schema_version", "train", "calibration", "provenance", "settings", "verdict",
+                     "steady_state", "modes", "modes_tolerance", "solvers", "diagnosis", "quantities",
+                     "measurements", "notes", "references", "volatile"],
+        "additionalProperties": False,
+        "$defs": {"value": _value(), "measurement": _measurement_schema(), "candidate": _candidate_schema()},
+    }
+
+
+def _report_properties() -> dict:
+    """The schema of each top-level field of ``report.json``, in the order :func:`to_dict` writes them."""
+    seconds = _value("s")
+    return {
+        "schema": {"const": SCHEMA}, "schema_version": {"const": SCHEMA_VERSION},
+        "train": _object({"name": STRING, "description": STRING, "source": STRING}),
+        "calibration": {"anyOf": [_object({"from": STRING, "fitted": _array(STRING)}), {"type": "null"}],
+                        "description": "the calibrated train file's origin and fitted fields (its header), "
+                                       "null for a train file's own parameters"},
+        "provenance": _object({
+            "gearcheck_version": STRING, "git_revision": NULLABLE_STRING, "mujoco_version": STRING,
+            "numpy_version": STRING, "python": STRING, "machine": STRING, "lumped_solver": {"type": "object"},
+            "mujoco_solver": {"type": "object"}, "train_file": STRING, "train_sha256": STRING}),
+        "settings": _settings_schema(),
+        "verdict": _verdict_schema(),
+        "steady_state": _object({"start": seconds, "detected": BOOLEAN,
+                                 "how": {"enum": ["detected", "decayed", "transient", None]},
+                                 "settling_time": _value("s", nullable=True)}),
+        "modes": _array(_object({
+            "mode": {"type": "integer"}, "type": STRING, "multiplicity": {"type": "integer"},
+            "lumped": _value("Hz"), "mujoco": _value("Hz"), "mujoco_type": STRING, "rel_error": _value(RATIO),
+            "status": {"enum": ["fail", "pass"]}})),
+        "modes_tolerance": _value(RATIO),
+        "solvers": _object({"reference": STRING, "test": STRING}),
+        "diagnosis": _diagnosis_schema(),
+        "quantities": _array(_quantity_schema()),
+        "measurements": _array({"$ref": "#/$defs/measurement"}),
+        "notes": _array(STRING),
+        "references": _array(_object({"key": STRING, "citation": STRING})),
+        "volatile": _object({"timestamp": {"type": "string", "format": "date-time"},
+                             "wall_time": {"type": "object", "additionalProperties": seconds}}),
+    }
+
+
+def _settings_schema() -> dict:
+    """``settings``: the run's settings, open to those a published 4-DOF model's run adds."""
+    seconds = _value("s")
+    return _object({
+        "duration": seconds, "simulated": seconds, "input_speed": _value("rpm"),
+        "output_torque": _value("N·m"), "lumped": {"type": "object"}, "mujoco": {"type": "object"},
+        "common_sample_rate": _value("Hz"), "steady_cycle": seconds,
+        "integration_check_steps": _value("s", {"type": "array", "items": NULLABLE_NUMBER}),
         "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
-        "measured": {"$ref": "#/$defs/value"}, "lumped": {"$ref": "#/$defs/value"},
-        "mujoco": {"$ref": "#/$defs/value"}, "published_model": _value(nullable=True),
-        "error_lumped": ratio, "error_mujoco": ratio, "error_published_model": ratio_or_null,
-    }, description="a measured value beside both solvers' statistic of it; errors (model - measured)/|measured|")
-    candidate = _object({
-        "term": STRING, "kind": {"enum": list(KINDS)}, "score": NUMBER,
-        "parts": {"type": "object", "additionalProperties": NUMBER}, "row": STRING, "coordinate": STRING,
-        "member": STRING, "factor": NUMBER, "coordinates": _array(STRING),
-        "equivalents": _array({"$ref": "#/$defs/candidate"}),
-    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference")
-    quantity = _object({
+        "tolerances": {"type": "object", "additionalProperties": _value(RATIO)},
+    }, closed=False, description="run settings; a published 4-DOF model's run adds its own")
+
+
+def _verdict_schema() -> dict:
+    """``verdict``: the verdict, what failed or stayed unresolved, what moved from a baseline, the counts."""
+    counts = lambda keys: _object({k: {"type": "integer", "minimum": 0} for k in keys})  # noqa: E731
+    return _object({
+        "verdict": {"enum": ["PASS", "FAIL", "INCONCLUSIVE"]}, "passed": BOOLEAN,
+        "failures": _array(STRING), "unresolved": _array(STRING),
+        "moved_from_baseline": {"anyOf": [_array(STRING), {"type": "null"}],
+                                "description": "null: no baseline checked"},
+        "counts": _object({"quantities": counts(STATUSES), "modes": counts(("fail", "pass")),
+                           "spectral_lines": counts(("fail", "pass", "negligible"))}),
+    })
+
+
+def _diagnosis_schema() -> dict:
+    """``diagnosis``: a user's model's best-explaining term of the reference, or null."""
+    return {"anyOf": [_object({
+        "train": STRING, "agrees": BOOLEAN, "reduced_to": {"type": ["integer", "null"]},
+        "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
+        "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
+        "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"})}),
+        {"type": "null"}], "description": "a user's model: the term of the reference that best explains "
+                                          "its modes; null otherwise"}
+
+
+def _quantity_schema() -> dict:
+    """An entry of ``quantities``: one compared signal, its statistics, errors, spectrum and measurements."""
+    ratio_or_null = _value(RATIO, nullable=True)
+    stats = _object({k: {"$ref": "#/$defs/value"} for k in ("mean", "rms", "peak_to_peak", "peak")})
+    return _object({
         "name": STRING, "kind": STRING, "unit": STRING, "description": STRING,
         "status": {"enum": list(STATUSES)}, "tolerance_nrmse": ratio_or_null,
         "lumped": stats, "mujoco": stats,
@@ -518,67 +594,25 @@ def report_schema() -> dict:
         }), "spectral lines; status advisory: fail when |rel_error| exceeds the quantity's NRMSE tolerance"),
         "measured": _array({"$ref": "#/$defs/measurement"}),
     }, description="one compared signal: 'lumped' is the reference (a), 'mujoco' the test (b) whatever solvers")
-    counts = lambda keys: _object({k: {"type": "integer", "minimum": 0} for k in keys})  # noqa: E731
-    seconds = _value("s")
-    return {
-        "$schema": DRAFT,
-        "title": f"gearcheck cross-check report ({SCHEMA} version {SCHEMA_VERSION})",
-        "description": "report.json of `gearcheck crosscheck`. Numbers with a unit are {value, unit} objects; "
-                       "ratios have unit '1'. 'lumped' and 'mujoco' name the reference and the test side, whatever "
-                       "their solvers ('solvers'). Only 'volatile' changes between runs of the same inputs.",
-        "type": "object",
-        "properties": {
-            "schema": {"const": SCHEMA}, "schema_version": {"const": SCHEMA_VERSION},
-            "train": _object({"name": STRING, "description": STRING, "source": STRING}),
-            "calibration": {"anyOf": [_object({"from": STRING, "fitted": _array(STRING)}), {"type": "null"}],
-                            "description": "the calibrated train file's origin and fitted fields (its header), "
-                                           "null for a train file's own parameters"},
-            "provenance": _object({
-                "gearcheck_version": STRING, "git_revision": NULLABLE_STRING, "mujoco_version": STRING,
-                "numpy_version": STRING, "python": STRING, "machine": STRING, "lumped_solver": {"type": "object"},
-                "mujoco_solver": {"type": "object"}, "train_file": STRING, "train_sha256": STRING}),
-            "settings": _object({
-                "duration": seconds, "simulated": seconds, "input_speed": _value("rpm"),
-                "output_torque": _value("N·m"), "lumped": {"type": "object"}, "mujoco": {"type": "object"},
-                "common_sample_rate": _value("Hz"), "steady_cycle": seconds,
-                "integration_check_steps": _value("s", {"type": "array", "items": NULLABLE_NUMBER}),
-                "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
-                "tolerances": {"type": "object", "additionalProperties": ratio},
-            }, closed=False, description="run settings; a published 4-DOF model's run adds its own"),
-            "verdict": _object({
-                "verdict": {"enum": ["PASS", "FAIL", "INCONCLUSIVE"]}, "passed": BOOLEAN,
-                "failures": _array(STRING), "unresolved": _array(STRING),
-                "moved_from_baseline": {"anyOf": [_array(STRING), {"type": "null"}],
-                                        "description": "null: no baseline checked"},
-                "counts": _object({"quantities": counts(STATUSES), "modes": counts(("fail", "pass")),
-                                   "spectral_lines": counts(("fail", "pass", "negligible"))}),
-            }),
-            "steady_state": _object({"start": seconds, "detected": BOOLEAN,
-                                     "how": {"enum": ["detected", "decayed", "transient", None]},
-                                     "settling_time": _value("s", nullable=True)}),
-            "modes": _array(_object({
-                "mode": {"type": "integer"}, "type": STRING, "multiplicity": {"type": "integer"},
-                "lumped": _value("Hz"), "mujoco": _value("Hz"), "mujoco_type": STRING, "rel_error": ratio,
-                "status": {"enum": ["fail", "pass"]}})),
-            "modes_tolerance": ratio,
-            "solvers": _object({"reference": STRING, "test": STRING}),
-            "diagnosis": {"anyOf": [_object({
-                "train": STRING, "agrees": BOOLEAN, "reduced_to": {"type": ["integer", "null"]},
-                "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
-                "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
-                "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"})}),
-                {"type": "null"}], "description": "a user's model: the term of the reference that best explains "
-                                                  "its modes; null otherwise"},
-            "quantities": _array(quantity),
-            "measurements": _array({"$ref": "#/$defs/measurement"}),
-            "notes": _array(STRING),
-            "references": _array(_object({"key": STRING, "citation": STRING})),
-            "volatile": _object({"timestamp": {"type": "string", "format": "date-time"},
-                                 "wall_time": {"type": "object", "additionalProperties": seconds}}),
-        },
-        "required": ["schema", "schema_version", "train", "calibration", "provenance", "settings", "verdict",
-                     "steady_state", "modes", "modes_tolerance", "solvers", "diagnosis", "quantities",
-                     "measurements", "notes", "references", "volatile"],
-        "additionalProperties": False,
-        "$defs": {"value": _value(), "measurement": measurement, "candidate": candidate},
-    }
+
+
+def _measurement_schema() -> dict:
+    """``$defs/measurement``: a measured value beside both solvers' statistic of it."""
+    ratio = _value(RATIO)
+    return _object({
+        "quantity": STRING, "metric": {"enum": list(MEASUREMENT.fields["metric"].choices)}, "source": STRING,
+        "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
+        "measured": {"$ref": "#/$defs/value"}, "lumped": {"$ref": "#/$defs/value"},
+        "mujoco": {"$ref": "#/$defs/value"}, "published_model": _value(nullable=True),
+        "error_lumped": ratio, "error_mujoco": ratio, "error_published_model": _value(RATIO, nullable=True),
+    }, description="a measured value beside both solvers' statistic of it; errors (model - measured)/|measured|")
+
+
+def _candidate_schema() -> dict:
+    """``$defs/candidate``: a one-term change of the reference that a diagnosis tried."""
+    return _object({
+        "term": STRING, "kind": {"enum": list(KINDS)}, "score": NUMBER,
+        "parts": {"type": "object", "additionalProperties": NUMBER}, "row": STRING, "coordinate": STRING,
+        "member": STRING, "factor": NUMBER, "coordinates": _array(STRING),
+        "equivalents": _array({"$ref": "#/$defs/candidate"}),
+    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference")

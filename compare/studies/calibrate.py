@@ -46,16 +46,18 @@ LOG_STEP = 0.05  # finite-difference step in ln p: a peak of a simulated signal 
 
 @dataclass
 class FitParameter:
-    """A number of a train file addressed by its path (``stages[0].sun.mass``), as ``option`` names it."""
+    """A number of a train file addressed by its path (``stages[0].sun.mass``), given by the Python argument
+    ``argument``, which its messages name (``fit=stages[0].sun.mass: ...``; the command line names its flag
+    instead: :func:`gearcheck.cli.as_flags`)."""
 
     path: str
     low: float
     high: float
     keys: list = field(default_factory=list)
-    option: str = "--fit"
+    argument: str = "fit"
 
     @classmethod
-    def parse(cls, text: str, option: str = "--fit") -> "FitParameter":
+    def parse(cls, text: str, argument: str = "fit") -> "FitParameter":
         """``PATH`` or ``PATH=LOW:HIGH`` (bounds in the file's units; default 1/100 to 100 times the file's
         value, which is the start; a value outside the bounds starts at their geometric mean)."""
         path, _, bounds = text.partition("=")
@@ -63,7 +65,7 @@ class FitParameter:
         for part in path.split("."):
             m = re.fullmatch(r"([A-Za-z_][\w\-]*)((?:\[\d+\])*)", part)
             if not m:
-                raise GearcheckError(f"{option} {text!r}: {part!r} is not a key or key[index]")
+                raise GearcheckError(f"{argument}={text!r}: {part!r} is not a key or key[index]")
             keys.append(m.group(1))
             keys += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
         low = high = math.nan
@@ -71,10 +73,10 @@ class FitParameter:
             try:
                 low, high = (float(b) for b in bounds.split(":"))
             except ValueError:
-                raise GearcheckError(f"{option} {text!r}: bounds must be LOW:HIGH numbers") from None
+                raise GearcheckError(f"{argument}={text!r}: bounds must be LOW:HIGH numbers") from None
             if not (0 < low < high and math.isfinite(high)):
-                raise GearcheckError(f"{option} {text!r}: need 0 < LOW < HIGH")
-        return cls(path, low, high, keys, option)
+                raise GearcheckError(f"{argument}={text!r}: need 0 < LOW < HIGH")
+        return cls(path, low, high, keys, argument)
 
     def get(self, document):
         node = document
@@ -82,11 +84,11 @@ class FitParameter:
             for k in self.keys:
                 node = node[k]
         except (KeyError, IndexError, TypeError):
-            raise GearcheckError(f"{self.option} {self.path}: no such field in the train file") from None
+            raise GearcheckError(f"{self.argument}={self.path}: no such field in the train file") from None
         if isinstance(node, bool) or not isinstance(node, (int, float)):
-            raise GearcheckError(f"{self.option} {self.path}: {node!r} is not a number")
+            raise GearcheckError(f"{self.argument}={self.path}: {node!r} is not a number")
         if node <= 0:
-            raise GearcheckError(f"{self.option} {self.path}: the value {node} must be positive (it is varied "
+            raise GearcheckError(f"{self.argument}={self.path}: the value {node} must be positive (it is varied "
                                  "in proportion)")
         return float(node)
 

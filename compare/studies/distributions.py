@@ -34,9 +34,9 @@ class Distribution:
     b: float  # sd, high or factor
 
     @classmethod
-    def parse(cls, text: str, what: str = "--vary") -> "Distribution":
-        """``normal(mean, sd)``, ``uniform(low, high)`` or ``lognormal(median, factor)``; ``what`` names the
-        option (and field) in the message of a bad one."""
+    def parse(cls, text: str, what: str = "distribution") -> "Distribution":
+        """``normal(mean, sd)``, ``uniform(low, high)`` or ``lognormal(median, factor)``; ``what`` starts the
+        message of a bad one (the argument and field that gave it: ``distributions=stages[0].sun.mass``)."""
         m = _PATTERN.fullmatch(str(text))
         if not m or m.group(1) not in KINDS:
             raise GearcheckError(f"{what} {text!r}: a distribution is normal(mean, sd), uniform(low, high) or "
@@ -84,24 +84,3 @@ def draw_samples(distributions: dict, samples: int, seed: int) -> list[dict[str,
         rng = sample_generator(int(seed), i)
         out.append({path: d.draw(rng) for path, d in distributions.items()})
     return out
-
-
-def read_distributions(path) -> dict[str, str]:
-    """A TOML file's ``[distributions]`` table: ``"FIELD" = "normal(mean, sd)"``, one per field."""
-    import tomllib
-    from pathlib import Path
-
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise GearcheckError(f"--distributions {path}: cannot be read ({exc.strerror or exc})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise GearcheckError(f"--distributions {path}: not TOML ({exc})") from None
-    table = data.get("distributions")
-    if not isinstance(table, dict) or not table:
-        raise GearcheckError(f"--distributions {path}: needs a [distributions] table of \"FIELD\" = "
-                             "\"normal(mean, sd)\" entries")
-    bad = [k for k, v in table.items() if not isinstance(v, str)]
-    if bad:
-        raise GearcheckError(f"--distributions {path}: {bad[0]} must be a string such as \"normal(10, 1)\"")
-    return dict(table)

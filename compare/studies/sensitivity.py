@@ -89,7 +89,7 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=None, metho
     ``step``, the whole response with ``check_step``; ``grids`` go to
     :func:`~gearcheck.lumped.forced_response.parametric_problem`."""
     _check(method)
-    field = FitParameter.parse(parameter, option="--parameter")
+    field = FitParameter.parse(parameter, "parameter")
     value = field.get(tomllib.loads(text))
     contacts: dict = {}
     base = _problem(text, source, field, value, speed, contacts, grids)
@@ -131,7 +131,7 @@ def lattice(problem: ParametricProblem, orders) -> tuple[int, ...]:
         return ORDERS[:problem.dim]
     orders = tuple(orders)
     if len(orders) != problem.dim or min(orders) < 0:
-        raise GearcheckError(f"--orders {' '.join(map(str, orders))}: give {problem.dim} non-negative number"
+        raise GearcheckError(f"orders={orders}: give {problem.dim} non-negative number"
                              f"{'s' if problem.dim > 1 else ''}, one per clock of this train (mesh"
                              f"{', eccentrics' if problem.dim > 1 else ''})")
     return orders
@@ -173,7 +173,7 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
 
     grids = grids or MAP_GRIDS
     _check(method)
-    fields = [FitParameter.parse(p, option="--parameter") for p in parameters]
+    fields = [FitParameter.parse(p, "parameters") for p in parameters]
     document = tomllib.loads(text)
     values = [f.get(document) for f in fields]
     contacts: dict = {}

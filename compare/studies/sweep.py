@@ -33,8 +33,8 @@ input is a new key), runs the others through a :class:`concurrent.futures.Execut
 in-process for one worker) or on a Dask distributed cluster (``scheduler``: an address or a
 ``distributed.Client``; :mod:`gearcheck.compare.studies.point_backends`), writes each finished point into the cache
 at once (whole or not at all), and concatenates the points in index order with their inputs as columns
-(``point``, ``sample``, ``seed``, ``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no time stamps, so the same
-inputs give a byte-identical Parquet file.
+(``point``, ``sample``, ``seed``, ``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no
+time stamps, so the same inputs give a byte-identical Parquet file.
 """
 
 from __future__ import annotations
@@ -128,17 +128,18 @@ def version() -> str:
 @dataclass(frozen=True)
 class Field:
     """A number of the train file by its path (``stages[0].mesh.ste[0].amplitude_um``, the calibration's
-    addressing), in the file's own units; ``option`` names it in messages."""
+    addressing), in the file's own units; its messages name the Python argument that gave it, ``argument``
+    (``fields=stages[0].sun.mass: ...``)."""
 
     path: str
     keys: tuple
-    option: str = "--set"
+    argument: str = "fields"
 
     @classmethod
-    def parse(cls, path: str, option: str = "--set") -> "Field":
+    def parse(cls, path: str, argument: str = "fields") -> "Field":
         if "=" in path or not path:
-            raise GearcheckError(f"{option} {path!r}: not a field path such as stages[0].sun.mass")
-        return cls(path, tuple(FitParameter.parse(path, option).keys), option)
+            raise GearcheckError(f"{argument}={path!r}: not a field path such as stages[0].sun.mass")
+        return cls(path, tuple(FitParameter.parse(path, argument).keys), argument)
 
     def check(self, document) -> float | int | None:
         """The field's value in ``document`` (None where its table exists but the file leaves it to its
@@ -148,15 +149,16 @@ class Field:
             last = i == len(self.keys) - 1
             if isinstance(k, int):
                 if not isinstance(node, list) or not -len(node) <= k < len(node):
-                    raise GearcheckError(f"{self.option} {self.path}: no such field in the train file "
+                    raise GearcheckError(f"{self.argument}={self.path}: no such field in the train file "
                                          f"(no element {k} there)")
             elif not isinstance(node, dict) or (k not in node and not last):
-                raise GearcheckError(f"{self.option} {self.path}: no such field in the train file ({k!r} is not there)")
+                raise GearcheckError(f"{self.argument}={self.path}: no such field in the train file ({k!r} is not "
+                                     "there)")
             elif k not in node:
                 return None
             node = node[k]
         if isinstance(node, bool) or not isinstance(node, (int, float)):
-            raise GearcheckError(f"{self.option} {self.path}: {node!r} is not a number")
+            raise GearcheckError(f"{self.argument}={self.path}: {node!r} is not a number")
         return node
 
     def set(self, document, value) -> None:
@@ -166,17 +168,18 @@ class Field:
         node[self.keys[-1]] = value
 
 
-def parse_values(text: str, option: str = "--set") -> tuple[str, list[float]]:
-    """``FIELD=v1,v2,...`` or ``FIELD=A:B:N`` (N values from A to B) -> (FIELD, values)."""
+def parse_values(text: str) -> tuple[str, list[float]]:
+    """``FIELD=v1,v2,...`` or ``FIELD=A:B:N`` (N values from A to B) -> (FIELD, values), an entry of ``fields=``
+    written as text."""
     path, eq, values = text.partition("=")
     if not eq or not values.strip():
-        raise GearcheckError(f"{option} {text!r}: give FIELD=v1,v2,... or FIELD=A:B:N")
-    return path.strip(), _numbers(values, f"{option} {text!r}", positive=False)
+        raise GearcheckError(f"fields={text!r}: give FIELD=v1,v2,... or FIELD=A:B:N")
+    return path.strip(), _numbers(values, f"fields={text!r}", positive=False)
 
 
-def parse_speeds(text: str, option: str = "--speeds") -> list[float]:
-    """``A:B:N`` (N speeds from A to B rpm) or ``v1,v2,...``: every speed > 0."""
-    return _numbers(text, f"{option} {text!r}", positive=True)
+def parse_speeds(text: str) -> list[float]:
+    """``A:B:N`` (N speeds from A to B rpm) or ``v1,v2,...``: every speed > 0; ``speeds=`` written as text."""
+    return _numbers(text, f"speeds={text!r}", positive=True)
 
 
 def _numbers(text: str, what: str, positive: bool) -> list[float]:
@@ -252,74 +255,23 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
         raise GearcheckError("a sweep needs the train file (a preset name or a path), not a loaded TrainSpec: "
                              "it edits the file's numbers and hashes its text")
     solvers = _solvers(solvers)
-    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
-        raise GearcheckError(f"duration={duration!r}: needs a positive number of seconds")
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
-        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to 20")
-    if not isinstance(integration_check, bool):
-        raise GearcheckError(f"integration_check {integration_check!r}: needs True or False")
-    if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:
-        raise GearcheckError(f"refine={refine!r}: needs an integer from 1 to {MAX_REFINE}")
+    _check_run_options(duration, harmonics, integration_check, refine)
     text, source = read_train_text(train)
     base = load_text(text, source)
     document = tomllib.loads(text)
-    fields = dict(fields or {})
-    distributions = dict(distributions or {})
-    if fields and distributions:
-        raise GearcheckError("--set (a grid) and --vary (Monte Carlo): give one or the other")
-    if samples is not None and not distributions:
-        raise GearcheckError("--samples: Monte Carlo needs --vary FIELD=DISTRIBUTION (or --distributions FILE)")
-    grid = {}
-    for path, values in fields.items():
-        f = Field.parse(path, "--set")
-        grid[f] = _checked_values(path, values, f.check(document))
-    laws = {}
-    for path, law in distributions.items():
-        f = Field.parse(path, "--vary")
-        f.check(document)
-        laws[f] = law if isinstance(law, Distribution) else Distribution.parse(law, f"--vary {path}")
-    if len({f.path for f in list(grid) + list(laws)}) != len(grid) + len(laws):
-        raise GearcheckError("a field is given twice")
-    if speeds is not None:
-        speeds = [checked_rpm(float(s), "--speeds: every speed") for s in speeds]
-        if not speeds:
-            raise GearcheckError("--speeds: an empty list of speeds")
-        if any(f.keys[:2] == ("operating", "input_speed_rpm") for f in list(grid) + list(laws)):
-            raise GearcheckError("operating.input_speed_rpm is swept by --speeds: give it there only")
+    grid, laws = _varied_fields(document, fields, distributions, samples)
+    speeds = _checked_speeds(speeds, list(grid) + list(laws))
     if laws:
-        n = 32 if samples is None else samples
-        sets = draw_samples({f: d for f, d in laws.items()}, n, seed)
-        options = "--vary"
+        sets = draw_samples(laws, 32 if samples is None else samples, seed)
     else:
         sets = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
-        options = "--set"
         seed = None
     count = len(sets) * (len(speeds) if speeds else 1)
     if count > MAX_POINTS:
         raise GearcheckError(f"{count} points: more than the {MAX_POINTS} a sweep holds")
-    extra = _files_digest(document, source)
-    points = []
-    for i, values in enumerate(sets):
-        doc = copy.deepcopy(document)
-        for f, v in values.items():
-            f.set(doc, v)
-        canonical = tomli_w.dumps(doc)
-        where = ", ".join(f"{f.path}={v!r}" for f, v in values.items())
-        try:
-            spec = load_text(canonical, source) if values else base
-        except GearcheckError as exc:
-            raise GearcheckError(f"{options} {where}" + (f" (sample {i})" if laws else "") + f": {exc}") from None
-        if speeds and (i == 0 or values):  # bounds and pitch-line speed grow with the speed: the ends decide
-            for speed in sorted({min(speeds), max(speeds)}):
-                try:
-                    load_train(spec, speed)
-                except GearcheckError as exc:
-                    raise GearcheckError(f"--speeds {speed:g}" + (f" ({where})" if values else "") + f": {exc}"
-                                         ) from None
-        for speed in speeds or [None]:
-            points.append(Point(len(points), canonical, source, speed, solvers, float(duration), harmonics, i,
-                                tuple((f.path, float(v)) for f, v in values.items()), seed, extra, integration_check,
-                                refine))
+    common = dict(source=source, solvers=solvers, duration=float(duration), harmonics=harmonics, seed=seed,
+                  extra=_files_digest(document, source), check=integration_check, refine=refine)
+    points = _points(document, base, sets, speeds, "distributions" if laws else "fields", common)
     settings = {"train": base.name, "source": source, "solvers": list(solvers), "duration_s": float(duration),
                 "harmonics": harmonics, "integration_check": integration_check, "refine": refine,
                 "speeds_rpm": speeds,
@@ -329,13 +281,103 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
     return SweepPlan(base.name, points, [f.path for f in list(grid) + list(laws)], settings)
 
 
+def _check_run_options(duration, harmonics, integration_check, refine) -> None:
+    """Refuse a setting of every point's runs that is out of its range (the integration check: not a bool)."""
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
+        raise GearcheckError(f"duration={duration!r}: needs a positive number of seconds")
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
+        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to 20")
+    if not isinstance(integration_check, bool):
+        raise GearcheckError(f"integration_check={integration_check!r}: needs True or False")
+    if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:
+        raise GearcheckError(f"refine={refine!r}: needs an integer from 1 to {MAX_REFINE}")
+
+
+def _varied_fields(document: dict, fields, distributions, samples) -> tuple[dict, dict]:
+    """The study's fields, each found in the train file ``document``: (grid, laws), {Field: [values]} of a
+    parameter study and {Field: Distribution} of a Monte Carlo; one of the two is empty."""
+    fields = dict(fields or {})
+    distributions = dict(distributions or {})
+    if fields and distributions:
+        raise GearcheckError("fields= (a grid) and distributions= (Monte Carlo): give one or the other")
+    if samples is not None and not distributions:
+        raise GearcheckError("samples=: Monte Carlo needs distributions=, the law of each field it draws")
+    grid = {}
+    for path, values in fields.items():
+        f = Field.parse(path, "fields")
+        grid[f] = _checked_values(path, values, f.check(document))
+    laws = {}
+    for path, law in distributions.items():
+        f = Field.parse(path, "distributions")
+        f.check(document)
+        laws[f] = law if isinstance(law, Distribution) else Distribution.parse(law, f"distributions={path}")
+    if len({f.path for f in list(grid) + list(laws)}) != len(grid) + len(laws):
+        raise GearcheckError("a field is given twice")
+    return grid, laws
+
+
+def _checked_speeds(speeds, varied: list) -> list[float] | None:
+    """``speeds`` (rpm) as floats, each a positive number of rpm no larger than any train turns at (whether this
+    train can is :func:`_check_speed_ends`'s); None: the file's own speed.  The input speed is swept by them alone,
+    not also as a varied field of ``varied``."""
+    if speeds is None:
+        return None
+    speeds = [checked_rpm(float(s), "every speed of speeds=") for s in speeds]
+    if not speeds:
+        raise GearcheckError("speeds=[]: an empty list of speeds")
+    if any(f.keys[:2] == ("operating", "input_speed_rpm") for f in varied):
+        raise GearcheckError("operating.input_speed_rpm is swept by speeds=: give it there only")
+    return speeds
+
+
+def _points(document: dict, base, sets: list[dict], speeds, argument: str, common: dict) -> list[Point]:
+    """The points of every parameter set of ``sets`` ({Field: value}, the outer loop) at every speed, each set's
+    edited train file loaded (``base`` where nothing is edited) and turned at the slowest and fastest speed;
+    ``argument`` (``fields`` or ``distributions``) names the sets in messages, ``common`` is what every point
+    shares."""
+    points = []
+    for i, values in enumerate(sets):
+        where = ", ".join(f"{f.path}={v!r}" for f, v in values.items())
+        what = f"{argument}={where}" + (f" (sample {i})" if argument == "distributions" else "")
+        canonical, spec = _edited_train(document, common["source"], base, values, what)
+        if speeds and (i == 0 or values):  # bounds and pitch-line speed grow with the speed: the ends decide
+            _check_speed_ends(spec, speeds, where)
+        for speed in speeds or [None]:
+            points.append(Point(index=len(points), text=canonical, speed_rpm=speed, sample=i,
+                                values=tuple((f.path, float(v)) for f, v in values.items()), **common))
+    return points
+
+
+def _edited_train(document: dict, source: str, base, values: dict, what: str):
+    """(canonical TOML, loaded train) of ``document`` with ``values`` ({Field: value}) set; ``base`` where there
+    are none.  A file that does not load is refused, its message after ``what``."""
+    doc = copy.deepcopy(document)
+    for f, v in values.items():
+        f.set(doc, v)
+    canonical = tomli_w.dumps(doc)
+    try:
+        return canonical, load_text(canonical, source) if values else base
+    except GearcheckError as exc:
+        raise GearcheckError(f"{what}: {exc}") from None
+
+
+def _check_speed_ends(spec, speeds: list[float], where: str) -> None:
+    """Refuse ``speeds`` whose slowest or fastest the train ``spec`` (edited as ``where`` says) cannot turn at."""
+    for speed in sorted({min(speeds), max(speeds)}):
+        try:
+            load_train(spec, speed)
+        except GearcheckError as exc:
+            raise GearcheckError(f"speeds={speed:g}" + (f" ({where})" if where else "") + f": {exc}") from None
+
+
 def check_quantities(train, quantities) -> None:
     """Refuse a quantity to plot that the train does not gate (before anything runs)."""
     spec = load_train(train)
     gated = [s.name for s in train_signals(spec) if s.compared]
     for q in quantities:
         if q not in gated:
-            raise GearcheckError(f"--quantity {q}: not a gated quantity of {spec.name} (e.g. {', '.join(gated[:3])})")
+            raise GearcheckError(f"quantities={q}: not a gated quantity of {spec.name} (e.g. "
+                                 f"{', '.join(gated[:3])})")
 
 
 def _solvers(solvers) -> tuple[str, ...]:
@@ -352,10 +394,10 @@ def _checked_values(path: str, values, current) -> list:
     """The values of a grid field; a field the file holds as an integer (teeth, planets) stays one."""
     values = [values] if isinstance(values, (int, float)) else list(values)
     if not values:
-        raise GearcheckError(f"--set {path}: an empty list of values")
+        raise GearcheckError(f"fields={path}: an empty list of values")
     for v in values:
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise GearcheckError(f"--set {path}={v!r}: every value must be a finite number")
+            raise GearcheckError(f"fields={path}={v!r}: every value must be a finite number")
     if isinstance(current, int) and all(float(v).is_integer() and abs(v) < 2**53 for v in values):
         return [int(v) for v in values]
     return [float(v) for v in values]
@@ -733,7 +775,7 @@ class SweepResult:
         present = set(frame["quantity"])
         missing = [q for q in quantities if q not in present]
         if missing:
-            raise GearcheckError(f"--quantity {missing[0]}: not a gated quantity of {self.train}")
+            raise GearcheckError(f"quantities={missing[0]}: not a gated quantity of {self.train}")
         written = ["sweep.parquet"]
         for name, png in sweep_plots.figures(frame, self.plan, quantities).items():
             (folder / name).write_bytes(png)
@@ -765,7 +807,7 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
                       seed=seed, solvers=solvers, duration=duration, harmonics=harmonics,
                       integration_check=integration_check, refine=refine)
     if cache is not None:
-        check_place(Path(cache), "--cache")
+        check_place(Path(cache), "cache=")
     if scheduler is not None and executor is not None:
         raise GearcheckError("scheduler= runs on a Dask cluster: give it or an executor, not both")
     if scheduler is not None and workers is not None:

@@ -71,7 +71,7 @@ class _Task:
     text: str
     source: str
     entries: tuple
-    fits: tuple  # the --fit texts, parsed afresh per sample (FitParameter keeps state)
+    fits: tuple  # the ``fits`` texts, parsed afresh per sample (FitParameter keeps state)
     fit_speed: float
     predict_speed: float
     duration: float
@@ -83,11 +83,11 @@ def _sample_text(task: _Task) -> str:
     document = tomllib.loads(task.text)
     for path, value in task.values:
         value = float(value)
-        field = Field.parse(path, "distribution")
+        field = Field.parse(path, "distributions")
         old = field.check(document)
         field.set(document, value)
         if task.scale_damping and old and path.endswith("_stiffness"):
-            sibling = Field.parse(path[: -len("_stiffness")] + "_damping", "distribution")
+            sibling = Field.parse(path[: -len("_stiffness")] + "_damping", "distributions")
             try:
                 c = sibling.check(document)
             except GearcheckError:
@@ -111,7 +111,7 @@ def run_sample(task: _Task) -> dict:
         text = _sample_text(task)
         settle = _settle(text, task.source, (task.fit_speed, task.predict_speed))
         duration = max(task.duration, settle + task.window)
-        fits = [FitParameter.parse(f) for f in task.fits]
+        fits = [FitParameter.parse(f, "fits") for f in task.fits]
         result = calibrate(text, task.source, list(task.entries), fits, duration, [task.fit_speed])
     except GearcheckError as exc:
         row["error"] = str(exc).splitlines()[0]
@@ -144,11 +144,12 @@ def _parse_distributions(distributions: dict, document: dict, fit_paths: set) ->
                              "{'stages[0].mesh.damping.ratio': 'uniform(0.03, 0.17)'}")
     out = {}
     for path, law in distributions.items():
-        field = Field.parse(str(path), "distribution")
+        field = Field.parse(str(path), "distributions")
         field.check(document)
         if path in fit_paths:
-            raise GearcheckError(f"distribution {path}: it is also fitted (--fit); a field is either drawn or fitted")
-        out[path] = law if isinstance(law, Distribution) else Distribution.parse(law, f"distribution of {path}")
+            raise GearcheckError(f"distributions={path}: it is also fitted (fits=); a field is either drawn or "
+                                 "fitted")
+        out[path] = law if isinstance(law, Distribution) else Distribution.parse(law, f"distributions={path}")
     return out
 
 
@@ -160,8 +161,8 @@ def uncertainty_study(text: str, source: str, entries: list[dict], distributions
 
     ``text``/``source``: the train file (as :func:`gearcheck.train.loader.read_train_text` gives it);
     ``entries``: its measurements (``spec.measurements``: speeds in rad/s); ``distributions``: field path ->
-    ``"lognormal(2e9, 1.6)"`` (or a :class:`~gearcheck.compare.studies.distributions.Distribution`), in the file's units;
-    ``fits``: ``PATH=LOW:HIGH`` as ``gearcheck calibrate --fit`` takes them, fitted on the measurements at
+    ``"lognormal(2e9, 1.6)"`` (or a :class:`~gearcheck.compare.studies.distributions.Distribution`), in the file's
+    units; ``fits``: ``PATH=LOW:HIGH`` as ``gearcheck calibrate --fit`` takes them, fitted on the measurements at
     ``fit_speed`` rpm; the measurements at ``predict_speed`` rpm are predicted.  ``duration`` s per run (longer
     where a sample's start-up decays more slowly, see the module's notes; ``window`` the least steady window,
     default ``duration`` minus the file's own decay time).  ``samples`` draws of ``seed``, run on ``workers``
@@ -183,31 +184,16 @@ def uncertainty_study(text: str, source: str, entries: list[dict], distributions
     except tomllib.TOMLDecodeError as exc:
         raise GearcheckError(f"{source}: not TOML ({exc})") from None
     fit_texts = [str(f) for f in fits]
-    parsed_fits = [FitParameter.parse(f) for f in fit_texts]
+    parsed_fits = [FitParameter.parse(f, "fits") for f in fit_texts]
     for f in parsed_fits:
         f.get(document)
     laws = _parse_distributions(distributions, document, {f.path for f in parsed_fits})
     fit_speed, predict_speed = checked_rpm(fit_speed, "fit_speed"), checked_rpm(predict_speed, "predict_speed")
-    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 < duration < math.inf:
-        raise GearcheckError(f"duration {duration!r}: needs a number > 0")
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise GearcheckError(f"workers {workers!r}: needs an integer >= 1")
-    base = load_text(text, source)
-    default_rpm = rad_s_to_rpm(base.operating.input_speed)
-
-    def at(e, rpm):
-        return abs(_rpm(e, default_rpm) - rpm) <= SPEED_MATCH * rpm
-
-    chosen = [e for e in entries if at(e, fit_speed) or at(e, predict_speed)]
-    if not any(at(e, fit_speed) for e in chosen):
-        raise GearcheckError(f"fit_speed {fit_speed:g} rpm: no measurement at that speed")
-    if not any(at(e, predict_speed) for e in chosen):
-        raise GearcheckError(f"predict_speed {predict_speed:g} rpm: no measurement at that speed")
+    _check_runs(duration, workers)
+    default_rpm = rad_s_to_rpm(load_text(text, source).operating.input_speed)
+    chosen = _chosen_entries(entries, default_rpm, fit_speed, predict_speed)
     if window is None:
-        window = duration - _settle(text, source, (fit_speed, predict_speed))
-        if window <= 0:
-            raise GearcheckError(f"duration {duration:g} s: shorter than the start-up decay of the file's model "
-                                 f"({duration - window:.4g} s); give a longer one")
+        window = _nominal_window(text, source, duration, (fit_speed, predict_speed))
     if isinstance(first, bool) or not isinstance(first, int) or first < 0:
         raise GearcheckError(f"first {first!r}: needs an integer >= 0")
     if samples == 0 and nominal and not isinstance(samples, bool):  # the plain calibration alone
@@ -219,6 +205,55 @@ def uncertainty_study(text: str, source: str, entries: list[dict], distributions
                   scale_damping=scale_damping)
     tasks = [_Task(NOMINAL, int(seed), (), **common)] if nominal else []
     tasks += [_Task(first + i, int(seed), tuple(d.items()), **common) for i, d in enumerate(draws)]
+    rows = _run_tasks(tasks, workers, progress)
+    frame = _table(tasks, rows, laws, document if nominal else None)
+    frame.attrs.update({
+        "source": source, "fits": fit_texts, "distributions": {p: str(d) for p, d in laws.items()},
+        "fit_speed": float(fit_speed), "predict_speed": float(predict_speed), "duration": float(duration),
+        "window": float(window), "seed": int(seed), "samples": int(samples), "first": int(first),
+        "measured": {f"{_label(e)}@{_rpm(e, default_rpm):g}": e["value"] for e in chosen},
+        "published_model": {f"{_label(e)}@{_rpm(e, default_rpm):g}": e.get("published_model") for e in chosen},
+        "wall_s": time.perf_counter() - started,
+    })
+    return frame
+
+
+def _check_runs(duration, workers) -> None:
+    """Refuse a duration per run that is not a number > 0, or a number of workers that is not an integer >= 1."""
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 < duration < math.inf:
+        raise GearcheckError(f"duration {duration!r}: needs a number > 0")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise GearcheckError(f"workers {workers!r}: needs an integer >= 1")
+
+
+def _chosen_entries(entries, default_rpm: float, fit_speed: float, predict_speed: float) -> list:
+    """The measurements at the fit speed or the prediction speed (an entry without a speed is at
+    ``default_rpm``, the file's); refused where either speed has none."""
+
+    def at(e, rpm):
+        return abs(_rpm(e, default_rpm) - rpm) <= SPEED_MATCH * rpm
+
+    chosen = [e for e in entries if at(e, fit_speed) or at(e, predict_speed)]
+    if not any(at(e, fit_speed) for e in chosen):
+        raise GearcheckError(f"fit_speed {fit_speed:g} rpm: no measurement at that speed")
+    if not any(at(e, predict_speed) for e in chosen):
+        raise GearcheckError(f"predict_speed {predict_speed:g} rpm: no measurement at that speed")
+    return chosen
+
+
+def _nominal_window(text: str, source: str, duration: float, speeds) -> float:
+    """The steady window the file's own model keeps at ``speeds`` in runs of ``duration``: what is left after its
+    start-up decay; refused where nothing is left."""
+    window = duration - _settle(text, source, speeds)
+    if window <= 0:
+        raise GearcheckError(f"duration {duration:g} s: shorter than the start-up decay of the file's model "
+                             f"({duration - window:.4g} s); give a longer one")
+    return window
+
+
+def _run_tasks(tasks: list[_Task], workers: int, progress) -> dict[int, dict]:
+    """Every task's row by its sample, run in this process (``workers`` 1) or on a pool; ``progress(done, total,
+    row)`` after each."""
     rows: dict[int, dict] = {}
 
     def finished(task, row):
@@ -231,22 +266,19 @@ def uncertainty_study(text: str, source: str, entries: list[dict], distributions
             finished(task, run_sample(task))
     else:
         backends.run_pool(run_sample, tasks, min(workers, len(tasks)), finished)
+    return rows
+
+
+def _table(tasks: list[_Task], rows: dict[int, dict], laws: dict, document: dict | None) -> pd.DataFrame:
+    """The rows in sample order, the drawn fields' columns first; with the train file's ``document``, the nominal
+    row's drawn columns hold its own values (NaN where it leaves a field to its default)."""
     frame = pd.DataFrame([rows[t.sample] for t in tasks])
-    if nominal:  # the file's own values (NaN where it leaves a field to its default)
+    if document is not None:
         for path in laws:
-            value = Field.parse(path, "distribution").check(document)
+            value = Field.parse(path, "distributions").check(document)
             frame.loc[frame["sample"] == NOMINAL, f"sampled:{path}"] = math.nan if value is None else float(value)
     leading = ["sample", "seed"] + [f"sampled:{p}" for p in laws]
-    frame = frame.reindex(columns=leading + [c for c in frame.columns if c not in leading])
-    frame.attrs.update({
-        "source": source, "fits": fit_texts, "distributions": {p: str(d) for p, d in laws.items()},
-        "fit_speed": float(fit_speed), "predict_speed": float(predict_speed), "duration": float(duration),
-        "window": float(window), "seed": int(seed), "samples": int(samples), "first": int(first),
-        "measured": {f"{_label(e)}@{_rpm(e, default_rpm):g}": e["value"] for e in chosen},
-        "published_model": {f"{_label(e)}@{_rpm(e, default_rpm):g}": e.get("published_model") for e in chosen},
-        "wall_s": time.perf_counter() - started,
-    })
-    return frame
+    return frame.reindex(columns=leading + [c for c in frame.columns if c not in leading])
 
 
 # ----------------------------------------------------------------------------- reductions

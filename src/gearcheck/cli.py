@@ -61,13 +61,16 @@ FLAGS = {  # a library error's Python parameter -> this command line's flag
     "model": "--model", "results": "--results", "columns": "--columns", "speed": "--speed", "duration": "--duration",
     "measurements": "--measurements", "solver": "--solver", "method": "--method", "coordinate": "--coordinate",
     "samples": "--samples", "seed": "--seed", "harmonics": "--harmonics", "refine": "--refine", "workers": "--workers",
-    "scheduler": "--scheduler"}
-_PARAMETER = re.compile(rf"\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
+    "scheduler": "--scheduler", "speeds": "--speeds", "cache": "--cache", "fit": "--fit", "parameter": "--parameter",
+    "orders": "--orders",
+    # a parameter that the command line names otherwise: a repeatable flag gives one entry of its list or dict
+    "fields": "--set", "distributions": "--vary", "parameters": "--parameter", "quantities": "--quantity"}
+_PARAMETER = re.compile(rf"(?<![.\]-])\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
 
 
 def as_flags(message: str) -> str:
     """A library error as the command line says it: ``model=x: ...`` as ``--model x: ...``, ``(duration=)`` as
-    ``(--duration)``."""
+    ``(--duration)``; a key of a train-file path (``stages[0].mesh.stiffness.model=``) is no parameter."""
     return _PARAMETER.sub(lambda m: FLAGS[m[1]] + (" " if m[2] else ""), message)
 
 
@@ -510,8 +513,28 @@ def cmd_calibrate(args) -> int:
     return 0
 
 
+def _read_distributions(path) -> dict[str, str]:
+    """The ``[distributions]`` table of the TOML file ``--distributions`` names: ``"FIELD" = "normal(mean, sd)"``, one
+    per field."""
+    import tomllib
+
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise GearcheckError(f"--distributions {path}: cannot be read ({exc.strerror or exc})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise GearcheckError(f"--distributions {path}: not TOML ({exc})") from None
+    table = data.get("distributions")
+    if not isinstance(table, dict) or not table:
+        raise GearcheckError(f"--distributions {path}: needs a [distributions] table of \"FIELD\" = "
+                             "\"normal(mean, sd)\" entries")
+    bad = [k for k, v in table.items() if not isinstance(v, str)]
+    if bad:
+        raise GearcheckError(f"--distributions {path}: {bad[0]} must be a string such as \"normal(10, 1)\"")
+    return dict(table)
+
+
 def cmd_sweep(args) -> int:
-    from gearcheck.compare.studies.distributions import read_distributions
     from gearcheck.compare.studies.sweep import check_quantities, parse_speeds, parse_values
     from gearcheck.compare.studies.sweep_lines import CONVERGED
 
@@ -522,7 +545,7 @@ def cmd_sweep(args) -> int:
         if path in fields:
             raise GearcheckError(f"--set {path}: given twice")
         fields[path] = values
-    distributions = read_distributions(args.distributions) if args.distributions is not None else {}
+    distributions = _read_distributions(args.distributions) if args.distributions is not None else {}
     for text in args.vary:
         path, eq, law = text.partition("=")
         if not eq or not path.strip():

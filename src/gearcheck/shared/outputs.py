@@ -34,21 +34,22 @@ MARKER = ".gearcheck"
 
 
 def check_place(out: Path, what: str, folder: bool = True) -> None:
-    """Refuse ``out`` (a folder, or a file when not ``folder``; ``what`` names the option) when it cannot
-    be written."""
+    """Refuse ``out`` (a folder, or a file when not ``folder``; ``what`` names the option, or the Python argument
+    as ``name=``) when it cannot be written."""
     out = Path(out)
+    named = f"{what}{out}" if what.endswith("=") else f"{what} {out}"
     if out.exists() and out.is_dir() != folder:
-        raise GearcheckError(f"{what} {out}: exists and is {'a folder' if out.is_dir() else 'not a folder'}")
+        raise GearcheckError(f"{named}: exists and is {'a folder' if out.is_dir() else 'not a folder'}")
     ancestor = out.absolute().parent
     while not ancestor.exists():
         ancestor = ancestor.parent
     if not ancestor.is_dir():
-        raise GearcheckError(f"{what} {out}: {ancestor} is a file, not a folder")
+        raise GearcheckError(f"{named}: {ancestor} is a file, not a folder")
     try:  # the only sure test of writing is to write: a file made and gone at once
         with tempfile.TemporaryFile(dir=ancestor):
             pass
     except OSError as exc:
-        raise GearcheckError(f"{what} {out}: {ancestor} is not writable ({exc.strerror or exc})") from None
+        raise GearcheckError(f"{named}: {ancestor} is not writable ({exc.strerror or exc})") from None
 
 
 def _make_parents(path: Path) -> list[Path]:

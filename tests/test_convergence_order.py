@@ -1,0 +1,90 @@
+"""Both solvers converge at fourth order on every preset and on the conditions gear trains bring, by step halving.
+
+Each train runs from each solver's own static start over 300 steps of h (two lumped default steps, at most the
+largest step both solvers take stably), at h, h/2 and h/4; the observed order log2(d(h)/d(h/2))
+(:func:`gearcheck.compare.studies.convergence.observed_orders`) must be at least 3.8 for every kind of signal
+whose differences stand above round-off.  Before both solvers drove every RK4 stage at its own time, the same
+measure read 1.3-2.1 on the time-varying trains (the drive held over a step) and 1.0 on the MuJoCo twin's
+accelerations with a turning carrier (its coefficients and damping correction set once a step).
+
+Contact events are not located within a step yet: where teeth or pins make or break contact during the window
+the order drops to about 2 or below (hub-drive with its backlash: 1.3-1.6; the RV reducer's disc accelerations
+with the pin contacts: 0.4 lumped, 2.0 MuJoCo; tip relief's tooth pairs likewise), so those trains are checked
+here without the events (hub-drive without backlash) or on the signals the events do not reach at this order
+(the RV reducer's transmission error and mesh forces), and the last test states the drop.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from gearcheck.compare.studies.convergence import KINDS, coarsest_step, halvings, observed_orders
+from gearcheck.train.loader import load_train
+from gearcheck.train.variants import edited, helical_stage, wide_stage
+
+STEPS, MULTIPLE, ORDER = 300, 2.0, 3.8
+HELD_CARRIER = [(r'^output = .*', 'output = "stage1.ring"'), (r'^held = .*', 'held = ["stage1.carrier"]'),
+                (r"^support = \{ radial_stiffness = 1.0e9, radial_damping = 2000.0 \}",
+                 "support = { radial_stiffness = 1.0e9, radial_damping = 2000.0, torsional_stiffness = 7.64e6, "
+                 "torsional_damping = 50.0 }")]
+CONDITIONS = {  # name: (train, the kinds checked)
+    "demo-3p": (lambda: load_train("demo-3p"), KINDS),
+    "demo-4p": (lambda: load_train("demo-4p"), KINDS),
+    "double-planet: torque ripple, carrier input": (lambda: load_train("double-planet"), KINDS),
+    "helical-planetary: contact lines, axial dofs": (lambda: load_train("helical-planetary"), KINDS),
+    "hub-drive without backlash: energy-method stiffness, transmission error, two carriers":
+        (lambda: edited("hub-drive", [(r"^backlash_um = .*", "backlash_um = 0.0")], "no backlash"), KINDS),
+    "rv-reducer: eccentrics, pins (their contacts not located)":
+        (lambda: load_train("rv-reducer"), ("dte", "mesh_force")),
+    "demo-3p torque-driven": (lambda: wide_stage(3, torque_driven=True), KINDS),
+    "demo-3p with a transmission error": (lambda: edited("demo-3p", [(
+        r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nste = [{ harmonic = 1, amplitude_um = 2.0 }, "
+        "{ harmonic = 2, amplitude_um = 0.5 }]")], "ste"), KINDS),
+    "demo-3p with a load ramp": (lambda: edited("demo-3p", [(r"^output_torque = (.*)", r"output_torque = \1\n"
+                                                             "ramp_s = 0.0004")], "ramp"), KINDS),
+    "demo-3p, carrier held (star)": (lambda: edited("demo-3p", HELD_CARRIER, "held carrier"), KINDS),
+    "helical, 15 deg, contact-line stiffness": (lambda: helical_stage(15.0, stiffness="contact-line"), KINDS),
+}
+
+
+@pytest.fixture(scope="module")
+def measured():
+    cache = {}
+
+    def get(name, solver):
+        if (name, solver) not in cache:
+            spec = CONDITIONS[name][0]()
+            runs = halvings(spec, solver, coarsest_step(spec, MULTIPLE), STEPS, 3)
+            cache[name, solver] = observed_orders(runs, CONDITIONS[name][1])
+        return cache[name, solver]
+
+    return get
+
+
+@pytest.mark.parametrize("solver", ["lumped", "mujoco"])
+@pytest.mark.parametrize("name", list(CONDITIONS))
+def test_fourth_order(measured, name, solver):
+    table = measured(name, solver)
+    orders = {kind: p[0] for kind, (p, _) in table.items() if not math.isnan(p[0])}
+    assert orders, f"every difference at round-off: {table}"
+    assert all(p >= ORDER for p in orders.values()), orders
+
+
+@pytest.mark.parametrize("name", ["demo-3p", "rv-reducer: eccentrics, pins (their contacts not located)"])
+def test_the_two_solvers_make_the_same_integration_error(measured, name):
+    """Both are RK4 with the drive at every stage on the same equations, so their differences between halvings
+    agree (to 2 %), signal kind by signal kind."""
+    lumped, mujoco = measured(name, "lumped"), measured(name, "mujoco")
+    for kind in lumped:
+        assert mujoco[kind][1][0] == pytest.approx(lumped[kind][1][0], rel=0.02)
+
+
+def test_backlash_events_inside_a_step_cost_the_order():
+    """hub-drive as shipped: its teeth leave and retake contact in the start transient, and a step that holds such
+    an event is only second-order accurate, so the measure falls well below 4 (it is 4.0 without the backlash,
+    above).  Locating the events is the next step."""
+    spec = load_train("hub-drive")
+    table = observed_orders(halvings(spec, "lumped", coarsest_step(spec, MULTIPLE), STEPS, 3))
+    assert min(p[0] for p, _ in table.values()) < 3.0

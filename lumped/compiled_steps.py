@@ -182,142 +182,333 @@ class Output(NamedTuple):
 
 
 # ---------------------------------------------------------------------------------------------- the kernel
-@njit(cache=True)
-def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out):
-    """Classical RK4 through the sub-steps of ``chunk`` (:class:`Chunk`, its ``pairs`` an array), q and v updated
-    in place.  The drive of sub-step r at its stage times ``times[r]`` (t, t + h/2, t + h) is ``[r, 0|1|2]`` of the
-    drive arrays (stages 2 and 3 both see index 1); the turning elements (:class:`Couplings`, :class:`Discs`) are
-    placed at ``times[r]``.  Returns the samples written to ``out`` (:class:`Output`).
+STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's samples t, t + h/2, t + h
+MAX_EVENTS = 8  # contact events located within one (sub-)step; more are resolved to the step
+MIN_FRACTION = 1e-9  # an event this close to a step's ends is taken as there
 
-    One function, the right-hand side written out in the loop over the four stages (a call per stage costs more
-    than the stage itself on a small train)."""
+
+@njit(inline="always")
+def _pin(d, i, x, t, discs):
+    """Pin i of disc d at state x, time t: (compression, normal x, normal y, arm on the disc, arm on the wheel)."""
+    disc_index, wheel_index, _, _, _, pin_place, _, disc = discs
+    dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
+    phi = disc[d, 0] + disc[d, 1] * t
+    cp, sp = np.cos(phi), np.sin(phi)
+    rel = disc[d, 2] * t - phi  # pin 0's angle relative to the eccentric
+    cw, sw = np.cos(rel), np.sin(rel)
+    K1, rc, pitch = disc[d, 3], disc[d, 4], disc[d, 5]
+    ci, si = pin_place[d, i, 0], pin_place[d, i, 1]
+    cr, sr = ci * cw - si * sw, si * cw + ci * sw
+    norm = np.sqrt(1 + K1 * K1 - 2 * K1 * cr)
+    ex, ey = (cr - K1) / norm, sr / norm
+    nx, ny = cp * ex - sp * ey, sp * ex + cp * ey
+    arm = rc * ey
+    compression = nx * x[dx_] + ny * x[dy] + arm * x[dth] - disc[d, 12]
+    wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
+    if wx >= 0:
+        compression -= nx * x[wx] + ny * x[wy] + pitch * ey * x[wt]
+    return compression, nx, ny, arm, pitch * ey
+
+
+@njit(inline="always")
+def _acceleration(x, u, out, t, ti, to, k, e, de, pairs, matrices, meshes, couplings, discs):
+    """q'' into ``out`` at state (x, u), time t, torques ti and to, the meshes' k, e, de and tooth pairs."""
     minv, F0, b_in, b_out = matrices.minv, matrices.load, matrices.b_in, matrices.b_out
     kp, ki, kx = matrices.K
     dp, di, dx = matrices.D
     (ap, ai, ax), c, half, backlash, relieved = meshes
     coupling_index, coupling = couplings
-    disc_index, wheel_index, crank_index, crank_place, cranks, pin_place, pins, disc = discs
+    disc_index, wheel_index, crank_index, crank_place, cranks, _, pins, disc = discs
+    n = x.size
+    for i in range(n):
+        f = F0[i] + b_in[i] * ti + b_out[i] * to
+        for p in range(kp[i], kp[i + 1]):
+            f -= kx[p] * x[ki[p]]
+        for p in range(dp[i], dp[i + 1]):
+            f -= dx[p] * u[di[p]]
+        out[i] = f
+    for m in range(c.size):  # meshes
+        d = 0.0
+        rate = 0.0
+        for p in range(ap[m], ap[m + 1]):
+            d += ax[p] * x[ai[p]]
+            rate += ax[p] * u[ai[p]]
+        y = d - e[m]
+        j = relieved[m]
+        if j >= 0:  # tooth pairs
+            elastic = 0.0
+            for pair in range(pairs.shape[1]):
+                gap = y - pairs[j, pair, 1]
+                if gap > 0.0:
+                    elastic += pairs[j, pair, 0] * gap
+        elif backlash:  # dead zone
+            b = half[m]
+            elastic = k[m] * (y - b if y > b else (y + b if y < -b else 0.0))
+        else:
+            elastic = k[m] * y
+        f = elastic + c[m] * (rate - de[m])
+        for p in range(ap[m], ap[m + 1]):
+            out[ai[p]] -= ax[p] * f
+    for w in range(coupling.shape[0]):  # radial couplings between turning frames
+        wa, wb, kc, cc = coupling[w, 0], coupling[w, 1], coupling[w, 2], coupling[w, 3]
+        i0, i1, i2, i3 = coupling_index[w, 0], coupling_index[w, 1], coupling_index[w, 2], coupling_index[w, 3]
+        phi = (wb - wa) * t
+        cs, sn = np.cos(phi), np.sin(phi)
+        va0, va1 = u[i0] - wa * x[i1], u[i1] + wa * x[i0]
+        vb0, vb1 = u[i2] - wb * x[i3], u[i3] + wb * x[i2]
+        p0 = kc * (x[i0] - (cs * x[i2] - sn * x[i3])) + cc * (va0 - (cs * vb0 - sn * vb1))
+        p1 = kc * (x[i1] - (sn * x[i2] + cs * x[i3])) + cc * (va1 - (sn * vb0 + cs * vb1))
+        out[i0] -= p0
+        out[i1] -= p1
+        out[i2] += cs * p0 + sn * p1
+        out[i3] += -sn * p0 + cs * p1
+    for d in range(disc.shape[0]):  # cycloid discs
+        dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
+        phi = disc[d, 0] + disc[d, 1] * t
+        cp, sp = np.cos(phi), np.sin(phi)
+        out[dx_] += disc[d, 7] * cp  # the orbit's centrifugal load
+        out[dy] += disc[d, 7] * sp
+        ecc, kn, cn, radius = disc[d, 6], disc[d, 8], disc[d, 9], disc[d, 13]
+        for kk in range(cranks[d]):  # needle bearings, x and y
+            c0, c1, c2 = crank_index[d, kk, 0], crank_index[d, kk, 1], crank_index[d, kk, 2]
+            ck, sk = crank_place[d, kk, 0], crank_place[d, kk, 1]
+            for axis in range(2):
+                if axis == 0:
+                    a0, a1, a2, b0, b1, b2 = ck, -sk, -ecc * sp, -1.0, 0.0, radius * sk
+                else:
+                    a0, a1, a2, b0, b1, b2 = sk, ck, ecc * cp, 0.0, -1.0, -radius * ck
+                dn = a0 * x[c0] + a1 * x[c1] + a2 * x[c2] + b0 * x[dx_] + b1 * x[dy] + b2 * x[dth]
+                rn = a0 * u[c0] + a1 * u[c1] + a2 * u[c2] + b0 * u[dx_] + b1 * u[dy] + b2 * u[dth]
+                f = kn * dn + cn * rn
+                out[c0] -= f * a0
+                out[c1] -= f * a1
+                out[c2] -= f * a2
+                out[dx_] -= f * b0
+                out[dy] -= f * b1
+                out[dth] -= f * b2
+        kp_, cp_ = disc[d, 10], disc[d, 11]
+        wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
+        for i in range(pins[d]):  # pin contacts, compression only
+            compression, nx, ny, arm, wheel_arm = _pin(d, i, x, t, discs)
+            if not compression > 0.0:
+                continue
+            rp = nx * u[dx_] + ny * u[dy] + arm * u[dth]
+            if wx >= 0:
+                rp -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
+            f = kp_ * compression + cp_ * rp
+            out[dx_] -= f * nx
+            out[dy] -= f * ny
+            out[dth] -= f * arm
+            if wx >= 0:
+                out[wx] += f * nx
+                out[wy] += f * ny
+                out[wt] += f * wheel_arm
+    for i in range(n):
+        out[i] *= minv[i]
+
+
+@njit(inline="always")
+def _rk4(q, v, h, times, k, e, de, tin, tout, pairs, Q, V, acc, matrices, meshes, couplings, discs):
+    """One classical RK4 step of length h in place, the drive given at the stage samples (axis 0: t, t + h/2,
+    t + h; stages 2 and 3 both see the middle one)."""
+    n = q.size
+    advance = (0.5 * h, 0.5 * h, h)
+    Q[0] = q
+    V[0] = v
+    for stage in range(4):
+        s = STAGE_TIMES[stage]
+        _acceleration(Q[stage], V[stage], acc[stage], times[s], tin[s], tout[s], k[s], e[s], de[s], pairs[s],
+                      matrices, meshes, couplings, discs)
+        if stage < 3:
+            a = advance[stage]
+            for i in range(n):
+                Q[stage + 1, i] = q[i] + a * V[stage, i]
+                V[stage + 1, i] = v[i] + a * acc[stage, i]
+    sixth = h / 6.0
+    for i in range(n):
+        q[i] = q[i] + sixth * (V[0, i] + 2 * V[1, i] + 2 * V[2, i] + V[3, i])
+        v[i] = v[i] + sixth * (acc[0, i] + 2 * acc[1, i] + 2 * acc[2, i] + acc[3, i])
+
+
+@njit(inline="always")
+def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
+    """The contact switching functions at state (x, u), time t into g and their rates of change into ``rate``,
+    each changing sign where a contact law has a kink: a backlash's two edges (y - b, y + b), a relieved mesh's
+    tooth pairs (y - e_j; -1 for a padded pair), the pins' compressions.  ``pairs``: the tooth pairs at the three
+    samples of a (sub-)step of length ``span``, t at sample ``s`` (their gaps' rates from the three); a pin's rate
+    leaves out its normal's turning."""
+    (ap, ai, ax), c, half, backlash, relieved = meshes
+    disc_index, wheel_index, _, _, _, _, pins, _ = discs
+    n = 0
+    for m in range(c.size):
+        j = relieved[m]
+        if j < 0 and not (backlash and half[m] > 0.0):
+            continue
+        y = -e[m]
+        dy = -de[m]
+        for p in range(ap[m], ap[m + 1]):
+            y += ax[p] * x[ai[p]]
+            dy += ax[p] * u[ai[p]]
+        if j >= 0:
+            for pair in range(pairs.shape[2]):
+                g0, g1, g2 = pairs[0, j, pair, 1], pairs[1, j, pair, 1], pairs[2, j, pair, 1]
+                if np.isfinite(g0) and np.isfinite(g1) and np.isfinite(g2):
+                    g[n] = y - pairs[s, j, pair, 1]
+                    slope = (-3.0 * g0 + 4.0 * g1 - g2) if s == 0 else (g0 - 4.0 * g1 + 3.0 * g2)
+                    rate[n] = dy - slope / span
+                else:
+                    g[n] = -1.0
+                    rate[n] = 0.0
+                n += 1
+        else:
+            g[n], g[n + 1] = y - half[m], y + half[m]
+            rate[n], rate[n + 1] = dy, dy
+            n += 2
+    for d in range(pins.size):
+        dx_, dy_, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
+        wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
+        for i in range(pins[d]):
+            compression, nx, ny, arm, wheel_arm = _pin(d, i, x, t, discs)
+            g[n] = compression
+            rate[n] = nx * u[dx_] + ny * u[dy_] + arm * u[dth]
+            if wx >= 0:
+                rate[n] -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
+            n += 1
+
+
+def switching_count(meshes: Meshes, discs: Discs, pairs_per_mesh: int) -> int:
+    """How many switching functions :func:`_switching` writes."""
+    relieved = meshes.relieved >= 0
+    edges = 2 * int(np.sum(~relieved & (meshes.half_backlash > 0))) if meshes.backlash else 0
+    return edges + int(np.sum(relieved)) * pairs_per_mesh + int(np.sum(discs.pins))
+
+
+@njit(inline="always")
+def _between(row, a, b, source, target) -> None:
+    """``target``'s three samples (axis 0) at the fractions a, (a + b)/2, b of the sub-step whose samples at 0, 1/2
+    and 1 are ``source[row]``, by quadratic interpolation; where a sample is infinite (a padded tooth pair) the
+    nearest is taken."""
+    for s in range(3):
+        x = a + 0.5 * s * (b - a)
+        w0, w1, w2 = 2.0 * (x - 0.5) * (x - 1.0), -4.0 * x * (x - 1.0), 2.0 * x * (x - 0.5)
+        nearest = 0 if x < 0.25 else (1 if x < 0.75 else 2)
+        flat_s, flat_t = source[row].reshape(3, -1), target.reshape(3, -1)
+        for i in range(flat_t.shape[1]):
+            y0, y1, y2 = flat_s[0, i], flat_s[1, i], flat_s[2, i]
+            if np.isfinite(y0) and np.isfinite(y1) and np.isfinite(y2):
+                flat_t[s, i] = w0 * y0 + w1 * y1 + w2 * y2
+            else:
+                flat_t[s, i] = flat_s[nearest, i]
+
+
+@njit(inline="always")
+def _part_of(chunk, r, a, b, part) -> None:
+    """The drive of the part from fraction a to b of sub-step r (:func:`_between`, each of ``part``'s arrays:
+    times, k, e, de, tin, tout, pairs)."""
+    _, _, times, k, e, de, tin, tout, pairs = chunk
+    _between(r, a, b, times, part[0])
+    _between(r, a, b, k, part[1])
+    _between(r, a, b, e, part[2])
+    _between(r, a, b, de, part[3])
+    _between(r, a, b, tin, part[4])
+    _between(r, a, b, tout, part[5])
+    _between(r, a, b, pairs, part[6])
+
+
+@njit(inline="always")
+def _hermite(g0, r0, g1, r1, theta):
+    """The cubic through (0, g0) and (1, g1) with slopes r0 and r1 (per step) at theta."""
+    t2 = theta * theta
+    t3 = t2 * theta
+    return (2 * t3 - 3 * t2 + 1) * g0 + (t3 - 2 * t2 + theta) * r0 + (3 * t2 - 2 * t3) * g1 + (t3 - t2) * r1
+
+
+@njit(cache=True)
+def first_crossing(g0, r0, g1, r1, span) -> float:
+    """The earliest fraction of the step at which a switching function crosses zero, on the cubic Hermite
+    interpolant of its values g and rates r at the step's ends (length ``span``): where g changes sign, and where
+    it does not but the cubic dips across zero and back (a contact made and broken within the step: the first
+    crossing lies before the cubic's turning point); the root by the Illinois method.  2: none."""
+    first = 2.0
+    for i in range(g0.size):
+        G0, R0, G1, R1 = g0[i], r0[i] * span, g1[i], r1[i] * span
+        end = 1.0
+        if not G0 * G1 < 0.0:
+            a3, a2 = 2 * G0 + R0 - 2 * G1 + R1, -3 * G0 - 2 * R0 + 3 * G1 - R1
+            end = 2.0
+            if G0 * R0 < 0.0:  # heading for zero: does the cubic get there before it turns?
+                disc = a2 * a2 - 3 * a3 * R0
+                if disc >= 0.0:
+                    for turn in ((-a2 - np.sqrt(disc)) / (3 * a3) if a3 != 0.0 else -R0 / (2 * a2),
+                                 (-a2 + np.sqrt(disc)) / (3 * a3) if a3 != 0.0 else 2.0):
+                        if 0.0 < turn < min(end, 1.0) and _hermite(G0, R0, G1, R1, turn) * G0 < 0.0:
+                            end = turn
+            if end > 1.0:
+                continue
+        a, b, fa, fb = 0.0, end, G0, _hermite(G0, R0, G1, R1, end)
+        side = 0
+        for _ in range(60):
+            theta = (a * fb - b * fa) / (fb - fa)
+            f = _hermite(G0, R0, G1, R1, theta)
+            if f * fb < 0.0:
+                a, fa = b, fb
+                side = 0
+            else:
+                fa = 0.5 * fa if side == 1 else fa
+                side = 1
+            b, fb = theta, f
+            if f == 0.0 or abs(b - a) < 1e-12:
+                break
+        first = min(first, b)
+    return first
+
+
+@njit(cache=True)
+def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out, switches, located):
+    """Classical RK4 through the sub-steps of ``chunk`` (:class:`Chunk`, its ``pairs`` an array, empty along its
+    last axes without tip relief), q and v updated in place.  The drive of sub-step r at its stage times
+    ``times[r]`` (t, t + h/2, t + h) is ``[r, 0|1|2]`` of the drive arrays (stages 2 and 3 both see index 1); the
+    turning elements (:class:`Couplings`, :class:`Discs`) are placed at the stage times.  ``switches``, the number
+    of switching functions (:func:`switching_count`; 0: none), enables contact-event location (counted into
+    ``located[0]``): where a switching function (:func:`_switching`) crosses zero within a step
+    (:func:`first_crossing`), the step is taken again, ended at the crossing, with the drive interpolated
+    quadratically from its three samples, and the rest of the step follows, itself checked; at most ``MAX_EVENTS``
+    a step.  A kink left inside a step costs an error of order h^2 there; ended at it, RK4 keeps its order.
+    Returns the samples written to ``out`` (:class:`Output`)."""
     lengths, ends, times, k, e, de, tin, tout, pairs = chunk
     first_step, every, q_out, v_out = out
     n = q.size
     Q, V, acc = np.empty((4, n)), np.empty((4, n)), np.empty((4, n))  # each stage's state and q''
-    time_index = (0, 1, 1, 2)
+    g0, g1, r0, r1 = np.empty(switches), np.empty(switches), np.empty(switches), np.empty(switches)
+    part = (np.empty(3), np.empty(k.shape[1:]), np.empty(e.shape[1:]), np.empty(de.shape[1:]), np.empty(3),
+            np.empty(3), np.empty(pairs.shape[1:]))  # the drive of a part of a step: times, k, e, de, tin, tout, pairs
     step = first_step
     written = 0
     for r in range(lengths.size):
         h = lengths[r]
-        advance = (0.5 * h, 0.5 * h, h)
-        Q[0] = q
-        V[0] = v
-        for stage in range(4):
-            s = time_index[stage]
-            x, u, out = Q[stage], V[stage], acc[stage]
-            ti, to = tin[r, s], tout[r, s]
-            for i in range(n):
-                f = F0[i] + b_in[i] * ti + b_out[i] * to
-                for p in range(kp[i], kp[i + 1]):
-                    f -= kx[p] * x[ki[p]]
-                for p in range(dp[i], dp[i + 1]):
-                    f -= dx[p] * u[di[p]]
-                out[i] = f
-            for m in range(c.size):  # meshes
-                d = 0.0
-                rate = 0.0
-                for p in range(ap[m], ap[m + 1]):
-                    d += ax[p] * x[ai[p]]
-                    rate += ax[p] * u[ai[p]]
-                y = d - e[r, s, m]
-                j = relieved[m]
-                if j >= 0:  # tooth pairs
-                    elastic = 0.0
-                    for pair in range(pairs.shape[3]):
-                        gap = y - pairs[r, s, j, pair, 1]
-                        if gap > 0.0:
-                            elastic += pairs[r, s, j, pair, 0] * gap
-                elif backlash:  # dead zone
-                    b = half[m]
-                    elastic = k[r, s, m] * (y - b if y > b else (y + b if y < -b else 0.0))
-                else:
-                    elastic = k[r, s, m] * y
-                f = elastic + c[m] * (rate - de[r, s, m])
-                for p in range(ap[m], ap[m + 1]):
-                    out[ai[p]] -= ax[p] * f
-            t = times[r, s]
-            for w in range(coupling.shape[0]):  # radial couplings between turning frames
-                wa, wb, kc, cc = coupling[w, 0], coupling[w, 1], coupling[w, 2], coupling[w, 3]
-                i0, i1, i2, i3 = coupling_index[w, 0], coupling_index[w, 1], coupling_index[w, 2], coupling_index[w, 3]
-                phi = (wb - wa) * t
-                cs, sn = np.cos(phi), np.sin(phi)
-                va0, va1 = u[i0] - wa * x[i1], u[i1] + wa * x[i0]
-                vb0, vb1 = u[i2] - wb * x[i3], u[i3] + wb * x[i2]
-                p0 = kc * (x[i0] - (cs * x[i2] - sn * x[i3])) + cc * (va0 - (cs * vb0 - sn * vb1))
-                p1 = kc * (x[i1] - (sn * x[i2] + cs * x[i3])) + cc * (va1 - (sn * vb0 + cs * vb1))
-                out[i0] -= p0
-                out[i1] -= p1
-                out[i2] += cs * p0 + sn * p1
-                out[i3] += -sn * p0 + cs * p1
-            for d in range(disc.shape[0]):  # cycloid discs
-                dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
-                phi = disc[d, 0] + disc[d, 1] * t
-                cp, sp = np.cos(phi), np.sin(phi)
-                out[dx_] += disc[d, 7] * cp  # the orbit's centrifugal load
-                out[dy] += disc[d, 7] * sp
-                ecc, kn, cn, radius = disc[d, 6], disc[d, 8], disc[d, 9], disc[d, 13]
-                for kk in range(cranks[d]):  # needle bearings, x and y
-                    c0, c1, c2 = crank_index[d, kk, 0], crank_index[d, kk, 1], crank_index[d, kk, 2]
-                    ck, sk = crank_place[d, kk, 0], crank_place[d, kk, 1]
-                    for axis in range(2):
-                        if axis == 0:
-                            a0, a1, a2, b0, b1, b2 = ck, -sk, -ecc * sp, -1.0, 0.0, radius * sk
-                        else:
-                            a0, a1, a2, b0, b1, b2 = sk, ck, ecc * cp, 0.0, -1.0, -radius * ck
-                        dn = a0 * x[c0] + a1 * x[c1] + a2 * x[c2] + b0 * x[dx_] + b1 * x[dy] + b2 * x[dth]
-                        rn = a0 * u[c0] + a1 * u[c1] + a2 * u[c2] + b0 * u[dx_] + b1 * u[dy] + b2 * u[dth]
-                        f = kn * dn + cn * rn
-                        out[c0] -= f * a0
-                        out[c1] -= f * a1
-                        out[c2] -= f * a2
-                        out[dx_] -= f * b0
-                        out[dy] -= f * b1
-                        out[dth] -= f * b2
-                K1, rc, pitch, kp_, cp_, gap = disc[d, 3], disc[d, 4], disc[d, 5], disc[d, 10], disc[d, 11], disc[d, 12]
-                rel = disc[d, 2] * t - phi  # pin 0's angle relative to the eccentric
-                cw, sw = np.cos(rel), np.sin(rel)
-                wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
-                for i in range(pins[d]):  # pin contacts, compression only
-                    ci, si = pin_place[d, i, 0], pin_place[d, i, 1]
-                    cr, sr = ci * cw - si * sw, si * cw + ci * sw
-                    norm = np.sqrt(1 + K1 * K1 - 2 * K1 * cr)
-                    ex, ey = (cr - K1) / norm, sr / norm
-                    nx, ny = cp * ex - sp * ey, sp * ex + cp * ey
-                    arm = rc * ey
-                    dp_ = nx * x[dx_] + ny * x[dy] + arm * x[dth] - gap
-                    if wx >= 0:
-                        dp_ -= nx * x[wx] + ny * x[wy] + pitch * ey * x[wt]
-                    if not dp_ > 0.0:
-                        continue
-                    rp = nx * u[dx_] + ny * u[dy] + arm * u[dth]
-                    if wx >= 0:
-                        rp -= nx * u[wx] + ny * u[wy] + pitch * ey * u[wt]
-                    f = kp_ * dp_ + cp_ * rp
-                    out[dx_] -= f * nx
-                    out[dy] -= f * ny
-                    out[dth] -= f * arm
-                    if wx >= 0:
-                        out[wx] += f * nx
-                        out[wy] += f * ny
-                        out[wt] += f * pitch * ey
-            for i in range(n):
-                out[i] *= minv[i]
-            if stage < 3:
-                a = advance[stage]
-                for i in range(n):
-                    Q[stage + 1, i] = q[i] + a * u[i]
-                    V[stage + 1, i] = v[i] + a * out[i]
-        sixth = h / 6.0
-        for i in range(n):
-            q[i] = q[i] + sixth * (V[0, i] + 2 * V[1, i] + 2 * V[2, i] + V[3, i])
-            v[i] = v[i] + sixth * (acc[0, i] + 2 * acc[1, i] + 2 * acc[2, i] + acc[3, i])
+        _rk4(q, v, h, times[r], k[r], e[r], de[r], tin[r], tout[r], pairs[r], Q, V, acc, matrices, meshes,
+             couplings, discs)
+        if switches > 0:
+            done, span = 0.0, h
+            _switching(Q[0], V[0], times[r, 0], e[r, 0], de[r, 0], pairs[r], 0, h, meshes, discs, g0, r0)
+            for _ in range(MAX_EVENTS):
+                _switching(q, v, times[r, 2], e[r, 2], de[r, 2], pairs[r], 2, h, meshes, discs, g1, r1)
+                theta = first_crossing(g0, r0, g1, r1, span)
+                if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
+                    break
+                at = done + theta * (1.0 - done)  # the crossing, a fraction of the whole sub-step
+                q[:] = Q[0]
+                v[:] = V[0]
+                _part_of(chunk, r, done, at, part)
+                _rk4(q, v, (at - done) * h, part[0], part[1], part[2], part[3], part[4], part[5], part[6], Q, V, acc,
+                     matrices, meshes, couplings, discs)
+                located[0] += 1
+                _switching(q, v, part[0][2], part[2][2], part[3][2], part[6], 2, (at - done) * h, meshes, discs,
+                           g0, r0)
+                done, span = at, (1.0 - at) * h
+                _part_of(chunk, r, done, 1.0, part)
+                _rk4(q, v, span, part[0], part[1], part[2], part[3], part[4], part[5], part[6], Q, V, acc, matrices,
+                     meshes, couplings, discs)
         if ends[r]:
             step += 1
             if step % every == 0:

@@ -29,7 +29,8 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearcheck.lumped.compiled_steps import Chunk, Output, kernel_groups, rk4_steps
+from gearcheck.lumped.compiled_steps import (MAX_EVENTS, MIN_FRACTION, Chunk, Output, first_crossing, kernel_groups,
+                                             rk4_steps, switching_count)
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
@@ -86,6 +87,8 @@ class _System:
         self.F0 = model.F_static
         self.b_in, self.b_out = model.b_input, model.b_output
         self.kernel = kernel_groups(self)
+        pairs = self.exc.tooth_pairs(0.0)[0]
+        self.switches = switching_count(self.kernel[1], self.kernel[3], 0 if pairs is None else pairs.shape[-1])
 
     def drive(self, t):
         """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``
@@ -116,6 +119,28 @@ class _System:
         k[..., self.relieved] = np.sum(pairs[..., 0] * (gap > 0.0), axis=-1)
         return k
 
+    def switching(self, q, v, t, e, de, pairs, s: int, span: float) -> tuple[np.ndarray, np.ndarray]:
+        """The contact switching functions at one state and their rates
+        (:func:`~gearcheck.lumped.compiled_steps._switching`'s, in its order): the backlash edges y - b and y + b, the
+        tooth pairs' y - e_j, the pins' compressions; ``pairs`` at a (sub-)step's three samples, of length
+        ``span``, t at sample ``s``."""
+        y, dy = self.A @ q - e, self.A @ v - de
+        g, rate = [], []
+        for m in range(y.size):
+            j = self.relieved_index[m]
+            if j >= 0:
+                finite = np.isfinite(pairs[:, j, :, 1]).all(axis=0)
+                gaps = np.where(finite, pairs[:, j, :, 1], 0.0)
+                slope = (-3 * gaps[0] + 4 * gaps[1] - gaps[2]) if s == 0 else (gaps[0] - 4 * gaps[1] + 3 * gaps[2])
+                g += list(np.where(finite, y[m] - gaps[s], -1.0))
+                rate += list(np.where(finite, dy[m] - slope / span, 0.0))
+            elif self.has_backlash and self.b[m] > 0:
+                g += [y[m] - self.b[m], y[m] + self.b[m]]
+                rate += [dy[m], dy[m]]
+        turning = [e.switching(t, q, v) for e in self.turning]
+        return (np.concatenate([np.array(g, dtype=float)] + [x[0] for x in turning]),
+                np.concatenate([np.array(rate, dtype=float)] + [x[1] for x in turning]))
+
     def acceleration(self, q, v, k, e, de, t_in, t_out, t=0.0, pairs=None):
         """q'' for one state (1-D) or many (time along axis 0, the torques then as columns)."""
         _, f = self.mesh_force(q, v, k, e, de, pairs)
@@ -124,10 +149,12 @@ class _System:
             force = force + coupling.forces(t, q, v)
         return force * self.Minv
 
-    def compiled_steps(self, q, v, chunk: Chunk, out: Output) -> int:
-        """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` on this system (see :func:`_chunk`)."""
-        pairs = np.zeros((0, 3, 0, 0, 2)) if chunk.pairs is None else np.ascontiguousarray(chunk.pairs)
-        return rk4_steps(q, v, *self.kernel, chunk._replace(pairs=pairs), out)
+    def compiled_steps(self, q, v, chunk: Chunk, out: Output, located: np.ndarray) -> int:
+        """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` on this system (see :func:`_chunk`), the contact events
+        it locates counted into ``located[0]``."""
+        rows = chunk.lengths.size
+        pairs = np.zeros((rows, 3, 0, 0, 2)) if chunk.pairs is None else np.ascontiguousarray(chunk.pairs)
+        return rk4_steps(q, v, *self.kernel, chunk._replace(pairs=pairs), out, self.switches, located)
 
 
 def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
@@ -172,18 +199,19 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
 
     started = clock.perf_counter()
     if method in ("rk4", "rk4-stages"):
-        t_out, q_out, v_out, sub_steps = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway,
-                                              method == "rk4-stages")
+        t_out, q_out, v_out, sub_steps, located = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway,
+                                                       method == "rk4-stages")
         engine, stages, calls = "numba-rk4" if method == "rk4" else "python-rk4", 4, 4 * sub_steps
     else:
         t_out, q_out, v_out, calls = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
         runaway(t_out, q_out)
-        engine, stages = f"scipy-{method}", None
+        engine, stages, located = f"scipy-{method}", None, None
     wall = clock.perf_counter() - started
     info = RunInfo(engine, n_steps, stages, calls, wall, {
         "method": method, "drive": "stages" if method.startswith("rk4") else "exact", "dt_s": dt, "steps": n_steps,
         "rhs_evaluations": calls if stages is None else 4 * n_steps, "wall_time_s": wall,  # as reports state them
-        "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms})
+        "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms,
+        "contact_events_located": located})
     return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
 
 
@@ -236,19 +264,21 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False):
     t_out[0], q_out[0], v_out[0] = 0.0, q, v
     q, v = q.copy(), v.copy()
     j, sub_steps = 1, 0
+    located = np.zeros(1, dtype=np.int64)
     chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
         steps = _chunk(sys, h, start, stop)
         sub_steps += steps.lengths.size
         out = Output(start, every, q_out[j:], v_out[j:])
-        written = _python_steps(sys, q, v, steps, out) if stage_by_stage else sys.compiled_steps(q, v, steps, out)
+        steps_of = _python_steps if stage_by_stage else sys.compiled_steps
+        written = steps_of(sys, q, v, steps, out, located) if stage_by_stage else steps_of(q, v, steps, out, located)
         t_out[j:j + written] = h * (every * (start // every + 1 + np.arange(written)))
         runaway(np.append(t_out[j:j + written], stop * h), np.vstack([q_out[j:j + written], q[None]]))
         j += written
         if progress is not None:
             progress(stop / n_steps)
-    return t_out[:j], q_out[:j], v_out[:j], sub_steps
+    return t_out[:j], q_out[:j], v_out[:j], sub_steps + 2 * int(located[0]), int(located[0])
 
 
 def stepper(model, dt: float, n_steps: int):
@@ -259,33 +289,76 @@ def stepper(model, dt: float, n_steps: int):
     chunk = _chunk_steps(sys)
     chunks = [(start, _chunk(sys, dt, start, min(start + chunk, n_steps))) for start in range(0, n_steps, chunk)]
     none = np.empty((0, model.n))
+    located = np.zeros(1, dtype=np.int64)
 
     def run(q, v):
         q, v = np.array(q, dtype=float), np.array(v, dtype=float)
         for start, steps in chunks:
-            sys.compiled_steps(q, v, steps, Output(start, n_steps + 1, none, none))
+            sys.compiled_steps(q, v, steps, Output(start, n_steps + 1, none, none), located)
         return q, v
 
     return run, sum(steps.lengths.size for _, steps in chunks)
 
 
-def _python_steps(sys, q, v, chunk: Chunk, out: Output) -> int:
-    """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` stage by stage in Python (the reference)."""
+def _python_steps(sys, q, v, chunk: Chunk, out: Output, located: np.ndarray) -> int:
+    """:func:`~gearcheck.lumped.compiled_steps.rk4_steps` stage by stage in Python (the reference), its contact
+    events located as there."""
     lengths, ends, times, k, e, de, tin, tout, pairs = chunk
     first_step, every, q_out, v_out = out
     step, written = first_step, 0
     for r, h in enumerate(lengths):
-        def stage(s, q, v):
-            return sys.acceleration(q, v, k[r, s], e[r, s], de[r, s], tin[r, s], tout[r, s], times[r, s],
-                                    None if pairs is None else pairs[r, s])
-
-        q[:], v[:] = rk4_step(stage, q, v, h)
+        drive = [x[r] for x in (times, k, e, de, tin, tout)] + [None if pairs is None else pairs[r]]
+        start = q.copy(), v.copy()
+        q[:], v[:] = _python_step(sys, drive, h, *start)
+        no_pairs = np.zeros((3, 0, 0, 2))
+        row_pairs = no_pairs if pairs is None else pairs[r]
+        done, span = 0.0, h
+        g0, r0 = sys.switching(*start, times[r, 0], e[r, 0], de[r, 0], row_pairs, 0, h)
+        for _ in range(MAX_EVENTS if sys.switches else 0):
+            theta = first_crossing(g0, r0, *sys.switching(q, v, times[r, 2], e[r, 2], de[r, 2], row_pairs, 2, h),
+                                   span)
+            if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
+                break
+            at = done + theta * (1.0 - done)
+            sub = [None if x is None else _between(x, done, at) for x in drive]
+            q[:], v[:] = _python_step(sys, sub, (at - done) * h, *start)
+            located[0] += 1
+            g0, r0 = sys.switching(q, v, sub[0][2], sub[2][2], sub[3][2], no_pairs if pairs is None else sub[6], 2,
+                                   (at - done) * h)
+            start, done, span = (q.copy(), v.copy()), at, (1.0 - at) * h
+            rest = [None if x is None else _between(x, done, 1.0) for x in drive]
+            q[:], v[:] = _python_step(sys, rest, span, *start)
         if ends[r]:
             step += 1
             if step % every == 0:
                 q_out[written], v_out[written] = q, v
                 written += 1
     return written
+
+
+def _python_step(sys, drive, h, q, v):
+    """One RK4 step of :meth:`_System.acceleration` from (q, v), ``drive`` (times, k, e, de, tin, tout, pairs) at
+    the stage samples."""
+    times, k, e, de, tin, tout, pairs = drive
+
+    def stage(s, q, v):
+        return sys.acceleration(q, v, k[s], e[s], de[s], tin[s], tout[s], times[s], None if pairs is None else pairs[s])
+
+    return rk4_step(stage, q, v, h)
+
+
+def _between(x: np.ndarray, a: float, b: float) -> np.ndarray:
+    """The three samples (axis 0) at the fractions a, (a + b)/2, b of a step whose samples at 0, 1/2 and 1 are
+    ``x``: quadratic interpolation, or the nearest sample where one is infinite (a padded tooth pair)."""
+    out = np.empty_like(x)
+    for s in range(3):
+        f = a + 0.5 * s * (b - a)
+        w = (2.0 * (f - 0.5) * (f - 1.0), -4.0 * f * (f - 1.0), 2.0 * f * (f - 0.5))
+        with np.errstate(invalid="ignore"):
+            value = w[0] * x[0] + w[1] * x[1] + w[2] * x[2]
+        nearest = x[0 if f < 0.25 else (1 if f < 0.75 else 2)]
+        out[s] = np.where(np.isfinite(x).all(axis=0), value, nearest)
+    return out
 
 
 def rk4_step(acceleration, q, v, h):

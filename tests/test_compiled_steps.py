@@ -33,22 +33,25 @@ def coordinates(run, model):
 @pytest.mark.parametrize("case", list(CASES))
 def test_compiled_steps_equal_stage_by_stage_rk4(case):
     """The compiled steps are the stage-by-stage RK4 (same drive sampling, splits at stiffness jumps, dead zone, tooth
-    pairs, turning couplings, cycloid needles and pin contacts) to round-off: the largest state difference over a
-    run, relative to the largest state, is below 1e-11 (measured at most 5e-15) and the mesh forces agree to 1e-10
-    of their peak (measured at most 2e-13)."""
+    pairs, turning couplings, cycloid needles and pin contacts, the same contact events located) to round-off: the
+    largest state difference over a run, relative to the largest state, is below 1e-11 (measured at most 5e-15) and
+    the mesh forces agree to 1e-10 of their peak (measured at most 2e-13)."""
     model = build_model(CASES[case]())
     settings = RunSettings(0.002)
     compiled = time_solver.simulate(model, settings)
     reference = time_solver.simulate(model, settings, method="rk4-stages")
     assert compiled.info["steps"] == reference.info["steps"] > 100
+    assert compiled.info["contact_events_located"] == reference.info["contact_events_located"]
+    assert compiled.info.rhs_calls == reference.info.rhs_calls
     np.testing.assert_array_equal(compiled.t, reference.t)
     for a, b in zip(coordinates(compiled, model), coordinates(reference, model)):
         assert np.max(np.abs(a - b)) <= 1e-11 * np.max(np.abs(b))
     fa, fb = compiled.select("mesh_force"), reference.select("mesh_force")
     np.testing.assert_allclose(fa, fb, rtol=0, atol=1e-10 * np.abs(fb).max())
-    if case == "backlash, light load":  # the teeth did leave their drive flanks
+    if case == "backlash, light load":  # the teeth did leave their drive flanks, and each time the step ended there
         e, _ = model.excitation.transmission_error(reference.t)
         assert np.any(reference.select("dte") - e < 20e-6)
+        assert reference.info["contact_events_located"] > 0
 
 
 @pytest.mark.parametrize("case", ["rv-reducer", "backlash, light load", "tip relief", "radial splines"])

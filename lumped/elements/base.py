@@ -103,6 +103,11 @@ class Turning:
         """Generalized forces (time along axis 0 allowed) of its rows at times ``t``."""
         raise NotImplementedError
 
+    def switching(self, t: float, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """Functions of one state (q, v) that change sign where its forces have a kink (a contact made or broken),
+        for the solver to end its step there, and their rates of change; none for a smooth element."""
+        return np.zeros(0), np.zeros(0)
+
     def frequencies(self) -> np.ndarray:
         """The frequencies (Hz) at which its rows move."""
         raise NotImplementedError

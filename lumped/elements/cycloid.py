@@ -161,6 +161,11 @@ class CycloidRows(Turning):
                 out.append((f"{self.stage}.disc{j + 1}.pin{i + 1}", a))
         return out
 
+    def switching(self, t: float, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """Every pin's compression (disc by disc, pin by pin), the contact made where it turns positive, and its
+        rate without its normal's turning."""
+        return self.pin_deflections(t, q).ravel(), (self.pin_deflections(t, v) + self.clearance).ravel()
+
     def pin_deflections(self, t, q) -> np.ndarray:
         """(..., N, Z_p) compression of every pin contact (negative: apart), time along axis 0 allowed."""
         return self._pins(self.pin_coefficients(t), q, np.zeros_like(np.asarray(q, dtype=float)))[0]

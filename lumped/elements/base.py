@@ -103,10 +103,6 @@ class Turning:
         """Generalized forces (time along axis 0 allowed) of its rows at times ``t``."""
         raise NotImplementedError
 
-    def frequencies(self) -> np.ndarray:
-        """The frequencies (Hz) at which its rows move."""
-        raise NotImplementedError
-
     def without_frame_terms(self):
         """The element with the rotating frame's terms off."""
         return self

@@ -1,19 +1,16 @@
 """The periodic steady state of the reference model by shooting, where its excitation has one period.
 
-Every time-varying part of the drive (mesh stiffness variation and transmission error at the mesh frequencies
-and their harmonics, eccentricities at the members' rotation frequencies in the carrier frame, torque ripple,
-the turning elements' rows) has a frequency; when all of them are whole multiples of one 1/T (within
-``PERIOD_TOLERANCE`` cycles over T) and T is at most ``MAX_MESH_PERIODS`` periods of the slowest time-varying
-mesh, the steady response is T-periodic.  The state y = (q, v) after one period of the compiled RK4 steps
-(:func:`gearcheck.lumped.time_solver.stepper`, the same steps, drive sampling and splits as
-:func:`~gearcheck.lumped.time_solver.simulate`, with a step that divides T) is a map y(T) = P(y0), and the steady
-state its fixed point, found from the static state by
+Where the train's drive has one period T (:func:`gearcheck.train.periods.common_period`: every time-varying part
+of it a whole number of cycles over T), the steady response is T-periodic.  The state y = (q, v) after one period
+of the compiled RK4 steps (:func:`gearcheck.lumped.time_solver.stepper`, the same steps, drive sampling and splits
+as :func:`~gearcheck.lumped.time_solver.simulate`, with a step that divides T) is a map y(T) = P(y0), and the
+steady state its fixed point, found from the static state by
 
-* ``method="anderson"`` (default): Anderson acceleration of y <- P(y) (Walker & Ni 2011), one period run an
-  iteration; on an affine map it is a Krylov method (GMRES in exact arithmetic), so it needs about as many runs
-  as the map has modes that a period does not damp out (14-28 on the presets, 3 for a long period), and it
-  takes the dead zones and contacts of a nonlinear model as they come.  Where it has not converged within
-  ``MAX_ANDERSON_RUNS`` runs, Newton goes on from its last iterate;
+* ``method="anderson"`` (default): Anderson acceleration of y <- P(y) (Walker & Ni 2011,
+  :func:`gearcheck.shared.anderson.anderson`), one period run an iteration; on an affine map it is a Krylov method
+  (GMRES in exact arithmetic), so it needs about as many runs as the map has modes that a period does not damp out
+  (14-28 on the presets, 3 for a long period), and it takes the dead zones and contacts of a nonlinear model as
+  they come.  Where it has not converged within ``MAX_ANDERSON_RUNS`` runs, Newton goes on from its last iterate;
 * ``method="newton"``: Newton shooting, y0 <- y0 - (Phi - I)^-1 (P(y0) - y0), Phi = dP/dy0 by forward differences
   (2n runs), kept while each step shrinks the residual tenfold (a chord step costs one run).  For a linear model
   (no backlash, tip relief or pin contacts) P is affine, y(T) = Phi y0 + g, and one solve of
@@ -39,13 +36,12 @@ import numpy as np
 
 from gearcheck.lumped.time_solver import initial_state, step_limits, stepper
 from gearcheck.shared import stepping
+from gearcheck.shared.anderson import anderson
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.run_info import RunInfo
+from gearcheck.train.periods import MAX_MESH_PERIODS, common_period
 
-PERIOD_TOLERANCE = 1e-9  # cycles over the common period by which a frequency may miss a whole number
-MAX_MESH_PERIODS = 64  # the longest common period sought, in periods of the slowest time-varying mesh
 MAX_ITERATIONS = 20  # Newton steps
-ANDERSON_DEPTH = 10  # differences kept
 MAX_ANDERSON_RUNS = 100
 
 
@@ -75,42 +71,6 @@ class PeriodicSteadyState:
         return self.q, self.v
 
 
-def drive_frequencies(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """(frequencies of the time-varying drive in Hz, those of the time-varying meshes, what has no period): the
-    excitation's periodic terms (:meth:`gearcheck.train.excitation.Excitation.periodic_terms`) and the
-    model's turning couplings and cycloid contacts."""
-    drive, meshes, aperiodic = model.excitation.periodic_terms()
-    freqs = [drive]
-    freqs += [e.frequencies() for e in model.turning]
-    f = np.concatenate(freqs) if freqs else np.empty(0)
-    return f[f > 0], meshes[meshes > 0], aperiodic
-
-
-def common_period(model, max_mesh_periods: int = MAX_MESH_PERIODS) -> float:
-    """The shortest T over which every frequency of :func:`drive_frequencies` completes whole cycles (within
-    ``PERIOD_TOLERANCE`` cycles), at most ``max_mesh_periods`` periods of the slowest time-varying mesh (or of the
-    slowest frequency when no mesh varies); :class:`SolverError` when there is none."""
-    f, meshes, aperiodic = drive_frequencies(model)
-    name = model.spec.name
-    if aperiodic:
-        raise SolverError(f"{name}: no periodic steady state to shoot for: {' and '.join(aperiodic)} "
-                          "not periodic; time-march with a settle time (RunSettings.settle) instead")
-    if f.size == 0:
-        raise SolverError(f"{name}: nothing in the drive varies with time: the steady state is the static "
-                          "solution (gearcheck.lumped.static.static_solution)")
-    base = float(meshes.min() if meshes.size else f.min())
-    for p in range(1, max_mesh_periods + 1):
-        cycles = f * (p / base)
-        if np.all(np.abs(cycles - np.round(cycles)) <= PERIOD_TOLERANCE * np.maximum(1.0, cycles)) \
-                and np.all(np.round(cycles) >= 1):
-            return p / base
-    listed = ", ".join(f"{x:.10g}" for x in np.unique(np.round(f, 9)))
-    raise SolverError(f"{name}: the drive's frequencies {listed} Hz have no common period within "
-                      f"{max_mesh_periods} periods of the slowest time-varying mesh ({base:.10g} Hz; tolerance "
-                      f"{PERIOD_TOLERANCE:g} cycles): no periodic steady state to shoot for (incommensurate "
-                      "excitation); time-march with a settle time (RunSettings.settle) instead")
-
-
 def _is_linear(model) -> bool:
     exc = model.excitation
     return not (np.any(exc.backlash > 0) or exc.relieved.size or not all(e.smooth for e in model.turning))
@@ -128,26 +88,6 @@ class _PeriodMap:
         y = z * self.scale / self.w
         n = y.size // 2
         return np.concatenate(self.run(y[:n], y[n:])) * self.w / self.scale
-
-
-def _anderson(P: _PeriodMap, z: np.ndarray, tolerance: float, max_runs: int):
-    """Anderson acceleration (Walker & Ni 2011, type II, depth ``ANDERSON_DEPTH``) of z <- P(z): (z, residual,
-    iterations); the residual max |P(z) - z| of the z returned."""
-    xs, fs = [], []
-    residual = math.inf
-    for iteration in range(max_runs):
-        f = P(z) - z
-        residual = float(np.max(np.abs(f)))
-        if residual <= tolerance:
-            return z, residual, iteration
-        xs, fs = (xs + [z])[-ANDERSON_DEPTH - 1:], (fs + [f])[-ANDERSON_DEPTH - 1:]
-        if len(xs) > 1:
-            dx, df = np.diff(np.array(xs), axis=0).T, np.diff(np.array(fs), axis=0).T
-            gamma = np.linalg.lstsq(df, f, rcond=None)[0]
-            z = z + f - (dx + df) @ gamma
-        else:
-            z = z + f
-    return z, residual, max_runs
 
 
 def _newton(P: _PeriodMap, z: np.ndarray, tolerance: float, linear: bool, name: str):
@@ -195,7 +135,7 @@ def periodic_steady_state(model, dt: float | None = None, tolerance: float = 1e-
     if method not in ("anderson", "newton"):
         raise SolverError(f"method must be 'anderson' or 'newton', not {method!r}")
     started = clock.perf_counter()
-    period = common_period(model, max_mesh_periods)
+    period = common_period(model.excitation, max_mesh_periods)
     name = model.spec.name
     limits = step_limits(model)
     h = stepping.default_step(limits, model.excitation.frequency) if dt is None else dt
@@ -211,7 +151,7 @@ def periodic_steady_state(model, dt: float | None = None, tolerance: float = 1e-
     P = _PeriodMap(run, w, scale)
     z, residual, iterations = w * y / scale, math.inf, 0
     if method == "anderson":
-        z, residual, iterations = _anderson(P, z, tolerance, MAX_ANDERSON_RUNS)
+        z, residual, iterations = anderson(P, z, tolerance, MAX_ANDERSON_RUNS)
     used = method
     if residual > tolerance:
         linear = _is_linear(model)

@@ -12,6 +12,7 @@ model's matrices or equations: nothing here imports :mod:`gearcheck.lumped`, at 
 * ``linearise`` -- MuJoCo's own M and K, natural frequencies and the highest one;
 * ``runner`` with ``compiled`` -- the driven run, its loop compiled;
 * ``static_state`` -- the steady rotating state at the operating point (the runner's start);
+* ``periodic_state`` -- the periodic steady state by shooting on the twin's own runs;
 * ``forces`` -- mesh and bearing forces read from MuJoCo's generalized forces;
 * ``published_twin`` -- the twin of the 4-DOF model of Matejic et al. (2021);
 * ``gear_visuals`` -- tooth outlines for the viewer;

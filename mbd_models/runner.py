@@ -337,7 +337,8 @@ ENGINES = ("auto", "compiled", "python")
 
 
 def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffness_clock: str = "nominal",
-                    initial_state=None, record_energy: bool = False, engine: str = "auto") -> TimeResult:
+                    initial_state=None, record_energy: bool = False, engine: str = "auto",
+                    return_state: bool = False) -> TimeResult:
     """Run the MuJoCo twin ``mb`` as ``settings`` ask; a :class:`TimeResult` with the lumped solver's signals.
 
     The step defaults to the model's own (``mb.default_step``) and is refused above the stability
@@ -348,7 +349,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     potential energy in ``raw``.  engine: "compiled" (the step loop in C,
     :mod:`gearcheck.mbd_models.compiled`; the same steps, equal to round-off), "python" (the loop in Python),
     or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); the result's ``info``
-    (:class:`~gearcheck.shared.run_info.RunInfo`) says which ran.
+    (:class:`~gearcheck.shared.run_info.RunInfo`) says which ran.  return_state: return (result, (qpos, qvel)),
+    the state after the last step.
     """
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
@@ -408,7 +410,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
         "static_newton_iterations": static.iterations, "static_residual": static.residual,
         "forward_evaluations": 4 * n_steps, "engine": loop})  # as reports state them
-    return _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
+    result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
+    return (result, (d.qpos.copy(), d.qvel.copy())) if return_state else result
 
 
 def simulate_mujoco_many(twins, settings, threads: int | None = None, **options) -> list[TimeResult]:

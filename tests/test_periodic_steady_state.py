@@ -6,7 +6,8 @@ import pytest
 from gearcheck.lumped import periodic_steady_state as periodic_steady_state_module
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.loader import load_train
-from gearcheck.lumped.periodic_steady_state import MAX_MESH_PERIODS, common_period, periodic_steady_state
+from gearcheck.lumped.periodic_steady_state import periodic_steady_state
+from gearcheck.train.periods import MAX_MESH_PERIODS, common_period
 from gearcheck.lumped.time_solver import default_step, simulate
 from gearcheck.train.variants import chained, edited
 from gearcheck.shared.errors import SolverError
@@ -79,17 +80,28 @@ def test_common_period_of_commensurate_stages():
     """Two chained demo-3p stages: their mesh frequencies 405.95 and 106.32 Hz (and the planets' rotations) meet after
     11 periods of the slower mesh."""
     model = build_model(chained(2))
-    period = common_period(model)
+    period = common_period(model.excitation)
     assert period == pytest.approx(11 / 106.3208617, rel=1e-8)
+
+
+def test_radial_coupling_between_turning_carriers_sets_the_period():
+    """A radial spline from the first stage's carrier to the second's sun turns in their frames at the carriers' speed
+    difference (Coupling.turning_frequencies, 4.83 Hz, the lumped model's turning coupling): the period doubles to 22
+    periods of the slower mesh."""
+    model = build_model(chained(2, radial_stiffness=1e8))
+    (coupling,) = model.turning
+    assert [p for part in model.spec.parts for p in part.turning_frequencies(model.spec, model.excitation.kin.speeds)
+            ] == pytest.approx([abs(coupling.omega_b - coupling.omega_a) / (2 * np.pi)], rel=1e-14)
+    assert common_period(model.excitation) == pytest.approx(22 / 106.3208617, rel=1e-8)
 
 
 def test_rv_reducer_period_is_one_turn_of_its_eccentrics():
     """The RV reducer's meshes (248.6 Hz), eccentrics (3.60 Hz) and pins passing (140.5 Hz) meet after one turn of the
     eccentrics relative to the carrier, 69 mesh periods: beyond the default MAX_MESH_PERIODS, within a larger one."""
     model = build_model(load_train("rv-reducer"))
-    assert common_period(model, max_mesh_periods=80) == pytest.approx(69 / 248.6486486, rel=1e-8)
+    assert common_period(model.excitation, max_mesh_periods=80) == pytest.approx(69 / 248.6486486, rel=1e-8)
     with pytest.raises(SolverError, match="no common period within 64 periods"):
-        common_period(model)
+        common_period(model.excitation)
 
 
 @pytest.mark.parametrize("case, why", [

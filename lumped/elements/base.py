@@ -108,10 +108,6 @@ class Turning:
         for the solver to end its step there, and their rates of change; none for a smooth element."""
         return np.zeros(0), np.zeros(0)
 
-    def frequencies(self) -> np.ndarray:
-        """The frequencies (Hz) at which its rows move."""
-        raise NotImplementedError
-
     def without_frame_terms(self):
         """The element with the rotating frame's terms off."""
         return self

@@ -51,9 +51,6 @@ class TurningCoupling(Turning):
     rows: tuple[str, str]  # names of its t = 0 rows
     compiled = "couplings"
 
-    def frequencies(self) -> np.ndarray:
-        return np.array([abs(self.omega_b - self.omega_a) / (2 * np.pi)])
-
     def forces(self, t, q, v) -> np.ndarray:
         """Generalized forces (time along axis 0 allowed) of the spring-damper between the two centres,
         acting on world-frame displacement and velocity and resolved in each member's own axes."""

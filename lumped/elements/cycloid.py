@@ -25,7 +25,6 @@ of t = 0 with the contact set of the static solution (like a turning coupling), 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -205,11 +204,6 @@ class CycloidRows(Turning):
         return out
 
     # ------------------------------------------------------------------ the element in the model
-    def frequencies(self) -> np.ndarray:
-        """The eccentrics' turn (needles, orbit) and the pins passing (identical pins)."""
-        return np.array([abs(self.omega_eccentric), self.geometry.pins * abs(self.omega_pins - self.omega_eccentric)]
-                        ) / (2 * math.pi)
-
     def without_frame_terms(self) -> "CycloidRows":
         return replace(self, omega_orbit=0.0)
 

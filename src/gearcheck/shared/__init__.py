@@ -1,3 +1,3 @@
 """The floor both solvers stand on: errors, units, citations, the run settings, the result types,
-the step rule, contact laws and the modal eigenproblem.  Nothing here knows either solver's
+the step rule, contact laws, the modal eigenproblem and Anderson acceleration.  Nothing here knows either solver's
 equations, so the lumped model and the MuJoCo twin may both import it and stay independent."""

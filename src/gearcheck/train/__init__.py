@@ -6,6 +6,8 @@
   speeds, flanks and mesh frequencies;
 * ``mesh_stiffness`` (with ``tooth_stiffness``, ``helical_mesh``, ``tooth_pairs`` and ``iso6336``) and
   ``excitation`` -- time-varying mesh stiffness and transmission error as functions of the nominal clock;
+* ``periods`` -- the drive's frequencies and its common period, over which both sides shoot for a periodic
+  steady state;
 * ``published_parameters`` -- the 4-DOF model of Matejic et al. (2021) read from a train;
 * ``variants`` -- a train file with numbers changed by path (sweeps, calibration);
 * ``presets`` -- the shipped trains.

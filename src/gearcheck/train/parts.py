@@ -28,6 +28,11 @@ class Part:
         """Frequencies (Hz) of the part's periodic contacts at the members' nominal ``speeds`` (rad/s), named."""
         return {}
 
+    def turning_frequencies(self, spec, speeds: dict) -> list[float]:
+        """Frequencies (Hz) at which the part's connections turn in the carrier frames of the members it joins at
+        the members' nominal ``speeds`` (rad/s): its forces there repeat with them."""
+        return []
+
     def dead_zones(self) -> list[str]:
         """The part's clearances that its contacts cross before they touch (a load that depends on the contact
         set), named."""

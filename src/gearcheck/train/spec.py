@@ -167,6 +167,13 @@ class Coupling(Part):
         row[index[self.a]], row[index[self.b]] = 1.0, -1.0
         return [(row, self.name)]
 
+    def turning_frequencies(self, spec, speeds: dict) -> list[float]:
+        """A radial coupling between stages whose carriers turn at different speeds turns at their difference."""
+        wa, wb = (speeds[f"{spec.members[m].stage}.carrier"] for m in (self.a, self.b))
+        if not (self.radial_stiffness or self.radial_damping) or abs(wa - wb) <= 1e-12 * max(abs(wa), abs(wb), 1.0):
+            return []
+        return [abs(wb - wa) / (2 * math.pi)]
+
 
 @dataclass(frozen=True)
 class Ripple:
@@ -236,6 +243,10 @@ class CycloidStage(Part):
         """The pin pass: the contact pattern moves on by one pin per pin pitch of the eccentric's turn."""
         wheel = speeds[self.pin_wheel] if self.pin_wheel else 0.0
         return {f"{self.stage}.pins": self.geometry.pins * abs(speeds[self.cranks[0]] - wheel) / (2 * math.pi)}
+
+    def turning_frequencies(self, spec, speeds: dict) -> list[float]:
+        """The eccentrics turn in the carrier with the cranks."""
+        return [abs(speeds[self.cranks[0]] - speeds[spec.stage_of(self.cranks[0]).carrier]) / (2 * math.pi)]
 
     def dead_zones(self) -> list[str]:
         """The pins' clearance, when there is one."""

@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import cached_property
 
 import numpy as np
@@ -18,10 +19,11 @@ from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, simulate_linear, step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed, settling_time
+from gearcheck.lumped.periodic_steady_state import periodic_steady_state
 from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
 from gearcheck.shared import stepping
-from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.modal import ModalResult, slowest_decaying_mode
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.side import Side
@@ -72,6 +74,19 @@ class LumpedSide(Side):
 
     def settling_time(self, fraction: float) -> float:
         return settling_time(self.model, fraction)
+
+    def slowest_mode(self) -> tuple[float, float]:
+        m = self.model
+        return slowest_decaying_mode(m.M, m.C + m.G, m.K_mean + m.K_frame)
+
+    def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
+        steady = periodic_steady_state(self.model, dt=settings.dt)
+        run = simulate(self.model, replace(settings, dt=steady.dt), method=self.method, y0=steady.y0,
+                       progress=progress)
+        check = simulate(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None), method=self.method,
+                         y0=steady.y0)
+        return run, check, (f"lumped: shooting over its period {steady.period:.6g} s, {steady.runs} runs "
+                            f"({steady.method}), residual {steady.residual:.1e}")
 
 
 class LinearSide(Side):

@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import cached_property
 
 import numpy as np
@@ -14,6 +15,7 @@ import numpy as np
 from gearcheck.train.published_parameters import KINEMATICS, PaperParameters, check_model
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.published_twin import PublishedTwin, build_twin, simulate_twin, twin_modes
+from gearcheck.mbd_models.periodic_state import periodic_state
 from gearcheck.mbd_models.runner import simulate_mujoco
 from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
@@ -65,6 +67,14 @@ class MujocoSide(Side):
 
     def settling_time(self, fraction: float) -> float:
         return linearise.settling_time(self.model, fraction)
+
+    def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
+        steady = periodic_state(self.model, dt=settings.dt)
+        options = {"initial_state": steady.initial_state, "stiffness_clock": self.stiffness_clock}
+        run = simulate_mujoco(self.model, replace(settings, dt=steady.dt), progress=progress, **options)
+        check = simulate_mujoco(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None), **options)
+        return run, check, (f"MuJoCo: shooting over its period {steady.period:.6g} s, {steady.runs} runs "
+                            f"({steady.method}), residual {steady.residual:.1e}")
 
 
 class PublishedTwinSide(Side):

@@ -29,6 +29,7 @@ Any pair of :class:`~gearcheck.shared.side.Side` objects, read by a comparison p
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 
@@ -177,11 +178,21 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     adjustable = [s.dt is None for s in settings]
     duration, steps, notes = asked, [s.dt for s in settings], []
     refinements, extended, best = 0, False, None
+    needed = plan.needed_duration() if plan.detect_steady else None
+    rerunnable = reference.rerunnable and test.rerunnable
+    periodic = rerunnable and needed is not None and needed > EXTENSION_FACTOR * asked
+    if periodic:
+        periodic = _periodic_note(plan, reference, needed, asked, notes)
     while True:
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
-        attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress)
-        needed = plan.needed_duration() if plan.detect_steady else None
-        rerunnable = reference.rerunnable and test.rerunnable
+        try:
+            attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress, periodic)
+        except (UnsupportedError, SolverError) as exc:
+            if not periodic:
+                raise
+            notes.append(f"They could not: {exc}.  Both runs start from their static states instead.")
+            periodic = False
+            continue
         reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked and rerunnable
         if attempt.how is None and not extended and reachable:
             notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
@@ -203,12 +214,14 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
             continue
         break
     (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
+    if best.starts:
+        notes.append("Periodic steady states found by " + "; ".join(best.starts) + ".")
     t0, how, comparisons, duration = best.t0, best.how, best.comparisons, a.t[-1]
     if plan.detect_steady and how is None:
         notes.append("No steady state in this run" + (
-            f": the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s; run at least "
-            f"{needed:.4g} s (--duration)." if needed is not None else
-            ": the reference model has a mode that does not decay."))
+            f": the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s"
+            f"{_slow_mode_words(reference)}; run at least {needed:.4g} s (--duration), or add damping where that "
+            "mode lives." if needed is not None else ": the reference model has a mode that does not decay."))
 
     run_settings = {
         "duration_s": asked, "simulated_s": duration, **plan.operating,
@@ -221,7 +234,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     }
     references = list(spec.references) + list(reference.references) + list(test.references)
     return CrosscheckResult(spec, run_settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
-                            comparisons, t0, how in ("detected", "decayed", "transient"), (a, b), (modes_a, modes_b),
+                            comparisons, t0, how in ("detected", "decayed", "transient", "periodic"), (a, b),
+                            (modes_a, modes_b),
                             grid, series, wall, notes=notes, references=list(dict.fromkeys(references)),
                             steady_how=how, settle_s=plan.settle if plan.detect_steady else None,
                             solvers=(reference.solver, test.solver))
@@ -239,6 +253,7 @@ class _Attempt:
     t0: float
     how: str | None
     comparisons: list
+    starts: list  # how each side found its periodic steady state, where the runs start there
 
     @property
     def worst(self) -> float:
@@ -246,12 +261,15 @@ class _Attempt:
         return max((q.error_ratio for q in self.comparisons if q.status != "negligible"), default=0.0)
 
     @classmethod
-    def of(cls, sides, settings, plan, tolerances, sensor_band, wall, progress) -> "_Attempt":
-        (a, a_check), (b, b_check) = _run_pairs(sides, settings, wall, progress)
+    def of(cls, sides, settings, plan, tolerances, sensor_band, wall, progress, periodic=False) -> "_Attempt":
+        """Both sides run (from their periodic steady states where ``periodic``: steady from the start) and
+        compared."""
+        starts = []
+        (a, a_check), (b, b_check) = _run_pairs(sides, settings, wall, progress, periodic, starts)
         names = [n for n in a.names(compared=True) if n in b]
         grid, fs, series = _common_grid(a, b, names, plan, sensor_band)
-        t0, how = 0.0, "transient"
-        if plan.detect_steady:
+        t0, how = 0.0, "periodic" if periodic else "transient"
+        if plan.detect_steady and not periodic:
             groups = [(np.stack([series[n][i] for n in forces], axis=1), cycle)
                       for forces, cycle in plan.steady_groups(names) for i in (0, 1)]
             t0, how = steady_state(grid, groups, plan.settle)
@@ -259,7 +277,7 @@ class _Attempt:
         errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a)
                            for run, check in ((a, a_check), (b, b_check))) for n in names}
         comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors)
-        return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons)
+        return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons, starts)
 
 
 def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
@@ -277,15 +295,22 @@ def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
                          modes_b.types, [modes_a.multiplicity[i] for i in partner])
 
 
-def _run_pairs(sides, settings, wall, progress):
-    """Each side's run and its integration check (2 h, or h / 2 where 2 h is beyond its stable step); a
-    recorded side (``rerunnable`` False) has no check."""
+def _run_pairs(sides, settings, wall, progress, periodic=False, starts=None):
+    """Each side's run and its integration check (2 h, or h / 2 where 2 h is beyond its stable step), both from
+    the side's periodic steady state where ``periodic`` (how each was found appended to ``starts``); a recorded
+    side (``rerunnable`` False) has no check."""
     pairs = []
     for i, (side, run_settings) in enumerate(zip(sides, settings)):
         label = ("lumped", "mujoco")[i]
         # progress over both sides: a run counts 1, its check (at most twice the step) 0.5
         report = (lambda f, i=i: progress((1.5 * i + f) / 3.0)) if progress else None
         started = time.perf_counter()
+        if periodic:
+            run, check, how = side.run_periodic(run_settings, lambda h, side=side: check_step(side, h), report)
+            starts.append(how)
+            wall[f"{label}_run_s"] = time.perf_counter() - started
+            pairs.append((run, check))
+            continue
         run = side.run(run_settings, report)
         wall[f"{label}_run_s"] = time.perf_counter() - started
         if not side.rerunnable:
@@ -298,6 +323,24 @@ def _run_pairs(sides, settings, wall, progress):
         wall[f"{label}_check_s"] = time.perf_counter() - started
         pairs.append((run, check))
     return pairs
+
+
+def _slow_mode_words(side) -> str:
+    """", its slowest mode ... decaying in ..." of ``side``, or nothing where it does not say."""
+    mode = side.slowest_mode()
+    if mode is None:
+        return ""
+    frequency, zeta = mode
+    return (f" (its slowest-decaying mode: {frequency:.4g} Hz, damping ratio {100 * zeta:.3g} %, time constant "
+            f"{1.0 / (2 * math.pi * frequency * zeta):.3g} s)")
+
+
+def _periodic_note(plan, reference, needed: float, asked: float, notes: list) -> bool:
+    """Note why both runs start on their periodic steady states; True."""
+    notes.append(f"The free vibration of the start decays to {STEADY_THRESHOLD:g} only after {plan.settle:.4g} s"
+                 f"{_slow_mode_words(reference)}, beyond {EXTENSION_FACTOR} times the {asked:.4g} s asked for: both "
+                 "runs start on their own periodic steady states, each solver shooting on its own runs.")
+    return True
 
 
 def check_step(side, h: float) -> float:

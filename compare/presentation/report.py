@@ -363,6 +363,7 @@ def _summary_lines(data) -> list[str]:
     how = {"detected": "detected: the mesh forces repeat cycle after cycle",
            "decayed": f"the free vibration of the start decayed to {STEADY_THRESHOLD:g}",
            "transient": "the whole transient",
+           "periodic": "both runs start on their periodic steady states: the whole run",
            None: "NO steady state: second half shown, verdict inconclusive"}[steady["how"]]
     steps = [f"{x:.4g} s" if x is not None else "none: a recording" for x in s["integration_check_steps"]["value"]]
     p = data["provenance"]
@@ -520,7 +521,7 @@ def _report_properties() -> dict:
         "settings": _settings_schema(),
         "verdict": _verdict_schema(),
         "steady_state": _object({"start": seconds, "detected": BOOLEAN,
-                                 "how": {"enum": ["detected", "decayed", "transient", None]},
+                                 "how": {"enum": ["detected", "decayed", "transient", "periodic", None]},
                                  "settling_time": _value("s", nullable=True)}),
         "modes": _array(_object({
             "mode": {"type": "integer"}, "type": STRING, "multiplicity": {"type": "integer"},

@@ -126,6 +126,15 @@ def settling_time(M: np.ndarray, D: np.ndarray, K: np.ndarray, fraction: float) 
     return math.log(1.0 / fraction) / rate if rate > 0 else math.inf
 
 
+def slowest_decaying_mode(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[float, float]:
+    """(natural frequency in Hz, damping ratio) of the elastic mode of M q'' + D q' + K q = 0 whose free
+    vibration decays slowest (the one :func:`settling_time` waits for): s = -zeta w +- i w sqrt(1 - zeta^2)."""
+    s, _ = quadratic_eigenvalues(M, D, K)
+    s = s[np.abs(s) ** 2 > RIGID_TOLERANCE * np.max(np.abs(s)) ** 2]
+    slowest = s[np.argmin(-s.real)]
+    return float(abs(slowest) / (2 * math.pi)), float(-slowest.real / abs(slowest))
+
+
 def frequency_groups(frequencies: np.ndarray) -> list[list[int]]:
     """Indices of the modes sharing one (multiple) frequency, in order."""
     groups: list[list[int]] = []

@@ -69,6 +69,17 @@ class Side(ABC):
         (no run is extended to reach its steady state)."""
         return None
 
+    def slowest_mode(self) -> tuple[float, float] | None:
+        """(frequency in Hz, damping ratio) of its slowest-decaying mode, the one a run from rest waits for.
+        Default None: not known."""
+        return None
+
+    def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
+        """A run started on its own periodic steady state (its step made a whole fraction of the drive's period),
+        the same run from the same state at the step ``check_step(h)`` (its integration check), and how the state
+        was found, in words.  Default: unsupported."""
+        raise UnsupportedError(f"{self.solver} cannot start on its periodic steady state (run_periodic)")
+
     def operating(self) -> dict:
         """The operating point a report of its runs states.  Default: the train's input speed and output torque."""
         return {"input_speed_rpm": rad_s_to_rpm(self.spec.operating.input_speed),

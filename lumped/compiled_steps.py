@@ -32,6 +32,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+                                     samples_between)
+
 
 
 class Sparse(NamedTuple):
@@ -183,8 +186,6 @@ class Output(NamedTuple):
 
 # ---------------------------------------------------------------------------------------------- the kernel
 STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's samples t, t + h/2, t + h
-MAX_EVENTS = 8  # contact events located within one (sub-)step; more are resolved to the step
-MIN_FRACTION = 1e-9  # an event this close to a step's ends is taken as there
 
 
 @njit(inline="always")
@@ -354,8 +355,7 @@ def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
                 g0, g1, g2 = pairs[0, j, pair, 1], pairs[1, j, pair, 1], pairs[2, j, pair, 1]
                 if np.isfinite(g0) and np.isfinite(g1) and np.isfinite(g2):
                     g[n] = y - pairs[s, j, pair, 1]
-                    slope = (-3.0 * g0 + 4.0 * g1 - g2) if s == 0 else (g0 - 4.0 * g1 + 3.0 * g2)
-                    rate[n] = dy - slope / span
+                    rate[n] = dy - rate_from_samples(g0, g1, g2, s, span)
                 else:
                     g[n] = -1.0
                     rate[n] = 0.0
@@ -384,83 +384,17 @@ def switching_count(meshes: Meshes, discs: Discs, pairs_per_mesh: int) -> int:
 
 
 @njit(inline="always")
-def _between(row, a, b, source, target) -> None:
-    """``target``'s three samples (axis 0) at the fractions a, (a + b)/2, b of the sub-step whose samples at 0, 1/2
-    and 1 are ``source[row]``, by quadratic interpolation; where a sample is infinite (a padded tooth pair) the
-    nearest is taken."""
-    for s in range(3):
-        x = a + 0.5 * s * (b - a)
-        w0, w1, w2 = 2.0 * (x - 0.5) * (x - 1.0), -4.0 * x * (x - 1.0), 2.0 * x * (x - 0.5)
-        nearest = 0 if x < 0.25 else (1 if x < 0.75 else 2)
-        flat_s, flat_t = source[row].reshape(3, -1), target.reshape(3, -1)
-        for i in range(flat_t.shape[1]):
-            y0, y1, y2 = flat_s[0, i], flat_s[1, i], flat_s[2, i]
-            if np.isfinite(y0) and np.isfinite(y1) and np.isfinite(y2):
-                flat_t[s, i] = w0 * y0 + w1 * y1 + w2 * y2
-            else:
-                flat_t[s, i] = flat_s[nearest, i]
-
-
-@njit(inline="always")
 def _part_of(chunk, r, a, b, part) -> None:
-    """The drive of the part from fraction a to b of sub-step r (:func:`_between`, each of ``part``'s arrays:
-    times, k, e, de, tin, tout, pairs)."""
+    """The drive of the part from fraction a to b of sub-step r (:func:`~gearcheck.shared.events.samples_between`,
+    each of ``part``'s arrays: times, k, e, de, tin, tout, pairs)."""
     _, _, times, k, e, de, tin, tout, pairs = chunk
-    _between(r, a, b, times, part[0])
-    _between(r, a, b, k, part[1])
-    _between(r, a, b, e, part[2])
-    _between(r, a, b, de, part[3])
-    _between(r, a, b, tin, part[4])
-    _between(r, a, b, tout, part[5])
-    _between(r, a, b, pairs, part[6])
-
-
-@njit(inline="always")
-def _hermite(g0, r0, g1, r1, theta):
-    """The cubic through (0, g0) and (1, g1) with slopes r0 and r1 (per step) at theta."""
-    t2 = theta * theta
-    t3 = t2 * theta
-    return (2 * t3 - 3 * t2 + 1) * g0 + (t3 - 2 * t2 + theta) * r0 + (3 * t2 - 2 * t3) * g1 + (t3 - t2) * r1
-
-
-@njit(cache=True)
-def first_crossing(g0, r0, g1, r1, span) -> float:
-    """The earliest fraction of the step at which a switching function crosses zero, on the cubic Hermite
-    interpolant of its values g and rates r at the step's ends (length ``span``): where g changes sign, and where
-    it does not but the cubic dips across zero and back (a contact made and broken within the step: the first
-    crossing lies before the cubic's turning point); the root by the Illinois method.  2: none."""
-    first = 2.0
-    for i in range(g0.size):
-        G0, R0, G1, R1 = g0[i], r0[i] * span, g1[i], r1[i] * span
-        end = 1.0
-        if not G0 * G1 < 0.0:
-            a3, a2 = 2 * G0 + R0 - 2 * G1 + R1, -3 * G0 - 2 * R0 + 3 * G1 - R1
-            end = 2.0
-            if G0 * R0 < 0.0:  # heading for zero: does the cubic get there before it turns?
-                disc = a2 * a2 - 3 * a3 * R0
-                if disc >= 0.0:
-                    for turn in ((-a2 - np.sqrt(disc)) / (3 * a3) if a3 != 0.0 else -R0 / (2 * a2),
-                                 (-a2 + np.sqrt(disc)) / (3 * a3) if a3 != 0.0 else 2.0):
-                        if 0.0 < turn < min(end, 1.0) and _hermite(G0, R0, G1, R1, turn) * G0 < 0.0:
-                            end = turn
-            if end > 1.0:
-                continue
-        a, b, fa, fb = 0.0, end, G0, _hermite(G0, R0, G1, R1, end)
-        side = 0
-        for _ in range(60):
-            theta = (a * fb - b * fa) / (fb - fa)
-            f = _hermite(G0, R0, G1, R1, theta)
-            if f * fb < 0.0:
-                a, fa = b, fb
-                side = 0
-            else:
-                fa = 0.5 * fa if side == 1 else fa
-                side = 1
-            b, fb = theta, f
-            if f == 0.0 or abs(b - a) < 1e-12:
-                break
-        first = min(first, b)
-    return first
+    samples_between(times[r], a, b, part[0])
+    samples_between(k[r], a, b, part[1])
+    samples_between(e[r], a, b, part[2])
+    samples_between(de[r], a, b, part[3])
+    samples_between(tin[r], a, b, part[4])
+    samples_between(tout[r], a, b, part[5])
+    samples_between(pairs[r], a, b, part[6])
 
 
 @njit(cache=True)
@@ -493,7 +427,7 @@ def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out, switches, lo
             _switching(Q[0], V[0], times[r, 0], e[r, 0], de[r, 0], pairs[r], 0, h, meshes, discs, g0, r0)
             for _ in range(MAX_EVENTS):
                 _switching(q, v, times[r, 2], e[r, 2], de[r, 2], pairs[r], 2, h, meshes, discs, g1, r1)
-                theta = first_crossing(g0, r0, g1, r1, span)
+                theta, crossed = first_crossing(g0, r0, g1, r1, span)
                 if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
                     break
                 at = done + theta * (1.0 - done)  # the crossing, a fraction of the whole sub-step
@@ -505,6 +439,7 @@ def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out, switches, lo
                 located[0] += 1
                 _switching(q, v, part[0][2], part[2][2], part[3][2], part[6], 2, (at - done) * h, meshes, discs,
                            g0, r0)
+                crossed_together(g0, r0, (at - done) * h, crossed)
                 done, span = at, (1.0 - at) * h
                 _part_of(chunk, r, done, 1.0, part)
                 _rk4(q, v, span, part[0], part[1], part[2], part[3], part[4], part[5], part[6], Q, V, acc, matrices,

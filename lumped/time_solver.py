@@ -29,13 +29,14 @@ import time as clock
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearcheck.lumped.compiled_steps import (MAX_EVENTS, MIN_FRACTION, Chunk, Output, first_crossing, kernel_groups,
-                                             rk4_steps, switching_count)
+from gearcheck.lumped.compiled_steps import Chunk, Output, kernel_groups, rk4_steps, switching_count
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+                                     samples_between)
 from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
@@ -131,9 +132,9 @@ class _System:
             if j >= 0:
                 finite = np.isfinite(pairs[:, j, :, 1]).all(axis=0)
                 gaps = np.where(finite, pairs[:, j, :, 1], 0.0)
-                slope = (-3 * gaps[0] + 4 * gaps[1] - gaps[2]) if s == 0 else (gaps[0] - 4 * gaps[1] + 3 * gaps[2])
+                slope = rate_from_samples(gaps[0], gaps[1], gaps[2], s, span)
                 g += list(np.where(finite, y[m] - gaps[s], -1.0))
-                rate += list(np.where(finite, dy[m] - slope / span, 0.0))
+                rate += list(np.where(finite, dy[m] - slope, 0.0))
             elif self.has_backlash and self.b[m] > 0:
                 g += [y[m] - self.b[m], y[m] + self.b[m]]
                 rate += [dy[m], dy[m]]
@@ -315,8 +316,8 @@ def _python_steps(sys, q, v, chunk: Chunk, out: Output, located: np.ndarray) -> 
         done, span = 0.0, h
         g0, r0 = sys.switching(*start, times[r, 0], e[r, 0], de[r, 0], row_pairs, 0, h)
         for _ in range(MAX_EVENTS if sys.switches else 0):
-            theta = first_crossing(g0, r0, *sys.switching(q, v, times[r, 2], e[r, 2], de[r, 2], row_pairs, 2, h),
-                                   span)
+            theta, crossed = first_crossing(g0, r0, *sys.switching(q, v, times[r, 2], e[r, 2], de[r, 2], row_pairs, 2,
+                                                                   h), span)
             if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
                 break
             at = done + theta * (1.0 - done)
@@ -325,6 +326,7 @@ def _python_steps(sys, q, v, chunk: Chunk, out: Output, located: np.ndarray) -> 
             located[0] += 1
             g0, r0 = sys.switching(q, v, sub[0][2], sub[2][2], sub[3][2], no_pairs if pairs is None else sub[6], 2,
                                    (at - done) * h)
+            crossed_together(g0, r0, (at - done) * h, crossed)
             start, done, span = (q.copy(), v.copy()), at, (1.0 - at) * h
             rest = [None if x is None else _between(x, done, 1.0) for x in drive]
             q[:], v[:] = _python_step(sys, rest, span, *start)
@@ -348,16 +350,10 @@ def _python_step(sys, drive, h, q, v):
 
 
 def _between(x: np.ndarray, a: float, b: float) -> np.ndarray:
-    """The three samples (axis 0) at the fractions a, (a + b)/2, b of a step whose samples at 0, 1/2 and 1 are
-    ``x``: quadratic interpolation, or the nearest sample where one is infinite (a padded tooth pair)."""
+    """The three samples of ``x`` (axis 0) at the fractions a, (a + b)/2, b of its step
+    (:func:`~gearcheck.shared.events.samples_between`)."""
     out = np.empty_like(x)
-    for s in range(3):
-        f = a + 0.5 * s * (b - a)
-        w = (2.0 * (f - 0.5) * (f - 1.0), -4.0 * f * (f - 1.0), 2.0 * f * (f - 0.5))
-        with np.errstate(invalid="ignore"):
-            value = w[0] * x[0] + w[1] * x[1] + w[2] * x[2]
-        nearest = x[0 if f < 0.25 else (1 if f < 0.75 else 2)]
-        out[s] = np.where(np.isfinite(x).all(axis=0), value, nearest)
+    samples_between(np.ascontiguousarray(x), a, b, out)
     return out
 
 

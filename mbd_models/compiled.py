@@ -31,6 +31,8 @@ import numba
 import numpy as np
 
 from gearcheck.mbd_models.elements.cycloid import PIN_BAND
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+                                     samples_between)
 
 _LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
 STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's stage times t, t + h/2, t + h
@@ -153,6 +155,21 @@ class Contacts(NamedTuple):
     starts: np.ndarray
 
 
+class MeshSwitches(NamedTuple):
+    """The mesh tendons whose contact law has kinks, for event location: tendons, their ``wrap_prm`` entries with
+    the qpos and dof addresses of their coefficients, each tendon's first entry (one more at the end), its mesh's
+    place among the relieved meshes (-1: a backlash's dead zone) and half backlash."""
+
+    tendons: np.ndarray
+    wraps: np.ndarray
+    qadr: np.ndarray
+    dofs: np.ndarray
+    starts: np.ndarray
+    relieved: np.ndarray
+    half_backlash: np.ndarray
+    count: int  # switching functions: these tendons' and the pins'
+
+
 class Work(NamedTuple):
     """Work space of the damping correction: the mesh Jacobian, the turned coefficients, g."""
 
@@ -197,13 +214,15 @@ class Discs(NamedTuple):
 
 
 class PinWork(NamedTuple):
-    """Work space of the pin contacts: a Jacobian, the contact point, G, each row's compression and length."""
+    """Work space of the pin contacts: a Jacobian, the contact point, G, each row's compression, length and rate
+    of length (its coefficients held)."""
 
     jacobian: np.ndarray
     point: np.ndarray
     G: np.ndarray
     delta: np.ndarray
     length: np.ndarray
+    speed: np.ndarray
 
 
 class Cycloid(NamedTuple):
@@ -321,7 +340,8 @@ def cycloid_arrays(contacts, nv: int) -> Cycloid:
     types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
     disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))
     disc = Discs(*disc[:9], *(x.reshape(len(discs), width) for x in disc[9:]))
-    work = PinWork(np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins))
+    work = PinWork(np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins),
+                   np.zeros(n_pins))
     return Cycloid(pins, disc, work)
 
 
@@ -331,10 +351,10 @@ def _pins(kinematics, com_pos, jac, m, d, model, data, cycloid):
     lengths, stiffness and damping at the discs' present poses, from MuJoCo's kinematics and Jacobians."""
     stiffness, lengthspring, wrap_prm, damping_model = (model.tendon_stiffness, model.tendon_lengthspring,
                                                         model.wrap_prm, model.tendon_damping)
-    qpos, xpos, xmat, site_xpos = data.qpos, data.xpos, data.xmat, data.site_xpos
+    qpos, qvel, xpos, xmat, site_xpos = data.qpos, data.qvel, data.xpos, data.xmat, data.site_xpos
     tendons, k_pin, c_pin, clearance, site, wraps = cycloid.pins
     body, wheel, phase, lobes, ecc, pitch_radius, first, count, ndof, dofs, qadr = cycloid.discs
-    jacobian, point, G, delta, length = cycloid.work
+    jacobian, point, G, delta, length, speed = cycloid.work
     kinematics(m, d)
     com_pos(m, d)
     for i in range(body.size):
@@ -367,11 +387,14 @@ def _pins(kinematics, com_pos, jac, m, d, model, data, cycloid):
             ny /= size
             delta[p] = nx * vx + ny * vy
             total = 0.0
+            rate = 0.0
             for k in range(ndof[i]):
                 coef = nx * G[0, k] + ny * G[1, k]
                 wrap_prm[wraps[p, k]] = coef
                 total += coef * qpos[qadr[i, k]]
+                rate += coef * qvel[dofs[i, k]]
             length[p] = total
+            speed[p] = rate
     for p in range(tendons.size):
         t = tendons[p]
         compression = delta[p] - clearance[p]
@@ -543,22 +566,133 @@ def _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, sta
     return j
 
 
+@numba.njit(cache=True)
+def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive, r, s, span, flags, g, rate):
+    """The contact switching functions of the twin's state into g and their rates into ``rate``: each mesh
+    tendon's backlash edges (L - e - b, L - e + b) or tooth pairs (L - e - e_j; -1 for a padded pair), L the
+    tendon's length with its coefficients turned to the state's carrier angles, and each pin's compression (its
+    coefficients and kinematics at the state); the drive of row ``r`` at sample ``s`` (0 or 2) of a step of length
+    ``span``.  Rates leave out the coefficients' own turning."""
+    qpos, qvel, wrap_prm = data.qpos, data.qvel, model.wrap_prm
+    tendons, wraps, qadr, dofs, starts, relieved, half, _ = switches
+    _refresh(qpos, wrap_prm, turning.wraps, turning.base, turning.carrier_qadr, work.coef)
+    n = 0
+    for i in range(tendons.size):
+        t = tendons[i]
+        length = 0.0
+        speed = 0.0
+        for w in range(starts[i], starts[i + 1]):
+            length += wrap_prm[wraps[w]] * qpos[qadr[w]]
+            speed += wrap_prm[wraps[w]] * qvel[dofs[w]]
+        if flags.transmission_error:
+            length -= drive.e[r, s, t]
+            speed -= drive.de[r, s, t]
+        j = relieved[i]
+        if j >= 0:
+            for pair in range(drive.pairs.shape[3]):
+                g0, g1, g2 = drive.pairs[r, 0, j, pair, 1], drive.pairs[r, 1, j, pair, 1], drive.pairs[r, 2, j, pair, 1]
+                if np.isfinite(g0) and np.isfinite(g1) and np.isfinite(g2):
+                    g[n] = length - drive.pairs[r, s, j, pair, 1]
+                    rate[n] = speed - rate_from_samples(g0, g1, g2, s, span)
+                else:
+                    g[n] = -1.0
+                    rate[n] = 0.0
+                n += 1
+        else:
+            g[n], g[n + 1] = length - half[i], length + half[i]
+            rate[n], rate[n + 1] = speed, speed
+            n += 2
+    if flags.pin_contacts:
+        _pins(c[4], c[5], c[6], pointers.model, pointers.data, model, data, cycloid)
+        delta, speed, clearance = cycloid.work.delta, cycloid.work.speed, cycloid.pins.clearance
+        for p in range(delta.size):
+            g[n] = delta[p] - clearance[p]
+            rate[n] = speed[p]
+            n += 1
+
+
+@numba.njit(cache=True)
+def _restart(stages, data) -> None:
+    """The state back at the start of the last step (RK4's ``qpos0``, ``qvel0``, ``act0``)."""
+    data.qpos[:] = stages.qpos0
+    data.qvel[:] = stages.qvel0
+    data.act[:] = stages.act0
+
+
+@numba.njit(cache=True)
+def _part_of(drive, r, a, b, part) -> None:
+    """Row 0 of ``part`` (a :class:`Drive` of one row): the drive of the part from fraction a to b of row r of
+    ``drive`` (:func:`~gearcheck.shared.events.samples_between`)."""
+    samples_between(drive.k[r], a, b, part.k[0])
+    samples_between(drive.u[r], a, b, part.u[0])
+    samples_between(drive.e[r], a, b, part.e[0])
+    samples_between(drive.de[r], a, b, part.de[0])
+    samples_between(drive.pairs[r], a, b, part.pairs[0])
+
+
+@numba.njit(cache=True)
+def _step(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, r, h, flags, outputs,
+          sample, j, switches, events):
+    """One (sub-)step of length h with the drive of row ``r`` (:func:`_rk4`), its contact events located where
+    ``switches`` has any (:mod:`gearcheck.shared.events`: the step taken again to the first crossing of a switching
+    function, :func:`_switching`, and on from there; counted into ``events.located[0]``).  Returns the next row."""
+    g0, r0, g1, r1, part, located = events
+    if g0.size:
+        _switching(c, pointers, model, data, turning, work, cycloid, switches, drive, r, 0, h, flags, g0, r0)
+    j = _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, r, h, flags, outputs,
+             sample, j)
+    if not g0.size:
+        return j
+    done, span = 0.0, h
+    for _ in range(MAX_EVENTS):
+        _switching(c, pointers, model, data, turning, work, cycloid, switches, drive, r, 2, h, flags, g1, r1)
+        theta, crossed = first_crossing(g0, r0, g1, r1, span)
+        if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
+            break
+        at = done + theta * (1.0 - done)  # the crossing, a fraction of the whole step
+        _restart(stages, data)
+        _part_of(drive, r, done, at, part)
+        _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, part, 0, (at - done) * h,
+             flags, outputs, False, j)
+        located[0] += 1
+        _switching(c, pointers, model, data, turning, work, cycloid, switches, part, 0, 2, (at - done) * h, flags,
+                   g0, r0)
+        crossed_together(g0, r0, (at - done) * h, crossed)
+        done, span = at, (1.0 - at) * h
+        _part_of(drive, r, done, 1.0, part)
+        _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, part, 0, span, flags,
+             outputs, False, j)
+    return j
+
+
+class Events(NamedTuple):
+    """Work space of the event location: switching functions and rates at a step's two ends, the drive of a part
+    of a step (a :class:`Drive` of one row), and the count of events located."""
+
+    g0: np.ndarray
+    r0: np.ndarray
+    g1: np.ndarray
+    r1: np.ndarray
+    part: Drive
+    located: np.ndarray
+
+
 @numba.njit(nogil=True, cache=True)
 def run_steps(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, split, flags,
-              outputs, h, start, stop, every, j):
+              outputs, h, start, stop, every, j, switches, events):
     """Steps start..stop-1 of one twin, sampling those that begin on a multiple of ``every`` into rows j.. of
     ``outputs``; returns the next row.  ``c``: MuJoCo's C functions (forward, forward_skip, integrate_pos, passive,
     kinematics, com_pos, jac); then the twin in the groups above: ``drive`` one row per step, ``split`` the split
-    steps' sub-steps."""
+    steps' sub-steps, ``switches`` and ``events`` the contact events' location (:func:`_step`)."""
     first, count, lengths = split.first, split.count, split.lengths
     for step in range(start, stop):
         i = step - start
         sample = step % every == 0
         if count[i] > 0:
             for s in range(first[i], first[i] + count[i]):
-                j = _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, split.drive, s,
-                         lengths[s], flags, outputs, sample and s == first[i], j)
+                j = _step(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, split.drive, s,
+                          lengths[s], flags, outputs, sample and s == first[i], j, switches, events)
             continue
-        j = _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, i, h, flags,
-                 outputs, sample, j)
+        j = _step(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, i, h, flags,
+                  outputs, sample, j, switches, events)
     return j

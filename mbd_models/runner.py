@@ -71,6 +71,8 @@ from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, st
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+                                     samples_between)
 from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
@@ -170,7 +172,56 @@ class _Stepper:
         self.energy = np.empty((n_samples, 2)) if energy else None
         self.moving = list(zip(mb.moving_contacts, mb.moving_slices()))  # each with its columns in ``pins``
         self.pins = np.empty((n_samples, sum(len(c.tendons) for c in mb.moving_contacts))) if self.moving else None
+        self.switches = mesh_switches(mb)
+        self.located = 0
         self.j = 0
+
+    def switching(self, drive, s: int, span: float) -> tuple[np.ndarray, np.ndarray]:
+        """The contact switching functions of the present state and their rates
+        (:func:`gearcheck.mbd_models.compiled._switching`'s, in its order), ``drive`` (k, u, e, de, pairs) at the
+        three samples of a step of length ``span``, taken at sample ``s``."""
+        m, d, sw = self.m, self.d, self.switches
+        self.mb.refresh(d.qpos)
+        length = np.add.reduceat(m.wrap_prm[sw.wraps] * d.qpos[sw.qadr], sw.starts[:-1]) if sw.wraps.size else []
+        speed = np.add.reduceat(m.wrap_prm[sw.wraps] * d.qvel[sw.dofs], sw.starts[:-1]) if sw.wraps.size else []
+        _, _, e, de, pairs = drive
+        g, rate = [], []
+        for i, (t, j, b) in enumerate(zip(sw.tendons, sw.relieved, sw.half_backlash)):
+            y, dy = length[i] - (0.0 if e is None else e[s][t]), speed[i] - (0.0 if de is None else de[s][t])
+            if j >= 0:
+                finite = np.isfinite(pairs[:, j, :, 1]).all(axis=0)
+                gaps = np.where(finite, pairs[:, j, :, 1], 0.0)
+                g += list(np.where(finite, y - gaps[s], -1.0))
+                rate += list(np.where(finite, dy - rate_from_samples(gaps[0], gaps[1], gaps[2], s, span), 0.0))
+            else:
+                g += [y - b, y + b]
+                rate += [dy, dy]
+        for c, _ in self.moving:
+            g += list(c.refresh(self.d))
+            rate += list(c.speed)
+        return np.array(g, dtype=float), np.array(rate, dtype=float)
+
+    def step(self, h: float, drive, sample: bool) -> None:
+        """One (sub-)step of length h (:meth:`rk4`), its contact events located as the compiled loop locates them
+        (:func:`gearcheck.mbd_models.compiled._step`)."""
+        if not self.switches.count:
+            self.rk4(h, drive, sample)
+            return
+        g0, r0 = self.switching(drive, 0, h)
+        self.rk4(h, drive, sample)
+        done, span = 0.0, h
+        for _ in range(MAX_EVENTS):
+            theta, crossed = first_crossing(g0, r0, *self.switching(drive, 2, h), span)
+            if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
+                break
+            at = done + theta * (1.0 - done)
+            self.d.qpos[:], self.d.qvel[:], self.d.act[:] = self.start
+            self.rk4((at - done) * h, _part_of(drive, done, at), False)
+            self.located += 1
+            g0, r0 = self.switching(_part_of(drive, done, at), 2, (at - done) * h)
+            crossed_together(g0, r0, (at - done) * h, crossed)
+            done, span = at, (1.0 - at) * h
+            self.rk4(span, _part_of(drive, done, 1.0), False)
 
     def set_stage(self, k, u, e, de, pairs=None) -> None:
         """Everything a stage sets from its own state: the mesh tendons' coefficients turned with their carriers,
@@ -211,17 +262,17 @@ class _Stepper:
             step = start + i
             sample = step % every == 0
             if step not in split:
-                self.rk4(self.h, [None if x is None else x[i] for x in values], sample)
+                self.step(self.h, [None if x is None else x[i] for x in values], sample)
                 continue
             starts, lengths = stepping.sub_steps(step * self.h, self.h, split[step])
             for n, (rows, length) in enumerate(zip(zip(*(_rows(x) for x in self.drive.steps(starts, lengths))),
                                                    lengths)):
-                self.rk4(length, rows, sample and n == 0)
+                self.step(length, rows, sample and n == 0)
 
     def rk4(self, h: float, drive, sample: bool) -> None:
         """One RK4 (sub-)step of length h, ``drive`` (k, u, e, de, pairs) at its stage times t, t + h/2, t + h."""
         m, d = self.m, self.d
-        qpos0, qvel0, act0 = d.qpos.copy(), d.qvel.copy(), d.act.copy()
+        qpos0, qvel0, act0 = self.start = d.qpos.copy(), d.qvel.copy(), d.act.copy()
         rates = []
         for stage, s in enumerate(compiled.STAGE_TIMES):
             if stage:
@@ -255,6 +306,40 @@ class _Stepper:
 
 
 RK4_WEIGHTS = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
+
+
+def mesh_switches(mb: MbdModel) -> compiled.MeshSwitches:
+    """The mesh tendons whose contact law has kinks (a backlash's dead zone, a relieved mesh's tooth pairs) with
+    their coefficients' addresses, and (``count``) how many switching functions the twin has with its pins."""
+    m, exc = mb.model, mb.excitation
+    place = {int(j): r for r, j in enumerate(exc.relieved)}
+    meshes = [i for i in range(len(mb.mesh_tendon)) if i in place or mb.half_backlash[i] > 0]
+    tendons = np.array([mb.mesh_tendon[i] for i in meshes], dtype=np.int64)
+    wraps = [np.arange(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t]) for t in tendons]
+    flat = np.concatenate(wraps).astype(np.int64) if wraps else np.zeros(0, dtype=np.int64)
+    joints = m.wrap_objid[flat]
+    pairs = exc.tooth_pairs(0.0)[0]
+    relieved = np.array([place.get(i, -1) for i in meshes], dtype=np.int64)
+    count = (2 * int(np.sum(relieved < 0)) + int(np.sum(relieved >= 0)) * (0 if pairs is None else pairs.shape[-1])
+             + sum(len(c.tendons) for c in mb.moving_contacts))
+    return compiled.MeshSwitches(tendons, flat, m.jnt_qposadr[joints].astype(np.int64),
+                                 m.jnt_dofadr[joints].astype(np.int64),
+                                 np.cumsum([0] + [w.size for w in wraps]).astype(np.int64), relieved,
+                                 np.array([mb.half_backlash[i] for i in meshes], dtype=float), count)
+
+
+def _part_of(drive, a: float, b: float) -> list:
+    """The drive (k, u, e, de, pairs) of the part from fraction a to b of a step whose three samples are
+    ``drive`` (:func:`~gearcheck.shared.events.samples_between`)."""
+    out = []
+    for x in drive:
+        if x is None:
+            out.append(None)
+            continue
+        part = np.empty_like(x)
+        samples_between(np.ascontiguousarray(x), a, b, part)
+        out.append(part)
+    return out
 
 
 def _rows(x):
@@ -299,6 +384,9 @@ class _CompiledStepper(_Stepper):
                                         np.zeros((0, 0)) if self.pins is None else self.pins)
         self.flags = compiled.Flags(self.drive.has_te, self.contacts is not None, self.stiffness is not None,
                                     self.energy is not None, self.pins is not None)
+        count = self.switches.count
+        self.events = compiled.Events(np.zeros(count), np.zeros(count), np.zeros(count), np.zeros(count),
+                                      self._arrays(self.drive.steps(np.zeros(1), h), 1), np.zeros(1, dtype=np.int64))
 
     def _arrays(self, values, rows: int) -> compiled.Drive:
         """(k, u, e, de, pairs) of :meth:`_Drive.steps` as contiguous arrays, the absent ones empty along their last
@@ -320,7 +408,9 @@ class _CompiledStepper(_Stepper):
         sub = self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size else [None] * 5
         self.j = compiled.run_steps(self.c, *self.twin, self._arrays(values, rows),
                                     compiled.Split(first, count, lengths, self._arrays(sub, lengths.size)),
-                                    self.flags, self.outputs, self.h, start, stop, every, self.j)
+                                    self.flags, self.outputs, self.h, start, stop, every, self.j, self.switches,
+                                    self.events)
+        self.located = int(self.events.located[0])
 
 
 def compiled_unsupported(mb: MbdModel, stiffness_clock: str = "nominal") -> str | None:
@@ -404,12 +494,14 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         m.tendon_damping[:] = saved[6]
     t = dt * every * np.arange(stepper.j)
     loop = "compiled" if use_compiled else "python"
-    info = RunInfo(f"mujoco-{loop}", n_steps, 4, 4 * sub_steps, wall, {  # mj_forward, then mj_RungeKutta's 3
+    sub_steps += 2 * stepper.located  # a located event takes its step again in two parts
+    info = RunInfo(f"mujoco-{loop}", n_steps, 4, 4 * sub_steps, wall, {  # mj_forward at each of RK4's stages
         "method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": n_steps, "wall_time_s": wall,
         "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
         "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
         "static_newton_iterations": static.iterations, "static_residual": static.residual,
-        "forward_evaluations": 4 * n_steps, "engine": loop})  # as reports state them
+        "forward_evaluations": 4 * n_steps, "engine": loop,  # as reports state them
+        "contact_events_located": stepper.located})
     result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
     return (result, (d.qpos.copy(), d.qvel.copy())) if return_state else result
 

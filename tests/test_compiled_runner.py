@@ -63,14 +63,25 @@ def difference(a, b) -> float:
 def test_the_compiled_loop_repeats_the_python_loop(twins, name):
     """demo-3p: rectangular stiffness (split steps); hub-drive: transmission error, backlash, two stages;
     double-planet: torque ripple; chained: two carriers; helical, 15 um: tip relief; rv-reducer: pin contacts
-    that follow the discs (MuJoCo's Jacobians every step), needle bearings."""
+    that follow the discs (MuJoCo's Jacobians every step), needle bearings.  Where both loops locate the same
+    contact events they agree to round-off (measured at most 4e-10); locating an event is a decision, and one
+    whose crossing falls within round-off of a threshold (a step's end, or the instant of another event) may go
+    one way in one loop and the other in the other: then they agree within 5 % of the integration error (the
+    difference between the runs at h and h/2; measured on the tip relief, 280 and 279 events: 2.6e-6 against
+    8.6e-5)."""
     mb = twins(name)
     settings = RunSettings(DURATION)
     fast = simulate_mujoco(mb, settings, record_energy=True)
     slow = simulate_mujoco(mb, settings, record_energy=True, engine="python")
     assert fast.info.engine == "mujoco-compiled" and slow.info.engine == "mujoco-python"
-    assert fast.info.rhs_calls == slow.info.rhs_calls >= 4 * fast.info.steps  # 4 a sub-step: split steps count more
+    # 4 a sub-step: split steps count more, and a located contact event 8 (its step taken again in two parts)
+    events = fast.info["contact_events_located"], slow.info["contact_events_located"]
+    assert fast.info.rhs_calls - 8 * events[0] == slow.info.rhs_calls - 8 * events[1] >= 4 * fast.info.steps
     round_off = 10 * ROUND_OFF if mb.moving_contacts else ROUND_OFF
+    if events[0] != events[1]:
+        assert abs(events[0] - events[1]) <= 2
+        finer = simulate_mujoco(mb, RunSettings(DURATION, dt=mb.default_step / 2, output_dt=mb.default_step))
+        round_off = 0.05 * difference(finer, fast)
     assert difference(slow, fast) < round_off
     assert fast.raw.keys() == slow.raw.keys()
     for key in ("energy_kinetic", "energy_potential"):

@@ -322,6 +322,7 @@ class CycloidTwin:
         self._jac = np.zeros((3, m.nv))
         n = len(self.tendons)
         self._delta, self._length, self._band = np.empty(n), np.empty(n), np.empty((n, 2))
+        self.speed = np.empty(n)  # each pin tendon's rate of length at the last refresh, its coefficients held
 
     def refresh(self, d: mujoco.MjData, touching: np.ndarray | None = None, gaps: bool = True) -> np.ndarray:
         """Coefficients, spring lengths, stiffness and damping of every pin tendon at ``d.qpos`` (its kinematics
@@ -356,6 +357,7 @@ class CycloidTwin:
             coef = n @ g.jacobian
             m.wrap_prm[g.wraps] = coef
             length[g.rows] = (coef @ qpos[g.qadr][..., None]).ravel()
+            self.speed[g.rows] = (coef @ d.qvel[g.dofs][..., None]).ravel()
         if gaps:
             delta -= self.clearance
         t, band = self.tendons, self._band

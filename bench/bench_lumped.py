@@ -42,7 +42,7 @@ from gearcheck.lumped.time_solver import default_step, simulate
 from gearcheck.train.variants import chained, edited, wide_stage
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS, per_step_drive
+from gearcheck.shared.stepping import STAGE_OFFSETS
 
 LIGHT_BACKLASH = [(r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nbacklash_um = 40.0\n"
                    "ste = [{ harmonic = 1, amplitude_um = 5.0 }]"), (r"^output_torque = .*", "output_torque = 30.0")]
@@ -71,8 +71,8 @@ def _acceleration(q, v, k, F, minv, C, K0, A, out):
 
 @njit(cache=True)
 def yardstick_rk4(q, v, h, minv, C, K0, A, k, F):
-    """RK4 of M q'' = F - C q' - K0 q - A^T (k * A q) over k.shape[0] steps; k, F (steps, 2, .): the drive of
-    stage 1 and of stages 2-4."""
+    """RK4 of M q'' = F - C q' - K0 q - A^T (k * A q) over k.shape[0] steps; k, F (steps, 3, .): the drive at
+    the stage times t, t + h/2, t + h."""
     n = q.size
     a1, a2, a3, a4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     q2, v2, q3, v3, q4, v4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
@@ -89,7 +89,7 @@ def yardstick_rk4(q, v, h, minv, C, K0, A, k, F):
         for i in range(n):
             q4[i] = q[i] + h * v3[i]
             v4[i] = v[i] + h * a3[i]
-        _acceleration(q4, v4, k[s, 1], F[s, 1], minv, C, K0, A, a4)
+        _acceleration(q4, v4, k[s, 2], F[s, 2], minv, C, K0, A, a4)
         for i in range(n):
             q[i] += h / 6.0 * (v[i] + 2 * v2[i] + 2 * v3[i] + v4[i])
             v[i] += h / 6.0 * (a1[i] + 2 * a2[i] + 2 * a3[i] + a4[i])
@@ -101,10 +101,9 @@ def yardstick_cost(model, dt: float, steps: int, repeats: int = 5) -> float:
     mesh stiffness and torques sampled as the solver samples them, best of ``repeats``."""
     exc = model.excitation
     times = (np.arange(steps)[:, None] + np.array(STAGE_OFFSETS)[None, :]) * dt
-    k = per_step_drive(exc.stiffness(times))[:, :2].copy()
-    t_in, t_out = (per_step_drive(x) for x in exc.torques(times))
+    k = exc.stiffness(times)
+    t_in, t_out = exc.torques(times)
     F = model.F_static + np.multiply.outer(t_in, model.b_input) + np.multiply.outer(t_out, model.b_output)
-    F = F[:, :2].copy()
     minv = 1.0 / np.diag(model.M)
     C, K0, A = model.C + model.G, model.K_b + model.K_frame, np.ascontiguousarray(model.mesh_rows)
     best = np.inf

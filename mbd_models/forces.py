@@ -63,7 +63,7 @@ class ForceReader:
     def sample(self, out: np.ndarray) -> None:
         """After ``mj_forward``: write the planet joints' (mesh-only, applied) generalized forces and the bearing
         slides' joint forces into ``out`` (one row of :attr:`width`), for :meth:`forces`.  Leaves the data's
-        passive forces those of a probe (nothing that ``mj_RungeKutta`` reads)."""
+        passive forces those of a probe (nothing that the RK4 stages read)."""
         n, dofs, total = len(self.dofs), self.dofs, self._sum
         self._probe_stiffness[:] = self._stiffness
         self._probe_lengths[:] = self._lengths

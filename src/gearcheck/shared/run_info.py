@@ -20,8 +20,9 @@ class RunInfo(Mapping):
     (the twin's step loop in C or in Python), "mujoco-step" (``mj_step``).
     steps: whole steps of the run's step (a scipy method's: of the output grid, each of its own steps at most that).
     stages: right-hand-side evaluations per step (4 for RK4; None where it varies: scipy's methods).
-    rhs_calls: right-hand-side evaluations the stepping took (MuJoCo's: forward-dynamics passes, ``mj_forward`` and
-    the stages of ``mj_RungeKutta``), a step split at a stiffness jump counting each of its sub-steps.
+    rhs_calls: right-hand-side evaluations the stepping took (MuJoCo's: forward-dynamics passes, one per RK4 stage),
+    a step split at a stiffness jump counting each of its sub-steps, one holding a located contact event its first
+    try and its two parts.
     wall_s: seconds the stepping took.
     settings: the run's settings and findings as its reports state them; the record reads as this mapping."""
 

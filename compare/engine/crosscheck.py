@@ -66,7 +66,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         A stored baseline to compare with (``"shipped"``: the one shipped for this preset); its speed
         and duration must match, which is checked before anything runs.
     update_baseline : bool
-        Rewrite ``baseline`` with this run instead of comparing.
+        Rewrite ``baseline`` with this run instead of comparing (over the duration it was taken over, unless
+        ``duration`` says otherwise).
     progress : callable, optional
         Called with the fraction done.
     sides : callable, optional
@@ -84,9 +85,11 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     _check_band(sensor_band)
     tol = Tolerances.for_train(spec, tolerances)
     path = baseline_path(baseline, spec.name)
-    stored = read_baseline(path) if path is not None and not update_baseline else None
+    # a baseline rewritten without a duration keeps the one it was taken over
+    keep = update_baseline and duration is None and path is not None and path.exists()
+    stored = read_baseline(path) if path is not None and (not update_baseline or keep) else None
     duration = pair.duration(stored) if duration is None else duration
-    if stored is not None:  # before the run: a mismatch is refused at once
+    if stored is not None and not update_baseline:  # before the run: a mismatch is refused at once
         check_settings(stored, duration, rad_s_to_rpm(spec.operating.input_speed))
     plan = pair.plan(spec, duration)
     settings = pair.settings(duration, plan, {"lumped": dt_lumped, "mujoco": dt_mujoco})

@@ -500,7 +500,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
         "stiffness_clock": stiffness_clock, "mujoco_version": mujoco.__version__,
         "static_newton_iterations": static.iterations, "static_residual": static.residual,
-        "forward_evaluations": 4 * n_steps, "engine": loop,  # as reports state them
+        "forward_evaluations": 4 * sub_steps, "engine": loop,  # sub-steps and located events included
         "contact_events_located": stepper.located})
     result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
     return (result, (d.qpos.copy(), d.qvel.copy())) if return_state else result

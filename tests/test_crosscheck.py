@@ -153,3 +153,15 @@ def test_sensor_band_filters_both_solvers_alike():
     assert band.passed and q1.metrics["nrmse"] < 0.01
     force0, force1 = plain["stage1.planet1.sun.force"], band["stage1.planet1.sun.force"]
     assert force1.metrics["reference"]["rms"] == force0.metrics["reference"]["rms"]  # forces unfiltered
+
+
+def test_spectral_lines_of_a_switching_stiffness_are_read_from_each_runs_own_samples():
+    """demo-3p's rectangular stiffness makes the carrier's angular acceleration jump at every switch.  Read from
+    each run's own samples with the jumps projected exactly (as the sweep reads its lines), its mesh harmonics agree
+    between the solvers within a quarter of the quantity's tolerance (0.24 measured); read from the anti-aliased
+    common grid they came out 7 to 12 tolerances apart, three lines flagged fail on a passing quantity."""
+    result = crosscheck("demo-3p", duration=0.1)
+    carrier = result["stage1.carrier.alpha"]
+    assert carrier.status == "pass"
+    assert max(abs(line["rel_error"]) for line in carrier.spectrum if line["rel_error"] is not None) \
+        < 0.3 * carrier.tolerance

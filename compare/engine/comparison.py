@@ -43,7 +43,8 @@ from gearcheck.compare.engine.align import (
     steady_state,
     uniform_grid,
 )
-from gearcheck.compare.engine.metrics import modal_metrics, spectral_metrics, waveform_metrics
+from gearcheck.compare.engine.line_projection import harmonics
+from gearcheck.compare.engine.metrics import modal_metrics, spectral_amplitude, spectral_metrics, waveform_metrics
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError, UnsupportedError
@@ -276,7 +277,8 @@ class _Attempt:
             t0 = 0.5 * grid[-1] if how is None else t0
         errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a)
                            for run, check in ((a, a_check), (b, b_check))) for n in names}
-        comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors)
+        own = (a, b, t0) if sensor_band is None else None  # lines from each run's own samples (see _lines)
+        comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors, own)
         return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons, starts)
 
 
@@ -368,7 +370,7 @@ def _common_grid(a, b, names, plan, sensor_band):
     return grid, fs, series
 
 
-def _quantities(a, names, series, window, fs, plan, tolerances, errors) -> list[QuantityComparison]:
+def _quantities(a, names, series, window, fs, plan, tolerances, errors, own=None) -> list[QuantityComparison]:
     scale: dict[str, float] = {}
     for n in names:
         kind = a.signal(n).kind
@@ -387,8 +389,32 @@ def _quantities(a, names, series, window, fs, plan, tolerances, errors) -> list[
         floor = plan.floors.get(s.kind, 0.0) / (tol or 1.0)  # round-off a tolerance's share of the signal
         status = verdict(metrics, tol, max(NEGLIGIBLE * scale[s.kind], floor) / NEGLIGIBLE)
         comparisons.append(QuantityComparison(n, s.kind, s.unit, s.description, status, metrics,
-                                              spectral_metrics(xa, xb, fs, lines), tol))
+                                              spectral_metrics(*_lines(n, xa, xb, fs, lines, plan, own), lines), tol))
     return comparisons
+
+
+def _lines(name, xa, xb, fs, lines, plan, own) -> tuple[np.ndarray, np.ndarray]:
+    """Both sides' amplitudes of ``name`` at the lines' frequencies.  From each run's own uniform samples over its
+    steady window (``own``: the two runs and the window's start), the jumps of a switching mesh stiffness projected
+    exactly (:func:`~gearcheck.compare.engine.line_projection.harmonics`, as the sweep reads its lines): a jump
+    sampled at a step aliases onto every line, which the anti-aliased common grid would smear instead.  Else (a
+    sensor band, a recording, no switches) from the common grid's series ``xa``, ``xb``."""
+    freqs = [f for _, f in lines]
+    runs = [] if own is None or plan.switch_times is None else [run for run in own[:2] if _uniform(run.t)]
+    if len(runs) < 2:
+        return spectral_amplitude(xa, fs, freqs), spectral_amplitude(xb, fs, freqs)
+    out = []
+    for run in runs:
+        window = run.t >= own[2]
+        t, x = run.t[window], run[name][window]
+        out.append(np.abs(harmonics(t, x, freqs, _rate(t), plan.switch_times(t[0], t[-1]))[:, 0]))
+    return tuple(out)
+
+
+def _uniform(t: np.ndarray) -> bool:
+    """Samples at one rate (a run's own steps), not a recording's times."""
+    step = np.diff(t)
+    return t.size > 2 and float(np.max(np.abs(step - step.mean()))) <= 1e-9 * float(step.mean())
 
 
 def integration_error(run, check, name: str, start: float, reference) -> float | None:

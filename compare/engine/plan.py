@@ -30,6 +30,7 @@ import numpy as np
 from gearcheck.compare.engine.align import STEADY_THRESHOLD, STEADY_WINDOW_CYCLES
 from gearcheck.compare.engine.metrics import spectral_lines
 from gearcheck.shared.stepping import transient_step
+from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import kinematics
 
 
@@ -43,6 +44,7 @@ class TrainPlan:
     operating: dict = field(default_factory=dict)  # the operating point the report states
     resample: bool = True
     detect_steady: bool = True
+    switch_times: object = None  # (t0, t1) -> the instants in between at which a mesh stiffness jumps
 
     @classmethod
     def of(cls, spec, reference, duration: float) -> "TrainPlan":
@@ -54,7 +56,8 @@ class TrainPlan:
             f_mesh = min(kin.mesh_frequency[m.id] for m in spec.meshes if m.stage == stage.name)
             stages[stage.name] = (f_mesh, abs(kin.speeds[stage.carrier]) / (2 * math.pi))
         return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, reference.omega_max(), duration),
-                   reference.settling_time(STEADY_THRESHOLD), reference.operating())
+                   reference.settling_time(STEADY_THRESHOLD), reference.operating(),
+                   switch_times=Excitation(spec, kin).switch_times)
 
     def steady_groups(self, names) -> list[tuple[list[str], float]]:
         """The mesh-force signals among ``names`` with the cycle over which they repeat in steady state: all
@@ -110,6 +113,7 @@ class TransientPlan:
     floors: dict = field(default_factory=dict)
     resample: bool = False
     detect_steady: bool = False
+    switch_times: object = None
 
     @classmethod
     def of(cls, reference, test) -> "TransientPlan":

@@ -44,7 +44,7 @@ from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.train.periods import MAX_MESH_PERIODS, common_period, whole_cycles
 
-MAX_DRIVE_PERIODS = 64  # the longest T_M sought, in periods of the drive
+MAX_DRIVE_PERIODS = 256  # the longest T_M sought, in drive periods: a carrier turns once in z_ring mesh periods
 MAX_ANDERSON_RUNS = 100
 
 

@@ -91,7 +91,7 @@ def test_demo_3p_shot_in_two_runs():
     (lambda: edited("demo-3p", [(r"^output_torque = .*", "output_torque = 1500.0\nramp_s = 0.01")], "ramp"),
      "the load ramp over the first 0.01 s not periodic"),
     (lambda: edited("double-planet", [(r"^order = 2.0", "frequency_hz = 41.3")], "41.3 Hz ripple"),
-     r"carriers \(stage1.carrier 20 Hz\) turn no whole number of revolutions within 64 periods of the drive"),
+     r"carriers \(stage1.carrier 20 Hz\) turn no whole number of revolutions within 256 periods of the drive"),
     (lambda: load_train("rv-reducer"), "pin contacts follow the bodies' poses"),
 ])
 def test_twin_without_a_period_is_refused(case, why):

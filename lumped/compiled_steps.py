@@ -32,7 +32,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
 
@@ -352,13 +352,8 @@ def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
             dy += ax[p] * u[ai[p]]
         if j >= 0:
             for pair in range(pairs.shape[2]):
-                g0, g1, g2 = pairs[0, j, pair, 1], pairs[1, j, pair, 1], pairs[2, j, pair, 1]
-                if np.isfinite(g0) and np.isfinite(g1) and np.isfinite(g2):
-                    g[n] = y - pairs[s, j, pair, 1]
-                    rate[n] = dy - rate_from_samples(g0, g1, g2, s, span)
-                else:
-                    g[n] = -1.0
-                    rate[n] = 0.0
+                g[n], rate[n] = pair_switch(y, dy, pairs[0, j, pair, 1], pairs[1, j, pair, 1], pairs[2, j, pair, 1], s,
+                                            span)
                 n += 1
         else:
             g[n], g[n + 1] = y - half[m], y + half[m]

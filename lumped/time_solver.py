@@ -35,7 +35,7 @@ from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
-from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.run_info import RunInfo
@@ -130,11 +130,10 @@ class _System:
         for m in range(y.size):
             j = self.relieved_index[m]
             if j >= 0:
-                finite = np.isfinite(pairs[:, j, :, 1]).all(axis=0)
-                gaps = np.where(finite, pairs[:, j, :, 1], 0.0)
-                slope = rate_from_samples(gaps[0], gaps[1], gaps[2], s, span)
-                g += list(np.where(finite, y[m] - gaps[s], -1.0))
-                rate += list(np.where(finite, dy[m] - slope, 0.0))
+                for gaps in pairs[:, j, :, 1].T:
+                    value, slope = pair_switch(y[m], dy[m], *gaps, s, span)
+                    g.append(value)
+                    rate.append(slope)
             elif self.has_backlash and self.b[m] > 0:
                 g += [y[m] - self.b[m], y[m] + self.b[m]]
                 rate += [dy[m], dy[m]]

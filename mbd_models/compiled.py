@@ -31,7 +31,7 @@ import numba
 import numpy as np
 
 from gearcheck.mbd_models.elements.cycloid import PIN_BAND
-from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
 _LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
@@ -590,13 +590,8 @@ def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive
         j = relieved[i]
         if j >= 0:
             for pair in range(drive.pairs.shape[3]):
-                g0, g1, g2 = drive.pairs[r, 0, j, pair, 1], drive.pairs[r, 1, j, pair, 1], drive.pairs[r, 2, j, pair, 1]
-                if np.isfinite(g0) and np.isfinite(g1) and np.isfinite(g2):
-                    g[n] = length - drive.pairs[r, s, j, pair, 1]
-                    rate[n] = speed - rate_from_samples(g0, g1, g2, s, span)
-                else:
-                    g[n] = -1.0
-                    rate[n] = 0.0
+                gaps = drive.pairs[r, :, j, pair, 1]
+                g[n], rate[n] = pair_switch(length, speed, gaps[0], gaps[1], gaps[2], s, span)
                 n += 1
         else:
             g[n], g[n + 1] = length - half[i], length + half[i]

@@ -71,7 +71,7 @@ from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, st
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
-from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, rate_from_samples,
+from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.run_info import RunInfo
@@ -189,10 +189,10 @@ class _Stepper:
         for i, (t, j, b) in enumerate(zip(sw.tendons, sw.relieved, sw.half_backlash)):
             y, dy = length[i] - (0.0 if e is None else e[s][t]), speed[i] - (0.0 if de is None else de[s][t])
             if j >= 0:
-                finite = np.isfinite(pairs[:, j, :, 1]).all(axis=0)
-                gaps = np.where(finite, pairs[:, j, :, 1], 0.0)
-                g += list(np.where(finite, y - gaps[s], -1.0))
-                rate += list(np.where(finite, dy - rate_from_samples(gaps[0], gaps[1], gaps[2], s, span), 0.0))
+                for gaps in pairs[:, j, :, 1].T:
+                    value, slope = pair_switch(y, dy, *gaps, s, span)
+                    g.append(value)
+                    rate.append(slope)
             else:
                 g += [y - b, y + b]
                 rate += [dy, dy]

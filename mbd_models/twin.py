@@ -75,8 +75,7 @@ class TurningCoefficients:
     Per wrap (x wraps of every mesh, then their y wraps): ``wraps`` the index into ``wrap_prm``;
     ``base`` (2n, 2) such that the coefficient is base @ (cos phi, sin phi), phi the angle of the
     carrier at qpos address ``carrier_qadr``; ``tendon`` the mesh it belongs to; ``slide_qadr`` and
-    ``slide_dof`` the slide it multiplies.  ``single``: the qpos address of the one carrier all wraps
-    turn with, or None (several stages)."""
+    ``slide_dof`` the slide it multiplies."""
 
     wraps: np.ndarray
     base: np.ndarray
@@ -84,7 +83,6 @@ class TurningCoefficients:
     tendon: np.ndarray
     slide_qadr: np.ndarray
     slide_dof: np.ndarray
-    single: int | None
 
     def values(self, phi) -> np.ndarray:
         """The coefficients at carrier angles ``phi`` (one per wrap, or one scalar for all)."""
@@ -314,9 +312,8 @@ def _indices(spec, kin, exc, model) -> MbdModel:
     slide_qadr = np.array([qadr[mid][0] for mid in slide_x] + [qadr[mid][1] for mid in slide_y], dtype=int)
     slide_dof = np.array([dadr[mid][0] for mid in slide_x] + [dadr[mid][1] for mid in slide_y], dtype=int)
     carrier_qadr = np.array(carrier + carrier, dtype=int)
-    single = int(carrier_qadr[0]) if len(set(carrier_qadr.tolist())) == 1 else None
     turning = TurningCoefficients(wraps, base, carrier_qadr, np.array(tendon + tendon, dtype=int), slide_qadr,
-                                  slide_dof, single)
+                                  slide_dof)
     return MbdModel(spec, kin, exc, "", model, None, body, qadr, dadr, mesh_tendon,
                     model.tendon_damping[mesh_tendon].copy(), model.tendon_lengthspring[mesh_tendon, 1].copy(),
                     actuator, sensor, turning)

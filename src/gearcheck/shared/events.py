@@ -105,6 +105,16 @@ def samples_between(source, a, b, target) -> None:
 
 
 @njit(inline="always")
+def pair_switch(y, dy, g0, g1, g2, s, span):
+    """(y - e_j, its rate) of a tooth pair whose gap e_j has the samples g0, g1, g2 over a step of length span, at
+    sample s (0 or 2), y and dy the mesh's deflection and its rate; (-1, 0) for a pair out of the path at one of
+    them."""
+    if np.isfinite(g0) and np.isfinite(g1) and np.isfinite(g2):
+        return y - (g0 if s == 0 else g2), dy - rate_from_samples(g0, g1, g2, s, span)
+    return -1.0, 0.0
+
+
+@njit(inline="always")
 def rate_from_samples(y0, y1, y2, s, span):
     """The time derivative at sample s (0 or 2) of the quadratic through three samples of a step of length span."""
     return ((-3.0 * y0 + 4.0 * y1 - y2) if s == 0 else (y0 - 4.0 * y1 + 3.0 * y2)) / span

@@ -1,14 +1,18 @@
 """Derived quantities of a train, as ``gearcheck show`` prints them: ratio, speeds, gear geometry
 (helix angles), contact ratios (transverse and face), operating pressure angles, mesh frequencies and phases, loaded
 flanks, mesh stiffness and damping; what the other parts show of themselves (an RV reducer's cycloid-pin stage:
-:meth:`gearcheck.train.parts.Part.describe`)."""
+:meth:`gearcheck.train.parts.Part.describe`); how long the free vibration of a start takes to die away, and which
+supports have no damping (gearcheck adds none that the train file does not state)."""
 
 from __future__ import annotations
 
 import math
 
 from gearcheck.lumped.assembly import build_model
+from gearcheck.shared.modal import slowest_decaying_mode
 from gearcheck.shared.units import rad_s_to_rpm
+
+SETTLED = 2e-3  # the fraction of a start's free vibration that counts as died away (the cross-check's steady rule)
 
 
 def describe(spec) -> dict:
@@ -51,7 +55,28 @@ def describe(spec) -> dict:
             "damping_n_s_per_m": float(model.mesh_damping[j]), "backlash_m": mesh.backlash,
             "stiffness_model": mesh.stiffness["model"],
         })
+    out["settling"] = settling(spec, model)
     return out
+
+
+def settling(spec, model) -> dict:
+    """The slowest-decaying mode of the model at mean mesh stiffness (frequency, damping ratio, time constant), the
+    time its free vibration takes to fall to ``SETTLED`` of its start, and each support or bearing direction that
+    is stiff but has no damping ("stage1.sun radial")."""
+    frequency, zeta = slowest_decaying_mode(model.M, model.C + model.G, model.K_mean + model.K_frame)
+    tau = None if zeta <= 0.0 else 1.0 / (2 * math.pi * frequency * zeta)  # None: it never decays
+    undamped = [f"{mid} {direction}" for mid, member in spec.members.items() for s in (member.support, member.bearing)
+                if s is not None for direction in _undamped(s)]
+    return {"slowest_mode_hz": frequency, "damping_ratio": zeta, "time_constant_s": tau,
+            "settle_s": None if tau is None else tau * math.log(1.0 / SETTLED), "undamped_supports": undamped}
+
+
+def _undamped(support) -> list[str]:
+    """The directions in which ``support`` is stiff but has no damping."""
+    return [direction for direction, k, c in (("radial", support.radial_stiffness, support.radial_damping),
+                                              ("torsional", support.torsional_stiffness, support.torsional_damping),
+                                              ("axial", support.axial_stiffness, support.axial_damping))
+            if k > 0.0 and c <= 0.0]
 
 
 def _gear_label(member, gear) -> str:

@@ -35,6 +35,7 @@ class LumpedSide(Side):
     :func:`gearcheck.lumped.time_solver.simulate`)."""
 
     solver = "lumped"
+    order = stepping.ORDER  # RK4, the drive set at every stage, contact events located
 
     def __init__(self, spec, method: str = "rk4"):
         self.spec = spec

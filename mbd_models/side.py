@@ -30,6 +30,7 @@ class MujocoSide(Side):
     :func:`gearcheck.mbd_models.runner.simulate_mujoco`)."""
 
     solver = "mujoco"
+    order = stepping.ORDER  # RK4, the drive set at every stage, contact events located
     references = ("todorov-2012",)
 
     def __init__(self, spec, stiffness_clock: str = "nominal"):

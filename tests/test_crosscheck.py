@@ -2,15 +2,17 @@
 reproducible byte for byte, baselines hold."""
 
 import dataclasses
+import math
 import json
 from pathlib import Path
 
 import pytest
 
+import gearcheck
 from gearcheck import crosscheck
-from gearcheck.cli import main
+from gearcheck.cli import main, settling_line
 from gearcheck.compare.engine.baseline import BASELINE_DIR
-from gearcheck.compare.engine.comparison import compare
+from gearcheck.compare.engine.comparison import MAX_REFINEMENTS, compare
 from gearcheck.compare.engine.plan import TrainPlan
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.train.loader import load_train, preset_names
@@ -134,7 +136,7 @@ def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
     assert result.verdict == "INCONCLUSIVE" and not result.failures
     assert "stage1.planet1.sun.force (integration error)" in result.unresolved
     assert result["stage1.ring.ay.world"].status == "pass"
-    assert any("halved (2x)" in note for note in result.notes)
+    assert any(f"Steps halved {MAX_REFINEMENTS}x" in note for note in result.notes)  # in one go, as far as allowed
     loose = tmp_path / "tol.toml"
     loose.write_text("[tolerances]\n\"stage1.planet1.sun.force.nrmse\" = 0.5\n")
     from gearcheck.compare.engine.tolerances import Tolerances
@@ -174,8 +176,26 @@ def test_a_lightly_damped_first_train_is_decided_from_its_periodic_steady_states
     cross-check starts both runs on their periodic steady states: the lumped model's over its mesh period, the
     twin's over the 69 mesh periods in which its carrier turns once (ring of 69 teeth held).  It passes, where it
     used to be INCONCLUSIVE with "run at least 6.9 s"; the note names the slow mode."""
-    pairs = [(r"^planets = 3", "planets = 5"), (r"^teeth = 22", "teeth = 21"), (r"^teeth = 20", "teeth = 24"),
-             (r"^teeth = 62 .*$", "teeth = 69"), (r"radial_damping = [0-9.]+", "radial_damping = 0.0")]
-    result = crosscheck(edited("demo-3p", pairs, "5 planets, undamped supports"))
+    result = crosscheck(edited("demo-3p", FIRST_TRAIN, "5 planets, undamped supports"))
     assert result.verdict == "PASS" and result.steady_how == "periodic", (result.failures, result.unresolved)
     assert any("1483 Hz" in note and "damping ratio" in note for note in result.notes)
+
+
+FIRST_TRAIN = [(r"^planets = 3", "planets = 5"), (r"^teeth = 22", "teeth = 21"), (r"^teeth = 20", "teeth = 24"),
+               (r"^teeth = 62 .*$", "teeth = 69"), (r"radial_damping = [0-9.]+", "radial_damping = 0.0")]
+
+
+def test_a_train_that_cannot_settle_says_so_when_shown():
+    """``gearcheck show`` (and ``describe``) states the slowest-decaying mode and how long a start takes to die away;
+    past a practical run it says what the cross-check does instead and names the supports without damping
+    (gearcheck adds none); a well-damped preset settles within the run."""
+    info = gearcheck.describe(edited("demo-3p", FIRST_TRAIN, "5 planets, undamped supports"))["settling"]
+    assert info["slowest_mode_hz"] == pytest.approx(1483, abs=1) and info["damping_ratio"] < 1e-4
+    assert info["settle_s"] == pytest.approx(math.log(500) * info["time_constant_s"]) and info["settle_s"] > 10
+    members = ["stage1.sun", "stage1.ring", "stage1.carrier"] + [f"stage1.planet{i}" for i in range(1, 6)]
+    assert sorted(info["undamped_supports"]) == sorted(f"{m} radial" for m in members)
+    line = settling_line(info)
+    assert "periodic steady states" in line and "stage1.planet5" in line
+    preset = gearcheck.describe("demo-3p")["settling"]
+    assert preset["undamped_supports"] == [] and preset["settle_s"] < 0.1
+    assert "note" not in settling_line(preset)

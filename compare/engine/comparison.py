@@ -14,17 +14,21 @@ Any pair of :class:`~gearcheck.shared.side.Side` objects, read by a comparison p
    record of a transient.  A run too short to reach it is extended once, to at most
    ``EXTENSION_FACTOR`` times the duration asked for; without a steady state the verdict is
    INCONCLUSIVE;
-5. per signal, lag-aligned waveform metrics, spectral lines and a verdict against the tolerances;
+5. per signal, lag-aligned waveform metrics, spectral lines and a verdict against the tolerances (each run's
+   mean, rms, peak-to-peak and peak, and its lines, from its own samples over the window: the anti-aliasing
+   filter rings at a jump, and inflated the peak-to-peak of demo-3p's mesh forces by 3 %);
    signals negligible in both runs (below ``NEGLIGIBLE`` of the largest of their kind, e.g.
    central-member translations that mesh phasing cancels, or so small that the plan's round-off
    floor of a solver is more than the tolerance's share of them) are reported as such and not gated;
-6. per signal and solver, a bound on the integration error: the NRMSE of the run against its
-   step-doubled twin (:func:`integration_error`; the error of an integrator of order p >= 1 in its
-   asymptotic range is at most the change on doubling its step, and RK4's is a fifteenth of it).
-   Default steps are halved (at most ``MAX_REFINEMENTS`` times) until the two solvers' bounds
-   together are within ``TARGET_FRACTION`` of every gated tolerance; a quantity whose bounds reach
-   its tolerance is *unresolved* (the comparison cannot tell at that tolerance, and the verdict is
-   INCONCLUSIVE).
+6. per signal and solver, an estimate of the integration error: the NRMSE of the run against its
+   step-doubled twin over 2^p - 1 (:func:`integration_error`, Richardson's estimate for both solvers'
+   order p = 4, which holds between the contact events both locate).  A side that picks its own step
+   starts at ``FIRST_STEP_FACTOR`` times its default step (where its check at twice that is stable),
+   and the steps are halved as many times as the estimates' h^p law says they must be (at most
+   ``MAX_REFINEMENTS``, in one go) until the two solvers' estimates together are within
+   ``TARGET_FRACTION`` of every gated tolerance: the largest such step of the sequence.  A quantity
+   whose estimates reach its tolerance is *unresolved* (the comparison cannot tell at that
+   tolerance, and the verdict is INCONCLUSIVE).
 """
 
 from __future__ import annotations
@@ -44,7 +48,8 @@ from gearcheck.compare.engine.align import (
     uniform_grid,
 )
 from gearcheck.compare.engine.line_projection import harmonics
-from gearcheck.compare.engine.metrics import modal_metrics, spectral_amplitude, spectral_metrics, waveform_metrics
+from gearcheck.compare.engine.metrics import modal_metrics, spectral_amplitude, spectral_metrics, statistics
+from gearcheck.compare.engine.metrics import waveform_metrics
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError, UnsupportedError
@@ -52,11 +57,14 @@ from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.side import display_name
+from gearcheck.shared.stepping import ORDER, richardson_factor
 
 NEGLIGIBLE = 1e-6
-TARGET_FRACTION = 0.5  # default steps keep both solvers' integration error bounds within this part of a tolerance
-MAX_REFINEMENTS = 2  # halvings of the default steps to get there
+TARGET_FRACTION = 0.5  # the steps keep both solvers' integration error estimates within this part of a tolerance
+FIRST_STEP_FACTOR = 2  # a side's first step in default steps (20 per period of its highest mode: 10)
+MAX_REFINEMENTS = 3  # halvings of the first steps to get there
 EXTENSION_FACTOR = 8  # a run is extended to its steady state up to this multiple of the duration asked for
+SENSED = ("acceleration", "angular_acceleration")  # the kinds an accelerometer chain (sensor_band) filters
 SIDE_SETTINGS = ("method", "dt_s", "steps", "rotating_frame_terms")  # what the report states of the reference run
 
 
@@ -74,8 +82,8 @@ class QuantityComparison:
 
     @property
     def error_ratio(self) -> float:
-        """The integration error bound over the tolerance (0 without a tolerance)."""
-        return error_bound(self.metrics) / self.tolerance if self.tolerance else 0.0
+        """The integration error estimate over the tolerance (0 without a tolerance)."""
+        return error_estimate(self.metrics) / self.tolerance if self.tolerance else 0.0
 
 
 @dataclass
@@ -111,7 +119,7 @@ class CrosscheckResult:
 
     @property
     def unresolved(self) -> list[str]:
-        """Why the comparison cannot decide: no steady state, or quantities whose integration error bounds
+        """Why the comparison cannot decide: no steady state, or quantities whose integration error estimates
         reach their tolerance."""
         reasons = [] if self.steady_found else ["no steady state"]
         return reasons + [f"{q.name} (integration error)" for q in self.quantities if q.status == "unresolved"]
@@ -177,7 +185,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
 
     asked = settings[0].duration
     adjustable = [s.dt is None for s in settings]
-    duration, steps, notes = asked, [s.dt for s in settings], []
+    duration, notes = asked, []
+    steps = first_steps((reference, test), settings)
     refinements, extended, best = 0, False, None
     needed = plan.needed_duration() if plan.detect_steady else None
     rerunnable = reference.rerunnable and test.rerunnable
@@ -202,16 +211,20 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
             duration, extended = needed, True
             continue
         if best is not None and attempt.worst >= best.worst:
-            notes.append(f"Halving the steps did not lower the integration error bound ({best.worst:.2g} -> "
+            notes.append(f"Halving the steps did not lower the integration error estimate ({best.worst:.2g} -> "
                          f"{attempt.worst:.2g} of a tolerance: round-off, not truncation); the coarser run is "
                          "reported.")
             break
         best = attempt
-        if attempt.worst > TARGET_FRACTION and refinements < MAX_REFINEMENTS and any(adjustable):
-            steps = [run.info["dt_s"] / 2 if free else dt for run, free, dt in zip(attempt.runs, adjustable, steps)]
-            refinements += 1
-            notes.append(f"Default steps halved ({refinements}x): the two solvers' integration error bounds reached "
-                         f"{attempt.worst:.2g} of a tolerance (target {TARGET_FRACTION:g}).")
+        order = min(side.order for side, free in zip((reference, test), adjustable) if free) if any(adjustable) else 0
+        halvings = min(_halvings(attempt.worst, order), MAX_REFINEMENTS - refinements)
+        if halvings > 0 and any(adjustable):
+            steps = [run.info["dt_s"] / 2**halvings if free else dt
+                     for run, free, dt in zip(attempt.runs, adjustable, steps)]
+            refinements += halvings
+            notes.append(f"Steps halved {halvings}x ({refinements}x in all): the two solvers' integration error "
+                         f"estimates reached {attempt.worst:.2g} of a tolerance (target {TARGET_FRACTION:g}; they fall "
+                         f"as h^{order}).")
             continue
         break
     (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
@@ -258,7 +271,7 @@ class _Attempt:
 
     @property
     def worst(self) -> float:
-        """The largest integration error bound over its tolerance among the gated quantities."""
+        """The largest integration error estimate over its tolerance among the gated quantities."""
         return max((q.error_ratio for q in self.comparisons if q.status != "negligible"), default=0.0)
 
     @classmethod
@@ -275,9 +288,11 @@ class _Attempt:
                       for forces, cycle in plan.steady_groups(names) for i in (0, 1)]
             t0, how = steady_state(grid, groups, plan.settle)
             t0 = 0.5 * grid[-1] if how is None else t0
-        errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a)
-                           for run, check in ((a, a_check), (b, b_check))) for n in names}
-        own = (a, b, t0) if sensor_band is None else None  # lines from each run's own samples (see _lines)
+        errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a, side.order)
+                           for side, run, check in zip(sides, (a, b), (a_check, b_check))) for n in names}
+        # statistics and lines from each run's own samples, but for the signals a sensor chain filters
+        sensed = set() if sensor_band is None else {n for n in names if a.signal(n).kind in SENSED}
+        own = {n: (a, b, t0) for n in names if n not in sensed}
         comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors, own)
         return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons, starts)
 
@@ -308,6 +323,10 @@ def _run_pairs(sides, settings, wall, progress, periodic=False, starts=None):
         report = (lambda f, i=i: progress((1.5 * i + f) / 3.0)) if progress else None
         started = time.perf_counter()
         if periodic:
+            if i == 1 and run_settings.dt is not None and run_settings.dt == settings[0].dt:
+                # the step the reference made a whole fraction of its period: a twin whose period is a multiple
+                # of it keeps it, and the two runs sample the same instants (as two free runs on one step do)
+                run_settings = replace(run_settings, dt=pairs[0][0].info["dt_s"])
             run, check, how = side.run_periodic(run_settings, lambda h, side=side: check_step(side, h), report)
             starts.append(how)
             wall[f"{label}_run_s"] = time.perf_counter() - started
@@ -345,6 +364,29 @@ def _periodic_note(plan, reference, needed: float, asked: float, notes: list) ->
     return True
 
 
+def first_steps(sides, settings) -> list[float | None]:
+    """The steps a cross-check first runs ``sides`` at: a step asked for in ``settings`` as it is.  Where both sides
+    pick their own, ``FIRST_STEP_FACTOR`` times the smaller of their default steps (the default where the check
+    at twice that would be unstable) for both, so that their samples fall at the same instants and alias alike (at
+    two rates the discontinuous accelerations of contact alias differently in each, and the NRMSE counts it).
+    Else a side that picks takes its default step (None: it picks by its own rule)."""
+    defaults = [side.default_step() if s.dt is None else None for side, s in zip(sides, settings)]
+    if len(sides) == 2 and None not in defaults:
+        h = min(defaults)
+        if all(2 * FIRST_STEP_FACTOR * h <= side.stable_step() for side in sides):
+            h *= FIRST_STEP_FACTOR
+        return [h, h]
+    return [s.dt if s.dt is not None else h for s, h in zip(settings, defaults)]
+
+
+def _halvings(worst: float, order: int) -> int:
+    """How many halvings of the steps bring estimates at ``worst`` of a tolerance within ``TARGET_FRACTION``
+    (they fall as h^order; none for order 0: no side picks its step)."""
+    if worst <= TARGET_FRACTION or order == 0:
+        return 0
+    return math.ceil(math.log2(worst / TARGET_FRACTION) / order)
+
+
 def check_step(side, h: float) -> float:
     """The step of the integration check of ``side``'s run at step ``h``: 2 h, or h / 2 where 2 h is beyond
     the side's stable step."""
@@ -365,12 +407,14 @@ def _common_grid(a, b, names, plan, sensor_band):
         if not (0 < low < high < 0.5 * fs):
             raise SolverError(f"sensor band {low:g}-{high:g} Hz must lie inside (0, {0.5 * fs:.6g}) Hz")
         for n in names:
-            if a.signal(n).kind in ("acceleration", "angular_acceleration"):
+            if a.signal(n).kind in SENSED:
                 series[n] = tuple(sensor_filter(x, fs, sensor_band) for x in series[n])
     return grid, fs, series
 
 
-def _quantities(a, names, series, window, fs, plan, tolerances, errors, own=None) -> list[QuantityComparison]:
+def _quantities(a, names, series, window, fs, plan, tolerances, errors, own) -> list[QuantityComparison]:
+    """Each quantity compared over ``window``; ``own``: name -> (the two runs, the window's start) for the
+    quantities whose statistics and lines are read from each run's own samples."""
     scale: dict[str, float] = {}
     for n in names:
         kind = a.signal(n).kind
@@ -383,13 +427,15 @@ def _quantities(a, names, series, window, fs, plan, tolerances, errors, own=None
         s = a.signal(n)
         xa, xb = series[n][0][window], series[n][1][window]
         metrics = waveform_metrics(xa, xb, fs, max_lag=plan.max_lag(n))
+        if n in own and all(_uniform(run.t) for run in own[n][:2]):
+            metrics |= statistics(*(run[n][run.t >= own[n][2]] for run in own[n][:2]))
         metrics["integration_error"] = {"reference": errors[n][0], "test": errors[n][1]}
         lines = [(label, f) for label, f in plan.lines(n, xa.size / fs) if f < 0.45 * fs]
         tol = tolerances.lookup(n, s.kind, "nrmse")
         floor = plan.floors.get(s.kind, 0.0) / (tol or 1.0)  # round-off a tolerance's share of the signal
         status = verdict(metrics, tol, max(NEGLIGIBLE * scale[s.kind], floor) / NEGLIGIBLE)
-        comparisons.append(QuantityComparison(n, s.kind, s.unit, s.description, status, metrics,
-                                              spectral_metrics(*_lines(n, xa, xb, fs, lines, plan, own), lines), tol))
+        spectrum = spectral_metrics(*_lines(n, xa, xb, fs, lines, plan, own.get(n)), lines)
+        comparisons.append(QuantityComparison(n, s.kind, s.unit, s.description, status, metrics, spectrum, tol))
     return comparisons
 
 
@@ -398,7 +444,7 @@ def _lines(name, xa, xb, fs, lines, plan, own) -> tuple[np.ndarray, np.ndarray]:
     steady window (``own``: the two runs and the window's start), the jumps of a switching mesh stiffness projected
     exactly (:func:`~gearcheck.compare.engine.line_projection.harmonics`, as the sweep reads its lines): a jump
     sampled at a step aliases onto every line, which the anti-aliased common grid would smear instead.  Else (a
-    sensor band, a recording, no switches) from the common grid's series ``xa``, ``xb``."""
+    signal a sensor chain filters, a recording, no switches) from the common grid's series ``xa``, ``xb``."""
     freqs = [f for _, f in lines]
     runs = [] if own is None or plan.switch_times is None else [run for run in own[:2] if _uniform(run.t)]
     if len(runs) < 2:
@@ -417,14 +463,14 @@ def _uniform(t: np.ndarray) -> bool:
     return t.size > 2 and float(np.max(np.abs(step - step.mean()))) <= 1e-9 * float(step.mean())
 
 
-def integration_error(run, check, name: str, start: float, reference) -> float | None:
-    """A bound on ``run``'s integration error in ``name`` over t >= ``start``, relative to the RMS of the
-    ``reference`` run's signal there (the denominator of the cross-check's NRMSE): rms(x_h - x_2h) when
-    ``check`` took twice the step, 2 rms(x_h - x_h/2) when it took half (each from samples at the same
-    times).  For an integrator of order p >= 1 in its asymptotic range the error of x_h is
-    rms(x_2h - x_h) / (2^p - 1) at most that."""
+def integration_error(run, check, name: str, start: float, reference, order: int = ORDER) -> float | None:
+    """An estimate of ``run``'s integration error in ``name`` over t >= ``start``, relative to the RMS of the
+    ``reference`` run's signal there (the denominator of the cross-check's NRMSE): Richardson's for a side of
+    ``order`` p, rms(x_h - x_2h) / (2^p - 1) when ``check`` took twice the step, rms(x_h - x_h/2) 2^p / (2^p - 1)
+    when it took half (each from samples at the same times; :func:`gearcheck.shared.stepping.richardson_factor`).
+    For p = 1 (a side whose order is not known) that is a bound: at most the change on doubling the step."""
     ratio = check.info["dt_s"] / run.info["dt_s"]
-    coarse, fine, factor = (check, run, 1.0) if ratio > 1 else (run, check, 2.0)
+    coarse, fine = (check, run) if ratio > 1 else (run, check)
     k = round(coarse.info["dt_s"] / fine.info["dt_s"])
     fine_t = fine.t[::k]
     n = min(fine_t.size, coarse.t.size)
@@ -434,23 +480,23 @@ def integration_error(run, check, name: str, start: float, reference) -> float |
     if scale == 0.0 or not np.any(window):
         return None
     diff = coarse[name][:n][window] - fine[name][::k][:n][window]
-    return factor * float(np.sqrt(np.mean(diff**2))) / scale
+    return richardson_factor(ratio, order) * float(np.sqrt(np.mean(diff**2))) / scale
 
 
 def verdict(metrics: dict, tolerance: float | None, scale: float) -> str:
     """negligible (below NEGLIGIBLE x the largest of its kind in both solvers); unresolved (the two
-    solvers' integration error bounds together reach the tolerance); else pass or fail on NRMSE."""
+    solvers' integration error estimates together reach the tolerance); else pass or fail on NRMSE."""
     if max(metrics["reference"]["rms"], metrics["test"]["rms"]) < NEGLIGIBLE * scale:
         return "negligible"
-    if tolerance is not None and error_bound(metrics) >= tolerance:
+    if tolerance is not None and error_estimate(metrics) >= tolerance:
         return "unresolved"
     if tolerance is None or (metrics["nrmse"] is not None and metrics["nrmse"] <= tolerance):
         return "pass"
     return "fail"
 
 
-def error_bound(metrics: dict) -> float:
-    """The two solvers' integration error bounds together (what integration alone could put into the NRMSE)."""
+def error_estimate(metrics: dict) -> float:
+    """The two solvers' integration error estimates together (what integration alone could put into the NRMSE)."""
     errors = metrics.get("integration_error") or {}
     return sum(e for e in errors.values() if e is not None)
 

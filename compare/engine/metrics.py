@@ -31,19 +31,22 @@ def _rel(b: float, a: float) -> float | None:
     return (b - a) / abs(a) if a != 0 else None
 
 
+def statistics(a: np.ndarray, b: np.ndarray) -> dict:
+    """Each signal's mean, rms, peak-to-peak and peak (``reference``, ``test``) and their relative differences."""
+    sa, sb = _stats(a), _stats(b)
+    return {"reference": sa, "test": sb, "rel_rms": _rel(sb["rms"], sa["rms"]),
+            "rel_peak_to_peak": _rel(sb["peak_to_peak"], sa["peak_to_peak"]), "rel_peak": _rel(sb["peak"], sa["peak"])}
+
+
 def waveform_metrics(a: np.ndarray, b: np.ndarray, fs: float, max_lag: float) -> dict:
     lag = estimate_lag(a, b, fs, max_lag)
     aligned = shift_signal(b, lag, fs)
     trim = int(np.ceil(abs(lag) * fs)) + 1
     a_w, b_w = (a[trim:-trim], aligned[trim:-trim]) if a.size > 2 * trim + 8 else (a, aligned)
-    sa, sb = _stats(a_w), _stats(b_w)
+    metrics = statistics(a_w, b_w)
     da, db = a_w - np.mean(a_w), b_w - np.mean(b_w)
-    rms_a, rms_da = sa["rms"], float(np.sqrt(np.mean(da**2)))
-    metrics = {
-        "reference": sa, "test": sb,
-        "rel_rms": _rel(sb["rms"], sa["rms"]),
-        "rel_peak_to_peak": _rel(sb["peak_to_peak"], sa["peak_to_peak"]),
-        "rel_peak": _rel(sb["peak"], sa["peak"]),
+    rms_a, rms_da = metrics["reference"]["rms"], float(np.sqrt(np.mean(da**2)))
+    metrics |= {
         "nrmse": float(np.sqrt(np.mean((b_w - a_w) ** 2)) / rms_a) if rms_a > 0 else None,
         "nrmse_ac": float(np.sqrt(np.mean((db - da) ** 2)) / rms_da) if rms_da > 0 else None,
         "correlation": float(np.corrcoef(da, db)[0, 1]) if rms_da > 0 and np.std(db) > 0 else None,

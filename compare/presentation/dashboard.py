@@ -358,7 +358,7 @@ def _overview(p: Preset) -> list:
     bounds = [k for k in p.series if k[1].startswith("integration_error.")]
     if bounds:
         line = p.aggregate("integration error / tolerance", worst(bounds, per_item=True), "integration-error-ratio")
-        out.append(("Integration error bound / tolerance (worst quantity)",
+        out.append(("Integration error estimate / tolerance (worst quantity)",
                     p.chart([line], log=True, limits=[(1.0, "unresolved")])))
     walls = [k for k in p.series if k[0] == "wall_time"]
     if walls:

@@ -9,7 +9,7 @@ the baseline.  Statuses map onto JUnit as follows:
   the tolerance;
 * ``negligible`` -- a passed testcase with the property ``status = negligible``: the quantity was compared and
   is below the negligibility floor in both solvers, which is a result, not a test that did not run;
-* ``unresolved`` -- an ``<error>``: the integration error bounds reach the tolerance, so the check could not
+* ``unresolved`` -- an ``<error>``: the integration error estimates reach the tolerance, so the check could not
   decide; like the verdict INCONCLUSIVE (exit 3) it must not read as a pass, which a skip would in most CI
   tools.  A run without a steady state gives its ``steady state`` testcase an ``<error>`` for the same reason;
 * metrics moved from the baseline -- a ``<failure>`` of the ``baseline`` testcase listing them.
@@ -63,7 +63,7 @@ def _quantity_case(suite, data, q) -> None:
         errors = q["integration_error"]
         bounds = " + ".join(_number(e and e["value"]) for e in (errors["lumped"], errors["mujoco"]))
         ET.SubElement(case, "error", type="Unresolved",
-                      message=f"integration error bounds {bounds} reach the tolerance {_number(tol)}: the comparison "
+                      message=f"integration error estimates {bounds} reach the tolerance {_number(tol)}: the comparison "
                               f"cannot decide (NRMSE {_number(nrmse)})")
 
 

@@ -1,4 +1,5 @@
-"""The observed convergence order of a solver on a train: the same run at h, h/2, h/4, ... compared on one grid.
+"""The observed convergence order of a solver on a train: the same run at h, h/2, h/4, ... compared on one grid;
+and how well the cross-check's integration error estimate tracks the error itself.
 
 For a method of order p the difference between the runs at h and h/2 falls as h^p, so successive halvings give
 
@@ -19,10 +20,11 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.mbd_models.runner import simulate_mujoco
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import stable_step
+from gearcheck.shared.stepping import richardson_factor, stable_step
 
 KINDS = ("dte", "mesh_force", "acceleration")
 ROUND_OFF = 1e-9  # relative differences below this are round-off (a twin's planet accelerations reach 1e-10)
+FINEST = 16  # the error of a run at h is measured against the same run at h / FINEST (its error 16^4 times less)
 
 
 def coarsest_step(spec, multiple: float) -> float:
@@ -54,3 +56,24 @@ def observed_orders(results, kinds=KINDS) -> dict[str, tuple[list[float], list[f
         p = [math.log2(a / b) if min(a, b) > ROUND_OFF else math.nan for a, b in zip(d, d[1:])]
         out[kind] = (p, d)
     return out
+
+
+def estimate_tracking(side, h: float, duration: float, start: float, names) -> dict[str, tuple[float, float]]:
+    """name -> (the cross-check's estimate of the error of ``side``'s run at step ``h``, the error itself), both
+    relative to the run's RMS over t >= ``start``: the estimate Richardson's, from the same run at 2 h
+    (:func:`gearcheck.shared.stepping.richardson_factor`), the error against the same run at h / ``FINEST``.
+    All three runs start from the same state and are sampled at the same instants (every 2 h)."""
+    run, check, fine = (side.run(RunSettings(duration, dt=h * f, output_dt=2 * h)) for f in (1, 2, 1 / FINEST))
+    n = min(run.t.size, check.t.size, fine.t.size)
+    window = run.t[:n] >= start
+    out = {}
+    for name in names:
+        x, x2, xf = (r[name][:n][window] for r in (run, check, fine))
+        scale = float(np.sqrt(np.mean(x**2)))
+        if scale > 0.0:
+            out[name] = (richardson_factor(2.0) * _rms(x2 - x) / scale, _rms(x - xf) / scale)
+    return out
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(x**2)))

@@ -2,7 +2,7 @@
 
 Exit status: 0 done (a cross-check passed), 1 a cross-check failed (a tolerance exceeded or a
 baseline metric moved), 3 a cross-check inconclusive (no steady state reached, or an integration
-error bound as large as a tolerance), 2 bad input (one line on stderr naming the file, field or option, and the
+error estimate as large as a tolerance), 2 bad input (one line on stderr naming the file, field or option, and the
 value; nothing written), 130 interrupted (SIGINT), 143 terminated (SIGTERM); a closed pipe ends the
 program quietly, as other command-line tools do.  Outputs are written whole or not at all
 (:class:`~gearcheck.shared.outputs.OutputDirectory`).
@@ -212,7 +212,27 @@ def cmd_show(args) -> int:
               f"alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
               f"f_mesh={m['mesh_frequency_hz']:.6g} Hz  phase={m['phase_cycles']:.4f}  "
               f"k={m['mean_stiffness_n_per_m']:.4g} N/m ({m['stiffness_model']})  c={m['damping_n_s_per_m']:.4g} N·s/m")
+    print(settling_line(info["settling"]))
     return 0
+
+
+PRACTICAL_SETTLE_S = 1.0  # a start that takes longer than this to die away gets a note
+
+
+def settling_line(s: dict) -> str:
+    """What ``gearcheck show`` says of how a start settles, with a note where it takes longer than a practical run."""
+    tau = "never decays" if s["time_constant_s"] is None else f"time constant {s['time_constant_s']:.3g} s"
+    line = (f"  settling: slowest-decaying mode {s['slowest_mode_hz']:.6g} Hz, damping ratio "
+            f"{100 * s['damping_ratio']:.3g} %, {tau}")
+    if s["settle_s"] is not None and s["settle_s"] <= PRACTICAL_SETTLE_S:
+        return line + f"; a run from rest settles in {s['settle_s']:.3g} s"
+    supports = (f" Supports and bearings without damping: {', '.join(s['undamped_supports'])} (gearcheck adds no "
+                "damping a train file does not state; their radial/torsional/axial_damping fields add it)."
+                if s["undamped_supports"] else "")
+    settles = "never" if s["settle_s"] is None else f"only after {s['settle_s']:.3g} s"
+    return (line + f"\n  note: a run from rest settles {settles}: a cross-check at its default duration starts both "
+            f"solvers on their periodic steady states instead, and a shorter plain run (gearcheck run) stays in its "
+            f"start-up transient.{supports}")
 
 
 def cmd_modes(args) -> int:

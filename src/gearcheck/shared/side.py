@@ -33,6 +33,7 @@ class Side(ABC):
     rerunnable: bool = True  # run() integrates anew at the settings asked (False: a recording, as it is)
     has_modes: bool = True  # modes() gives natural frequencies (False: a recording without a modes file)
     linear = None  # its matrices (a LinearModel) when it is a model given as matrices
+    order = 1  # the order its runs converge at; 1 (not known) makes the change on doubling the step a bound
 
     @abstractmethod
     def modes(self) -> ModalResult:
@@ -45,6 +46,11 @@ class Side(ABC):
     @abstractmethod
     def stable_step(self) -> float:
         """The largest fixed step its runs accept (s)."""
+
+    def default_step(self) -> float | None:
+        """The step its runs take when none is asked (s), which a cross-check starts from a multiple of.
+        Default None: it picks its own, and the cross-check leaves it to it."""
+        return None
 
     def modes_at_speed(self, input_speed: float) -> ModalResult:
         """The gyroscopic modes of the train turning at ``input_speed`` (rad/s).  Default: unsupported."""

@@ -171,11 +171,13 @@ class MeshSwitches(NamedTuple):
 
 
 class Work(NamedTuple):
-    """Work space of the damping correction: the mesh Jacobian, the turned coefficients, g."""
+    """Work space of the damping correction and the switching functions: the mesh Jacobian, the turned
+    coefficients, g, each mesh's deflection rate from its coefficients' turning."""
 
     jacobian: np.ndarray
     coef: np.ndarray
     g: np.ndarray
+    turning_rate: np.ndarray
 
 
 class Reader(NamedTuple):
@@ -307,6 +309,19 @@ def _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef):
         wrap_prm[wraps[w]] = coef[w]
 
 
+@numba.njit(inline="always")
+def _turning_rates(qpos, qvel, turning, coef, out):
+    """Per mesh, the part of its deflection rate that its tendon's J qvel misses, its coefficients c(phi) turning
+    with their carrier: d/dt (c q) = c q' + (dc/dphi) phi' q (``TurningCoefficients.missing_rate``), ``coef`` the
+    coefficients at qpos."""
+    wraps, carrier_qadr, tendon, slide_qadr = turning.wraps, turning.carrier_qadr, turning.tendon, turning.slide_qadr
+    half = wraps.size // 2
+    out[:] = 0.0
+    for w in range(wraps.size):
+        turned = -coef[w + half] if w < half else coef[w - half]  # dc/dphi: the pair (x, y) turns as (-y, x)
+        out[tendon[w]] += turned * qvel[carrier_qadr[w]] * qpos[slide_qadr[w]]
+
+
 def cycloid_arrays(contacts, nv: int) -> Cycloid:
     """The twin's pin contacts (:attr:`gearcheck.mbd_models.twin.MbdModel.moving_contacts`: an RV reducer's
     ``CycloidTwin``) as flat arrays for :func:`_pins`, every contact's tendons in their order; none: empty arrays
@@ -412,7 +427,7 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
     qpos, qvel, ctrl, applied = data.qpos, data.qvel, data.ctrl, data.qfrc_applied
     wraps, base, carrier_qadr, tendon, slide_qadr, slide_dof, damping, half_backlash = turning
     rel_tendons, rel_wraps, rel_qadr, rel_starts = contacts
-    J, coef, g = work
+    J, coef, g, _ = work
     n = k.size
     for i in range(n):
         stiffness[i] = k[i]
@@ -441,15 +456,12 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
             lengthspring[t, 0] = spring
             lengthspring[t, 1] = spring
     # DampingCorrection.apply: g = c (de/dt - m), qfrc_applied = J^T g
-    half = wraps.size // 2
     for w in range(wraps.size):
         coef[w] = wrap_prm[wraps[w]]
         J[tendon[w], slide_dof[w]] = coef[w]
+    _turning_rates(qpos, qvel, turning, coef, g)
     for i in range(n):
-        g[i] = 0.0
-    for w in range(wraps.size):
-        turned = -coef[w + half] if w < half else coef[w - half]  # dc/dphi: the pair (x, y) turns as (-y, x)
-        g[tendon[w]] -= damping[tendon[w]] * (turned * qvel[carrier_qadr[w]] * qpos[slide_qadr[w]])
+        g[i] *= -damping[i]
     if has_te:
         for i in range(n):
             g[i] += damping[i] * de[i]
@@ -572,15 +584,16 @@ def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive
     tendon's backlash edges (L - e - b, L - e + b) or tooth pairs (L - e - e_j; -1 for a padded pair), L the
     tendon's length with its coefficients turned to the state's carrier angles, and each pin's compression (its
     coefficients and kinematics at the state); the drive of row ``r`` at sample ``s`` (0 or 2) of a step of length
-    ``span``.  Rates leave out the coefficients' own turning."""
+    ``span``.  A mesh's rate includes what its coefficients' turning adds (:func:`_turning_rates`)."""
     qpos, qvel, wrap_prm = data.qpos, data.qvel, model.wrap_prm
     tendons, wraps, qadr, dofs, starts, relieved, half, _ = switches
     _refresh(qpos, wrap_prm, turning.wraps, turning.base, turning.carrier_qadr, work.coef)
+    _turning_rates(qpos, qvel, turning, work.coef, work.turning_rate)
     n = 0
     for i in range(tendons.size):
         t = tendons[i]
         length = 0.0
-        speed = 0.0
+        speed = work.turning_rate[t]
         for w in range(starts[i], starts[i + 1]):
             length += wrap_prm[wraps[w]] * qpos[qadr[w]]
             speed += wrap_prm[wraps[w]] * qvel[dofs[w]]

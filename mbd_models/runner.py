@@ -180,10 +180,12 @@ class _Stepper:
         """The contact switching functions of the present state and their rates
         (:func:`gearcheck.mbd_models.compiled._switching`'s, in its order), ``drive`` (k, u, e, de, pairs) at the
         three samples of a step of length ``span``, taken at sample ``s``."""
-        m, d, sw = self.m, self.d, self.switches
+        m, d, sw, tc = self.m, self.d, self.switches, self.mb.turning
         self.mb.refresh(d.qpos)
         length = np.add.reduceat(m.wrap_prm[sw.wraps] * d.qpos[sw.qadr], sw.starts[:-1]) if sw.wraps.size else []
         speed = np.add.reduceat(m.wrap_prm[sw.wraps] * d.qvel[sw.dofs], sw.starts[:-1]) if sw.wraps.size else []
+        speed = speed + tc.missing_rate(d.qpos[tc.carrier_qadr], d.qvel[tc.carrier_qadr], d.qpos[tc.slide_qadr],
+                                        len(self.mb.mesh_tendon))[sw.tendons] if sw.wraps.size else speed
         _, _, e, de, pairs = drive
         g, rate = [], []
         for i, (t, j, b) in enumerate(zip(sw.tendons, sw.relieved, sw.half_backlash)):
@@ -373,7 +375,7 @@ class _CompiledStepper(_Stepper):
             compiled.Contacts(none, none, none, np.zeros(1, dtype=np.int64)) if c is None else compiled.Contacts(
                 *(np.ascontiguousarray(x, dtype=np.int64) for x in
                   (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps))))),
-            compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n)),
+            compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n), np.zeros(n)),
             compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
                             np.ascontiguousarray(reader.slides, dtype=np.int64)),
             compiled.cycloid_arrays(mb.moving_contacts, m.nv),

@@ -9,8 +9,10 @@ accelerations with a turning carrier (its coefficients and damping correction se
 
 Contact events (a backlash's edges, tooth pairs, pins making or breaking contact) are located within the step by
 both solvers, each from its own state (:mod:`gearcheck.shared.events`).  The trains without them converge at 4;
-hub-drive, whose teeth leave and retake their flanks 114 times in its start window, converges at 3.1-3.9 in both
-(1.3-1.6 while the events were resolved only to the step, the error 50 times larger), which the last tests state.
+hub-drive, whose teeth leave and retake their flanks 114 times in its start window, converges at 3.1-3.6 from
+twice the default step (before the asymptotic range) and at 3.8-4.0 from a quarter of it, both solvers alike (1.3-1.6
+while the events were resolved only to the step, the error 50 times larger; the twin read 3.0 then 4.6 while its
+switching rates left out what its turning tendon coefficients add), which the last test states.
 The RV reducer's disc accelerations are left out: a pin's contact damping makes its force jump where the pin
 touches, so a sample that falls at such an instant reads one side or the other, whatever the step.
 """
@@ -82,13 +84,18 @@ def test_the_two_solvers_make_the_same_integration_error(measured, name):
         assert mujoco[kind][1][0] == pytest.approx(lumped[kind][1][0], rel=0.02)
 
 
-@pytest.mark.parametrize("solver", ["lumped", "mujoco"])
-def test_located_backlash_events_keep_the_order_near_four(solver):
-    """hub-drive as shipped: every run, at every step, locates the same 114 contact events (the two solvers alike),
-    and the order stays above 3 (measured 3.1-3.6 over the first halvings, 3.0-3.9 over the next)."""
+def test_located_backlash_events_keep_the_fourth_order():
+    """hub-drive as shipped: every run, at every step, locates the same 114 contact events, and from a quarter of the
+    default step (the asymptotic range; from half of it the order reads 3.80-3.86) both solvers converge at order 3.8
+    or more, with the same differences."""
     spec = load_train("hub-drive")
-    runs = halvings(spec, solver, coarsest_step(spec, MULTIPLE), STEPS, 3)
-    assert len({run.info["contact_events_located"] for run in runs}) == 1
-    assert runs[0].info["contact_events_located"] > 100
-    table = observed_orders(runs)
-    assert min(p[0] for p, _ in table.values()) > 3.0
+    tables = {}
+    for solver in ("lumped", "mujoco"):
+        runs = halvings(spec, solver, coarsest_step(spec, 0.25), 8 * STEPS, 3)
+        assert len({run.info["contact_events_located"] for run in runs}) == 1
+        assert runs[0].info["contact_events_located"] > 100
+        tables[solver] = observed_orders(runs)
+        orders = {kind: p[0] for kind, (p, _) in tables[solver].items() if not math.isnan(p[0])}  # above round-off
+        assert len(orders) >= 2 and all(p >= ORDER for p in orders.values()), tables[solver]
+    for kind in orders:
+        assert tables["mujoco"][kind][1][0] == pytest.approx(tables["lumped"][kind][1][0], rel=0.02)

@@ -22,7 +22,9 @@ Any pair of :class:`~gearcheck.shared.side.Side` objects, read by a comparison p
    floor of a solver is more than the tolerance's share of them) are reported as such and not gated;
 6. per signal and solver, an estimate of the integration error: the NRMSE of the run against its
    step-doubled twin over 2^p - 1 (:func:`integration_error`, Richardson's estimate for both solvers'
-   order p = 4, which holds between the contact events both locate).  A side that picks its own step
+   order p = 4, which holds between the contact events both locate; where doubling the step moves the
+   mesh forces by more than ``ASYMPTOTIC`` of their fluctuation, the runs are outside the asymptotic range and the
+   change itself is the estimate).  A side that picks its own step
    starts at ``FIRST_STEP_FACTOR`` times its default step (where its check at twice that is stable),
    and the steps are halved as many times as the estimates' h^p law says they must be (at most
    ``MAX_REFINEMENTS``, in one go) until the two solvers' estimates together are within
@@ -63,6 +65,7 @@ NEGLIGIBLE = 1e-6
 TARGET_FRACTION = 0.5  # the steps keep both solvers' integration error estimates within this part of a tolerance
 FIRST_STEP_FACTOR = 2  # a side's first step in default steps (20 per period of its highest mode: 10)
 MAX_REFINEMENTS = 3  # halvings of the first steps to get there
+ASYMPTOTIC = 0.25  # Richardson's estimate where doubling the step moves the mesh forces' ripple by less than this
 EXTENSION_FACTOR = 8  # a run is extended to its steady state up to this multiple of the duration asked for
 SENSED = ("acceleration", "angular_acceleration")  # the kinds an accelerometer chain (sensor_band) filters
 SIDE_SETTINGS = ("method", "dt_s", "steps", "rotating_frame_terms")  # what the report states of the reference run
@@ -211,12 +214,13 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
             duration, extended = needed, True
             continue
         if best is not None and attempt.worst >= best.worst:
+            why = "the response does not converge with the step" if attempt.drifting else "round-off, not truncation"
             notes.append(f"Halving the steps did not lower the integration error estimate ({best.worst:.2g} -> "
-                         f"{attempt.worst:.2g} of a tolerance: round-off, not truncation); the coarser run is "
-                         "reported.")
+                         f"{attempt.worst:.2g} of a tolerance: {why}); the coarser run is reported.")
             break
         best = attempt
         order = min(side.order for side, free in zip((reference, test), adjustable) if free) if any(adjustable) else 0
+        order = min(order, 1) if attempt.drifting else order  # the worst are bounds, not Richardson's estimates
         halvings = min(_halvings(attempt.worst, order), MAX_REFINEMENTS - refinements)
         if halvings > 0 and any(adjustable):
             steps = [run.info["dt_s"] / 2**halvings if free else dt
@@ -230,6 +234,12 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
     if best.starts:
         notes.append("Periodic steady states found by " + "; ".join(best.starts) + ".")
+    for solver, change in best.drifting:
+        name = display_name(solver)
+        notes.append(f"{name[:1].upper() + name[1:]}'s runs at h and 2h differ by {100 * change:.3g} % of their mesh "
+                     "forces' fluctuation over the window: the response does not converge with the step (it is "
+                     "sensitive to its start, as a vibro-impact response can be), outside the asymptotic range "
+                     "Richardson's estimate presumes; the change itself is that solver's integration error estimate.")
     t0, how, comparisons, duration = best.t0, best.how, best.comparisons, a.t[-1]
     if plan.detect_steady and how is None:
         notes.append("No steady state in this run" + (
@@ -268,6 +278,7 @@ class _Attempt:
     how: str | None
     comparisons: list
     starts: list  # how each side found its periodic steady state, where the runs start there
+    drifting: list  # (solver, change) of the sides whose runs at h and 2h are outside the asymptotic range
 
     @property
     def worst(self) -> float:
@@ -288,13 +299,20 @@ class _Attempt:
                       for forces, cycle in plan.steady_groups(names) for i in (0, 1)]
             t0, how = steady_state(grid, groups, plan.settle)
             t0 = 0.5 * grid[-1] if how is None else t0
-        errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a, side.order)
-                           for side, run, check in zip(sides, (a, b), (a_check, b_check))) for n in names}
+        forces = [n for n in names if a.signal(n).kind == "mesh_force"]
+        orders, drifting = [], []
+        for side, run, check in zip(sides, (a, b), (a_check, b_check)):
+            change = 0.0 if check is None or side.order == 1 else step_change(run, check, forces, t0)
+            orders.append(1 if change > ASYMPTOTIC else side.order)
+            if change > ASYMPTOTIC:
+                drifting.append((side.solver, change))
+        errors = {n: tuple(None if check is None else integration_error(run, check, n, t0, a, p)
+                           for run, check, p in zip((a, b), (a_check, b_check), orders)) for n in names}
         # statistics and lines from each run's own samples, but for the signals a sensor chain filters
         sensed = set() if sensor_band is None else {n for n in names if a.signal(n).kind in SENSED}
         own = {n: (a, b, t0) for n in names if n not in sensed}
         comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors, own)
-        return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons, starts)
+        return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons, starts, drifting)
 
 
 def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
@@ -468,19 +486,38 @@ def integration_error(run, check, name: str, start: float, reference, order: int
     ``reference`` run's signal there (the denominator of the cross-check's NRMSE): Richardson's for a side of
     ``order`` p, rms(x_h - x_2h) / (2^p - 1) when ``check`` took twice the step, rms(x_h - x_h/2) 2^p / (2^p - 1)
     when it took half (each from samples at the same times; :func:`gearcheck.shared.stepping.richardson_factor`).
-    For p = 1 (a side whose order is not known) that is a bound: at most the change on doubling the step."""
-    ratio = check.info["dt_s"] / run.info["dt_s"]
-    coarse, fine = (check, run) if ratio > 1 else (run, check)
-    k = round(coarse.info["dt_s"] / fine.info["dt_s"])
-    fine_t = fine.t[::k]
-    n = min(fine_t.size, coarse.t.size)
-    window = coarse.t[:n] >= start
+    For p = 1 (a side whose order is not known, or runs outside the asymptotic range) that is the change itself: a
+    bound for a converging run."""
+    change = _change(run, check, name, start)
     x_ref = reference[name][reference.t >= start]
     scale = float(np.sqrt(np.mean(x_ref**2))) if x_ref.size else 0.0
-    if scale == 0.0 or not np.any(window):
+    if change is None or scale == 0.0:
         return None
-    diff = coarse[name][:n][window] - fine[name][::k][:n][window]
-    return richardson_factor(ratio, order) * float(np.sqrt(np.mean(diff**2))) / scale
+    return richardson_factor(check.info["dt_s"] / run.info["dt_s"], order) * change / scale
+
+
+def step_change(run, check, names, start: float) -> float:
+    """The largest change of ``names`` between ``run`` and its ``check`` over t >= ``start``, relative to each one's
+    fluctuation in ``run`` (the RMS about its mean: a mesh force's static load would hide a ripple that does not
+    converge; 0 without any)."""
+    out = 0.0
+    for name in names:
+        change, x = _change(run, check, name, start), run[name][run.t >= start]
+        scale = float(np.std(x)) if x.size else 0.0
+        if change is not None and scale > 0.0:
+            out = max(out, change / scale)
+    return out
+
+
+def _change(run, check, name: str, start: float) -> float | None:
+    """rms(x_coarse - x_fine) of ``name`` over t >= ``start``, from the samples the two runs share."""
+    coarse, fine = (check, run) if check.info["dt_s"] > run.info["dt_s"] else (run, check)
+    k = round(coarse.info["dt_s"] / fine.info["dt_s"])
+    n = min(fine.t[::k].size, coarse.t.size)
+    window = coarse.t[:n] >= start
+    if not np.any(window):
+        return None
+    return float(np.sqrt(np.mean((coarse[name][:n][window] - fine[name][::k][:n][window]) ** 2)))
 
 
 def verdict(metrics: dict, tolerance: float | None, scale: float) -> str:

@@ -234,6 +234,10 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
     if best.starts:
         notes.append("Periodic steady states found by " + "; ".join(best.starts) + ".")
+    for side in (reference, test):
+        if side.rerunnable and side.order == 1:
+            notes.append(f"The order of convergence of {display_name(side.solver)} is not known to gearcheck: its "
+                         "integration error estimate is the change on doubling its step, a bound for any order.")
     for solver, change in best.drifting:
         name = display_name(solver)
         notes.append(f"{name[:1].upper() + name[1:]}'s runs at h and 2h differ by {100 * change:.3g} % of their mesh "

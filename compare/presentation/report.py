@@ -387,10 +387,11 @@ def _summary_lines(data) -> list[str]:
         f"sha256 {p['train_sha256'][:16]}…",
         f"Metrics: NRMSE = rms(b − a)/rms(a) after removing the lag; {A} = a (reference), {B} = b; "
         "'negligible' = below 1e-6 of the largest quantity of its kind in both solvers (not gated).",
-        "Integration error: Richardson's estimate per solver, rms(x_h − x_2h)/rms(a)/15 against the same run at "
-        "twice the step, 16/15 rms(x_h − x_h/2)/rms(a) against half "
-        f"(check steps {', '.join(steps)}; both solvers are fourth order between the contact "
-        "events they locate); 'unresolved' = the two estimates together reach the tolerance.",
+        "Integration error per solver, from the same run at twice the step or half it "
+        f"(check steps {', '.join(steps)}): Richardson's estimate for gearcheck's fourth-order solvers, "
+        "rms(x_h − x_2h)/rms(a)/15 or 16/15 rms(x_h − x_h/2)/rms(a); the change itself, a bound, for a model of "
+        "unknown order or runs outside the asymptotic range (the findings say which); 'unresolved' = the two "
+        "estimates together reach the tolerance.",
     ]
 
 

@@ -1,12 +1,13 @@
 """The cross-check's integration error estimate against the error itself, on every preset, both solvers.
 
 For each preset the cross-check runs once (its default settings, the shipped baseline's duration) to find the
-quantities it gates, their steady window and its first steps; each solver then runs from its own start at that
-step h, at 2 h and at h / 16 (:func:`gearcheck.compare.studies.convergence.estimate_tracking`).  Printed per
+quantities it gates, their steady window and its first steps; each solver then runs from its own static start (a
+train the cross-check starts on periodic states, double-planet, is run from rest here) at that step h, at 2 h and
+at h / 16 (:func:`gearcheck.compare.studies.convergence.estimate_tracking`).  Printed per
 preset and solver: the step, the largest true error over the gated quantities and its estimate, and the ratio
 estimate / error over the gated quantities whose error is above round-off (1e-9): its least, median and largest.
-A ratio of 1 is an exact estimate; below 1 it underestimates.  ``--speed`` adds the hub drive at its second test
-speed (1823 rpm, vibro-impact: backlash events in every mesh cycle).
+A ratio of 1 is an exact estimate; below 1 it underestimates.  ``--hub-speed`` adds the hub drive at another speed
+(default its second test speed, 1823 rpm, where backlash opens and closes in every mesh cycle).
 
     python bench/bench_estimate.py [PRESET ...] [--hub-speed RPM]
 """

@@ -39,6 +39,7 @@ from gearcheck.shared import stepping
 from gearcheck.shared.anderson import anderson
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.run_info import RunInfo
+from gearcheck.shared.shooting import Shooting
 from gearcheck.train.periods import MAX_MESH_PERIODS, common_period
 
 MAX_ITERATIONS = 20  # Newton steps
@@ -46,25 +47,15 @@ MAX_ANDERSON_RUNS = 100
 
 
 @dataclass(frozen=True)
-class PeriodicSteadyState:
-    """The state at t = 0 of the T-periodic steady response and how it was found.
+class PeriodicSteadyState(Shooting):
+    """The state at t = 0 of the T-periodic steady response and how it was found (:class:`Shooting`; method
+    "anderson", "anderson, then newton", "affine" (Newton on a linear model: one solve) or "newton"; the residual
+    max |y(T) - y0| over the largest |y| of the first guess, v weighted by 1/omega_max).
 
-    q, v: pass ``(q, v)`` as ``y0`` to :func:`~gearcheck.lumped.time_solver.simulate` with ``dt``;
-    period: T (s); steps: RK4 steps per period; method: "anderson", "anderson, then newton", "affine" (Newton on
-    a linear model: one solve) or "newton"; iterations: Anderson and Newton steps; residual: max |y(T) - y0|
-    over the largest |y| of the first guess (v weighted by 1/omega_max); runs: one-period runs taken; info: their
-    work (:class:`~gearcheck.shared.run_info.RunInfo`, the search's own wall time included)."""
+    q, v: pass ``(q, v)`` as ``y0`` to :func:`~gearcheck.lumped.time_solver.simulate` with ``dt``."""
 
     q: np.ndarray
     v: np.ndarray
-    period: float
-    dt: float
-    steps: int
-    method: str
-    iterations: int
-    residual: float
-    runs: int
-    info: RunInfo
 
     @property
     def y0(self) -> tuple[np.ndarray, np.ndarray]:
@@ -164,4 +155,5 @@ def periodic_steady_state(model, dt: float | None = None, tolerance: float = 1e-
     y = z * scale / w
     info = RunInfo("numba-rk4", P.runs * steps, 4, 4 * P.runs * sub_steps, clock.perf_counter() - started,
                    {"method": used, "dt_s": h, "steps": P.runs * steps})
-    return PeriodicSteadyState(y[:n].copy(), y[n:].copy(), period, h, steps, used, iterations, residual, P.runs, info)
+    return PeriodicSteadyState(q=y[:n].copy(), v=y[n:].copy(), period=period, dt=h, steps=steps, method=used,
+                               iterations=iterations, residual=residual, runs=P.runs, info=info)

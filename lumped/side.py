@@ -86,8 +86,7 @@ class LumpedSide(Side):
                        progress=progress)
         check = simulate(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None), method=self.method,
                          y0=steady.y0)
-        return run, check, (f"lumped: shooting over its period {steady.period:.6g} s, {steady.runs} runs "
-                            f"({steady.method}), residual {steady.residual:.1e}")
+        return run, check, steady.words("lumped")
 
 
 class LinearSide(Side):

@@ -42,6 +42,7 @@ from gearcheck.shared.anderson import anderson
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.shooting import Shooting
 from gearcheck.train.periods import MAX_MESH_PERIODS, common_period, whole_cycles
 
 MAX_DRIVE_PERIODS = 256  # the longest T_M sought, in drive periods: a carrier turns once in z_ring mesh periods
@@ -49,25 +50,15 @@ MAX_ANDERSON_RUNS = 100
 
 
 @dataclass(frozen=True)
-class PeriodicState:
-    """The twin's state at t = 0 of its T_M-periodic steady response and how it was found.
+class PeriodicState(Shooting):
+    """The twin's state at t = 0 of its T_M-periodic steady response and how it was found (:class:`Shooting`;
+    method "anderson"; the residual max |P(y0) - y0| over the largest |y0 - nominal motion| of the first guess,
+    qvel weighted by 1/omega_max).
 
-    qpos, qvel: pass ``initial_state`` to :func:`~gearcheck.mbd_models.runner.simulate_mujoco` with ``dt``;
-    period: T_M (s); steps: RK4 steps per period; method: "anderson"; iterations: Anderson steps; residual:
-    max |P(y0) - y0| over the largest |y0 - nominal motion| of the first guess (qvel weighted by 1/omega_max);
-    runs: runs of one period taken; info: their work (:class:`~gearcheck.shared.run_info.RunInfo`, the search's
-    own wall time included)."""
+    qpos, qvel: pass ``initial_state`` to :func:`~gearcheck.mbd_models.runner.simulate_mujoco` with ``dt``."""
 
     qpos: np.ndarray
     qvel: np.ndarray
-    period: float
-    dt: float
-    steps: int
-    method: str
-    iterations: int
-    residual: float
-    runs: int
-    info: RunInfo
 
     @property
     def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
@@ -148,5 +139,5 @@ def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = 1e-
     y = z * scale / w + offset
     info = RunInfo(runs[0].engine, sum(r.steps for r in runs), 4, sum(r.rhs_calls for r in runs),
                    clock.perf_counter() - started, {"method": "anderson", "dt_s": h, "steps": len(runs) * steps})
-    return PeriodicState(y[:nq].copy(), y[nq:].copy(), period, h, steps, "anderson", iterations, residual,
-                         len(runs), info)
+    return PeriodicState(qpos=y[:nq].copy(), qvel=y[nq:].copy(), period=period, dt=h, steps=steps, method="anderson",
+                         iterations=iterations, residual=residual, runs=len(runs), info=info)

@@ -74,8 +74,7 @@ class MujocoSide(Side):
         options = {"initial_state": steady.initial_state, "stiffness_clock": self.stiffness_clock}
         run = simulate_mujoco(self.model, replace(settings, dt=steady.dt), progress=progress, **options)
         check = simulate_mujoco(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None), **options)
-        return run, check, (f"MuJoCo: shooting over its period {steady.period:.6g} s, {steady.runs} runs "
-                            f"({steady.method}), residual {steady.residual:.1e}")
+        return run, check, steady.words("MuJoCo")
 
 
 class PublishedTwinSide(Side):

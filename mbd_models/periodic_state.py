@@ -12,11 +12,14 @@ off its position.  The input servo's activation, its reference angle, starts eve
 advances by w_in T_M exactly, as the input hinge's nominal angle does.  The steady state is the fixed point
 y0 = P(y0), found from the twin's static state (:func:`~gearcheck.mbd_models.static_state.static_state`) by
 Anderson acceleration (Walker & Ni 2011, :func:`gearcheck.shared.anderson.anderson`), one run an iteration, to a
-residual of 1e-9 (the lumped side's 1e-10 is below the round-off of world-frame angles: a hinge turned to |theta|
-over the steps of a period carries errors of order |theta| eps sqrt(steps), on double-planet a residual floor of
-2-5e-10, where Anderson acceleration stalls).  A run
+residual of ``TOLERANCE`` = 1e-8.  The lumped side's 1e-10 is below the round-off of world-frame angles: a hinge
+turned to |theta| over the steps of a period carries errors of order |theta| eps sqrt(steps), on double-planet a
+residual floor of 2-5e-10, near which Anderson acceleration stalls (asked for 1e-9 there, it spent 6 of its 14
+runs between 6e-9 and 7e-10).  1e-8 stands 20-50 times above that floor; the start it leaves lies within 1e-8 of
+the first guess's deviation from the nominal motion off the orbit, which moved double-planet's cross-check errors
+by at most 1.3e-3 of their tolerances against the start shot to 1e-9.  A run
 ``simulate_mujoco(mb, RunSettings(duration, dt=result.dt), initial_state=result.initial_state)`` is steady from
-t = 0.  Measured (compiled runner, a shared 2-core machine): double-planet 9 runs of 57173 steps, 11-15 s, where
+t = 0.  Measured (compiled runner, a shared 2-core machine): double-planet 8 runs of 57173 steps, 10 s, where
 its 2.45 s transient would take about 49 such periods of time marching; demo-3p (T_M = 62 mesh periods, over which
 its 5 % mesh damping leaves nothing of the start) 2 runs, 2.8 s.
 
@@ -47,6 +50,7 @@ from gearcheck.train.periods import MAX_MESH_PERIODS, common_period, whole_cycle
 
 MAX_DRIVE_PERIODS = 256  # the longest T_M sought, in drive periods: a carrier turns once in z_ring mesh periods
 MAX_ANDERSON_RUNS = 100
+TOLERANCE = 1e-8  # on the residual, 20-50 times the round-off floor of world-frame angles
 
 
 @dataclass(frozen=True)
@@ -91,7 +95,7 @@ def nominal_advance(mb: MbdModel, duration: float) -> np.ndarray:
     return advance
 
 
-def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = 1e-9, initial_state=None,
+def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = TOLERANCE, initial_state=None,
                    max_mesh_periods: int = MAX_MESH_PERIODS, engine: str = "auto") -> PeriodicState:
     """The T_M-periodic steady state of the twin ``mb`` (see the module docstring).
 

@@ -15,6 +15,14 @@ while the events were resolved only to the step, the error 50 times larger; the 
 switching rates left out what its turning tendon coefficients add), which the last test states.
 The RV reducer's disc accelerations are left out: a pin's contact damping makes its force jump where the pin
 touches, so a sample that falls at such an instant reads one side or the other, whatever the step.
+
+Tip relief: a parabolic relief (its flank meets the true involute with a common tangent) keeps the fourth order, its
+tooth pairs' entries and exits located as events (15 um: 3.91-3.97 from h, 3.99 from h/8).  A linear relief's
+flank meets the involute at a corner, so each loaded slice-pair's force has a kink in time at a known mesh position
+where the relief begins; those kinks are not located (6 meshes of 20 slices: a kink every 5 steps at the default
+step, each a split step), and RK4's quadrature over a step holding one errs by O(h^2): on the helical
+stage with 15 um of linear relief the order reads 3.90, 3.62 from h, then 2.8, 2.3 below h/4, where the
+differences have fallen below 1e-6 of the signals, four orders of magnitude below any tolerance a cross-check applies.
 """
 
 from __future__ import annotations
@@ -49,6 +57,9 @@ CONDITIONS = {  # name: (train, the kinds checked)
                                                              "ramp_s = 0.0004")], "ramp"), KINDS),
     "demo-3p, carrier held (star)": (lambda: edited("demo-3p", HELD_CARRIER, "held carrier"), KINDS),
     "helical, 15 deg, contact-line stiffness": (lambda: helical_stage(15.0, stiffness="contact-line"), KINDS),
+    "helical-planetary, 15 um parabolic tip relief: tooth pairs entering and leaving contact": (lambda: edited(
+        "helical-planetary", [(r"amount_um = 0.0", "amount_um = 15.0"), (r'shape = "linear"', 'shape = "parabolic"')],
+        "15 um parabolic"), KINDS),
 }
 
 

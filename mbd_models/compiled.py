@@ -31,6 +31,7 @@ import numba
 import numpy as np
 
 from gearcheck.mbd_models.elements.cycloid import PIN_BAND
+from gearcheck.mbd_models.twin import TurningCoefficients
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
@@ -131,16 +132,10 @@ class DataViews(NamedTuple):
 
 
 class Turning(NamedTuple):
-    """The mesh tendons' turning slide coefficients (``MbdModel.turning``: their ``wrap_prm`` entries, world-frame
-    bases, carriers' qpos addresses, tendons, slides' qpos and dof addresses), the meshes' damping and half
+    """The mesh tendons' turning slide coefficients (``MbdModel.turning``), the meshes' damping and half
     backlash."""
 
-    wraps: np.ndarray
-    base: np.ndarray
-    carrier_qadr: np.ndarray
-    tendon: np.ndarray
-    slide_qadr: np.ndarray
-    slide_dof: np.ndarray
+    coefficients: TurningCoefficients
     damping: np.ndarray
     half_backlash: np.ndarray
 
@@ -314,7 +309,7 @@ def _turning_rates(qpos, qvel, turning, coef, out):
     """Per mesh, the part of its deflection rate that its tendon's J qvel misses, its coefficients c(phi) turning
     with their carrier: d/dt (c q) = c q' + (dc/dphi) phi' q (``TurningCoefficients.missing_rate``), ``coef`` the
     coefficients at qpos."""
-    wraps, carrier_qadr, tendon, slide_qadr = turning.wraps, turning.carrier_qadr, turning.tendon, turning.slide_qadr
+    wraps, _, carrier_qadr, tendon, slide_qadr, _ = turning.coefficients
     half = wraps.size // 2
     out[:] = 0.0
     for w in range(wraps.size):
@@ -425,7 +420,7 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
     """``_Stepper.set_stage``: stiffness, controls, spring lengths, tooth contacts, damping correction."""
     stiffness, lengthspring, wrap_prm = model.tendon_stiffness, model.tendon_lengthspring, model.wrap_prm
     qpos, qvel, ctrl, applied = data.qpos, data.qvel, data.ctrl, data.qfrc_applied
-    wraps, base, carrier_qadr, tendon, slide_qadr, slide_dof, damping, half_backlash = turning
+    (wraps, base, carrier_qadr, tendon, slide_qadr, slide_dof), damping, half_backlash = turning
     rel_tendons, rel_wraps, rel_qadr, rel_starts = contacts
     J, coef, g, _ = work
     n = k.size
@@ -518,7 +513,7 @@ def _drive_stage(s, r, drive, kinematics, com_pos, jac, pointers, model, data, t
     at stage time ``s``."""
     if flags.pin_contacts:
         _pins(kinematics, com_pos, jac, pointers.model, pointers.data, model, data, cycloid)
-    _refresh(data.qpos, model.wrap_prm, turning.wraps, turning.base, turning.carrier_qadr, work.coef)
+    _refresh(data.qpos, model.wrap_prm, *turning.coefficients[:3], work.coef)
     _set_stage(drive.k[r, s], drive.u[r, s], drive.e[r, s], drive.de[r, s], drive.pairs[r, s],
                flags.transmission_error, flags.tooth_pairs, model, data, turning, contacts, work)
 
@@ -587,7 +582,7 @@ def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive
     ``span``.  A mesh's rate includes what its coefficients' turning adds (:func:`_turning_rates`)."""
     qpos, qvel, wrap_prm = data.qpos, data.qvel, model.wrap_prm
     tendons, wraps, qadr, dofs, starts, relieved, half, _ = switches
-    _refresh(qpos, wrap_prm, turning.wraps, turning.base, turning.carrier_qadr, work.coef)
+    _refresh(qpos, wrap_prm, *turning.coefficients[:3], work.coef)
     _turning_rates(qpos, qvel, turning, work.coef, work.turning_rate)
     n = 0
     for i in range(tendons.size):

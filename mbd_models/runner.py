@@ -369,9 +369,8 @@ class _CompiledStepper(_Stepper):
             compiled.DataViews(d.qpos, d.qvel, d.act, d.qacc, d.act_dot, d.ctrl, d.qfrc_applied, d.sensordata,
                                d.qfrc_spring, d.qfrc_damper, d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length,
                                d.ten_velocity),
-            compiled.Turning(*(np.ascontiguousarray(x) for x in (
-                tc.wraps, tc.base, tc.carrier_qadr, tc.tendon, tc.slide_qadr, tc.slide_dof, mb.mesh_damping,
-                mb.half_backlash))),
+            compiled.Turning(tc._make(np.ascontiguousarray(x) for x in tc), np.ascontiguousarray(mb.mesh_damping),
+                             np.ascontiguousarray(mb.half_backlash)),
             compiled.Contacts(none, none, none, np.zeros(1, dtype=np.int64)) if c is None else compiled.Contacts(
                 *(np.ascontiguousarray(x, dtype=np.int64) for x in
                   (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps))))),

@@ -110,28 +110,78 @@ def _set_static_drive(mb, d: mujoco.MjData, load_scale: float) -> None:
     d.ctrl[a["output_load"]] = kin.output_torque * load_scale
 
 
-def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int = 40) -> StaticState:
-    """Steady rotating equilibrium of the MuJoCo model under the mean load (times ``load_scale``).
+class _PinContacts:
+    """An RV reducer's pin contacts as an active set on the static solve: every pin touching at first, then those
+    in compression at the solution, until the set settles; the clearances last (:meth:`settle`)."""
 
-    Newton's method on r(q) = qacc(q) - qacc_steady(q), with MuJoCo's forward dynamics
-    evaluated at the nominal speeds, every mesh at its mean stiffness, the damping acting on the
-    true deflection rate (zero in steady rotation) and the Jacobian dr/dq by central differences;
-    minimum-norm steps where a free rotation makes it singular.  Backlash: solved first without it,
-    then with every mesh on its drive flank.  Pin contacts: linear springs on an active set, from all pins
-    to those in compression at the solution, until it settles.
+    def __init__(self, mb, d: mujoco.MjData):
+        self.contacts, self.slices, self.d = mb.moving_contacts, mb.moving_slices(), d
+        self.touching = np.ones(sum(len(c.tendons) for c in self.contacts), dtype=bool)
+        self.gaps = True
+        self.name = mb.spec.name
+
+    def refresh(self) -> np.ndarray:
+        """Every contact set to ``touching`` at the data's pose; the compressions."""
+        return np.concatenate([c.refresh(self.d, self.touching[at], self.gaps)
+                               for c, at in zip(self.contacts, self.slices)])
+
+    def settle(self, q: np.ndarray, newton, residual) -> np.ndarray:
+        """``newton``'s solution with the contact set settled: without the clearances first (every pin touching
+        is then the loaded half, whence the set with them follows; from all pins in tension, none might touch)."""
+        for gaps in (False, True) if any(np.any(c.clearance) for c in self.contacts) else (True,):
+            self.gaps = gaps
+            q = newton(q)
+            for rounds in itertools.count():
+                residual(q)
+                compressed = self.refresh() > 0.0
+                if np.array_equal(compressed, self.touching):
+                    break
+                if rounds == len(self.touching):
+                    raise SolverError(f"MuJoCo static state of {self.name}: the pin contact set did not settle")
+                self.touching[:] = compressed
+                q = newton(q)
+        return q
+
+    def forces(self) -> np.ndarray:
+        return np.concatenate([c.pin_forces(self.d) for c in self.contacts])
+
+
+def _newton(residual, q: np.ndarray, tol: float, max_iter: int, name: str) -> tuple[np.ndarray, int, float]:
+    """Newton's method on residual(q) = 0 from q, the Jacobian by central differences, minimum-norm steps where a
+    free rotation makes it singular, until a step is below ``tol``: (q, iterations, the residual's largest entry)."""
+    res = math.inf
+    for iteration in range(1, max_iter + 1):
+        r0 = residual(q)
+        J = np.empty((q.size, q.size))
+        h = 1e-7
+        for j in range(q.size):
+            dq = np.zeros(q.size)
+            dq[j] = h
+            J[:, j] = (residual(q + dq) - residual(q - dq)) / (2 * h)
+        step = np.linalg.lstsq(J, -r0, rcond=1e-12)[0]
+        q = q + step
+        res = float(np.max(np.abs(residual(q))))
+        if np.max(np.abs(step)) < tol:
+            return q, iteration, res
+    raise SolverError(f"MuJoCo static state of {name}: Newton did not converge (residual {res:.3g} m/s^2)")
+
+
+def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int = 40) -> StaticState:
+    """Steady rotating equilibrium of the MuJoCo model under the mean load (times ``load_scale``); ``tol`` and
+    ``max_iter`` for each Newton solve.
+
+    Newton's method (:func:`_newton`) on r(q) = qacc(q) - qacc_steady(q), with MuJoCo's forward dynamics
+    evaluated at the nominal speeds, every mesh at its mean stiffness and the damping acting on the
+    true deflection rate (zero in steady rotation).  Backlash: solved first without it,
+    then with every mesh on its drive flank.  Pin contacts: linear springs on an active set
+    (:class:`_PinContacts`).
     """
     m = mb.model
     d = mujoco.MjData(m)
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.tendon_damping.copy(), m.wrap_prm.copy())
     t = mb.mesh_tendon
     correction = DampingCorrection(mb, d)
-    contacts, slices = mb.moving_contacts, mb.moving_slices()
-    touching = np.ones(sum(len(c.tendons) for c in contacts), dtype=bool) if contacts else None
-    gaps = True
-
-    def refresh_contacts(d) -> np.ndarray:
-        """Every contact set to ``touching`` at ``d``'s pose; the compressions."""
-        return np.concatenate([c.refresh(d, touching[at], gaps) for c, at in zip(contacts, slices)])
+    pins = _PinContacts(mb, d) if mb.moving_contacts else None
     try:
         m.tendon_stiffness[t] = mb.excitation.mean_stiffness
         _set_static_drive(mb, d, load_scale)
@@ -140,30 +190,17 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
             qpos, qvel, target = _nominal(mb, q)
             d.qpos[:], d.qvel[:] = qpos, qvel
             mb.refresh(d.qpos)
-            if touching is not None:
-                refresh_contacts(d)
+            if pins is not None:
+                pins.refresh()
             correction.apply(None)
             mujoco.mj_forward(m, d)
             return d.qacc - target
 
         def newton(q):
             nonlocal iterations, res
-            for _ in range(max_iter):
-                iterations += 1
-                r0 = residual(q)
-                J = np.empty((m.nv, m.nv))
-                h = 1e-7
-                for j in range(m.nv):
-                    dq = np.zeros(m.nv)
-                    dq[j] = h
-                    J[:, j] = (residual(q + dq) - residual(q - dq)) / (2 * h)
-                step = np.linalg.lstsq(J, -r0, rcond=1e-12)[0]
-                q = q + step
-                res = float(np.max(np.abs(residual(q))))
-                if np.max(np.abs(step)) < tol:
-                    return q
-            raise SolverError(f"MuJoCo static state of {mb.spec.name}: Newton did not converge "
-                              f"(residual {res:.3g} m/s^2)")
+            q, taken, res = _newton(residual, q, tol, max_iter, mb.spec.name)
+            iterations += taken
+            return q
 
         q = m.qpos0.copy()
         iterations, res = 0, math.inf
@@ -175,31 +212,14 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
             m.tendon_lengthspring[t, 1] = mb.half_backlash if band else 0.0
             if band and not np.any(mb.half_backlash):
                 break
-            if touching is None:
-                q = newton(q)
-                continue
-            # the pins' clearances last: the contact set without them (every pin touching at first) is the
-            # loaded half, whence the set with them follows (from all pins in tension, none might touch)
-            for gaps in (False, True) if any(np.any(c.clearance) for c in contacts) else (True,):
-                q = newton(q)
-                for rounds in itertools.count():
-                    residual(q)
-                    compressed = refresh_contacts(d) > 0.0
-                    if np.array_equal(compressed, touching):
-                        break
-                    if rounds == len(touching):
-                        raise SolverError(f"MuJoCo static state of {mb.spec.name}: the pin contact set did not "
-                                          "settle")
-                    touching[:] = compressed
-                    q = newton(q)
+            q = newton(q) if pins is None else pins.settle(q, newton, residual)
         residual(q)
         reader = ForceReader(mb, d)
         sample = np.empty((1, reader.width))
         reader.sample(sample[0])
         force, bearing = (f[0] for f in reader.forces(sample))
         qpos, qvel, _ = _nominal(mb, q)
-        pins = None if touching is None else np.concatenate([c.pin_forces(d) for c in contacts])
-        return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res, touching, pins)
+        touching, pin_force = (None, None) if pins is None else (pins.touching, pins.forces())
+        return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res, touching, pin_force)
     finally:
         m.tendon_stiffness[:], m.tendon_lengthspring[:], m.tendon_damping[:], m.wrap_prm[:] = saved
-

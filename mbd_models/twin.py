@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -68,9 +69,9 @@ from gearcheck.shared import stepping
 PLACEHOLDER_STEP = 1e-5  # s, the compiled model's step until its own default is known
 
 
-@dataclass(frozen=True)
-class TurningCoefficients:
-    """The mesh tendons' world-frame slide coefficients, which turn with their carrier.
+class TurningCoefficients(NamedTuple):
+    """The mesh tendons' world-frame slide coefficients, which turn with their carrier (a named tuple of contiguous
+    arrays: the compiled kernels take it as it is, inside :class:`~gearcheck.mbd_models.compiled.Turning`).
 
     Per wrap (x wraps of every mesh, then their y wraps): ``wraps`` the index into ``wrap_prm``;
     ``base`` (2n, 2) such that the coefficient is base @ (cos phi, sin phi), phi the angle of the

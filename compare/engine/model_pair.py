@@ -20,7 +20,6 @@ from gearcheck.compare.engine.diagnosis import diagnose_side
 from gearcheck.compare.engine.plan import TrainPlan, TransientPlan
 from gearcheck.compare.engine.recorded import RecordedSide
 from gearcheck.compare.engine.user_model import user_side
-from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.matrix_file import SUFFIXES
 from gearcheck.lumped.published import FINDING
 from gearcheck.lumped.side import LumpedSide, PublishedSide
@@ -70,9 +69,13 @@ class ModelPair:
         """Nothing to diagnose: the twin is derived from the train, not a model given to gearcheck."""
 
 
+@dataclass(frozen=True)
 class UserPair(ModelPair):
     """A user's model (the test, run at its own step) against the lumped model or the twin; its modes diagnosed
-    against the lumped model (:func:`gearcheck.compare.engine.diagnosis.diagnose_side`)."""
+    against the lumped model of ``lumped`` (:func:`gearcheck.compare.engine.diagnosis.diagnose_side`), the
+    reference itself where that is the lumped side, so that the model is built once."""
+
+    lumped: LumpedSide
 
     def settings(self, duration: float, plan, steps: dict) -> tuple[RunSettings, RunSettings]:
         return RunSettings(duration, steps[self.reference.solver]), RunSettings(duration)
@@ -80,7 +83,7 @@ class UserPair(ModelPair):
     def diagnose(self, spec, result) -> None:
         """Attach the diagnosis of the user's modes to ``result`` and its lines to the notes."""
         if result.modal_results[1] is not None:
-            result.diagnosis = diagnose_side(build_model(spec), self.test, result.modal_results[1])
+            result.diagnosis = diagnose_side(self.lumped.model, self.test, result.modal_results[1])
             result.notes += [f"Diagnosis: {line}" for line in result.diagnosis.lines()]
 
 
@@ -120,13 +123,19 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     if against not in SOLVERS:
         raise GearcheckError(f"against={against!r}: choose {' or '.join(SOLVERS)}")
     built = sides or (lambda solver: SOLVERS[solver](spec))
+
+    def with_lumped(test: Side) -> tuple[Side, Side, LumpedSide]:
+        """(the reference, ``test``, the lumped side: the reference where it is the lumped side)."""
+        reference = built(against)
+        return reference, test, reference if against == "lumped" else built("lumped")
+
     named = model if isinstance(model, str) else None
     if results is not None:
         if named != "general":
             raise GearcheckError("results= gives the model checked: leave model= out")
         if columns is None:
             raise GearcheckError("results= needs columns=, the map of its columns to gearcheck's signals")
-        return RecordedPair(built(against), RecordedSide(spec, results, columns, modes))
+        return RecordedPair(*with_lumped(RecordedSide(spec, results, columns, modes)))
     if named == "general":
         return ModelPair(built("lumped"), built("mujoco"))
     if named in PUBLISHED_MODELS:
@@ -134,11 +143,11 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     if named == USER:
         if spec.user_model is None:
             raise GearcheckError(f"model=user: {spec.name} registers no user_model (train.user_model in its file)")
-        return UserPair(built(against), user_side(spec.user_model, spec))
+        return UserPair(*with_lumped(user_side(spec.user_model, spec)))
     if named is not None and ":" not in named and Path(named).suffix not in SUFFIXES:
         if Path(named).suffix:
             raise GearcheckError(f"model={named}: a model file is {' or '.join(SUFFIXES)}, "
                                  f"not {Path(named).suffix!r}")
         raise GearcheckError(f"unknown model {named!r}: choose one of {', '.join(MODELS)}, or give your own: a model "
                              f"file ({' or '.join(SUFFIXES)}), module:factory or file.py:factory")
-    return UserPair(built(against), user_side(model, spec))
+    return UserPair(*with_lumped(user_side(model, spec)))

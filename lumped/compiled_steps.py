@@ -17,8 +17,13 @@ chunk, and runs RK4 through them in compiled code.  Its right-hand side is that 
   :func:`gearcheck.train.cycloid.pin_contacts` states them).
 
 It takes the model and the chunk in named groups (numba passes named tuples of arrays as structs):
-:class:`Matrices`, :class:`Meshes`, :class:`Couplings` and :class:`Discs` built once per model
-(:func:`kernel_groups`), :class:`Chunk` per chunk of steps, :class:`Output` where the samples go.
+:class:`Matrices` and :class:`Meshes`, and each turning element kind's group, built once per model
+(:func:`kernel_groups`); :class:`Chunk` per chunk of steps, :class:`Output` where the samples go.  A turning
+element kind keeps its group and its compiled forces in its own file, beside its rows
+(:class:`~gearcheck.lumped.elements.coupling.Couplings` and
+:func:`~gearcheck.lumped.elements.coupling.coupling_forces`; :class:`~gearcheck.lumped.elements.cycloid.Discs`,
+:func:`~gearcheck.lumped.elements.cycloid.disc_forces` and :func:`~gearcheck.lumped.elements.cycloid.pin_switching`);
+the kernel calls each kind's functions once per stage.
 
 numba (``@njit(cache=True)``, compiled on the first call and cached on disk) is the one compiled dependency:
 a step is a loop over a few hundred numbers with branches (dead zones, contacts) that numpy cannot vectorise
@@ -32,6 +37,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from gearcheck.lumped.elements.coupling import Couplings, coupling_forces
+from gearcheck.lumped.elements.cycloid import Discs, disc_forces, pin_switching
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
@@ -75,66 +82,6 @@ class Meshes(NamedTuple):
     half_backlash: np.ndarray
     backlash: bool
     relieved: np.ndarray
-
-
-class Couplings(NamedTuple):
-    """Radial couplings between turning frames: ``index`` (T, 4) the (a_x, a_y, b_x, b_y) coordinates, ``values``
-    (T, 4) their (Omega_a, Omega_b, stiffness, damping)."""
-
-    index: np.ndarray
-    values: np.ndarray
-
-    @classmethod
-    def of(cls, couplings) -> "Couplings":
-        return cls(np.array([[*e.a, *e.b] for e in couplings], dtype=np.int64).reshape(-1, 4),
-                   np.array([[e.omega_a, e.omega_b, e.stiffness, e.damping] for e in couplings],
-                            dtype=float).reshape(-1, 4))
-
-
-class Discs(NamedTuple):
-    """Cycloid discs, one row per disc of every cycloid stage: ``index`` (D, 3) its (x, y, theta), ``wheel`` (D, 3)
-    its pin wheel's (-1: fixed), ``crank_index`` (D, M, 3) its stage's cranks, ``crank_place`` (D, M, 2) cos and sin
-    of their places psi_k (padded), ``cranks`` (D,) their number, ``pin_place`` (D, Z, 2) cos and sin of
-    2 pi i / Z_p (padded), ``pins`` (D,) Z_p, and ``values`` (D, 14): phase, w_H - Omega, w_w - Omega, K1, r_c,
-    Z_p e, e, m e w_H^2, needle k and c, pin k and c, clearance, and the carrier radius."""
-
-    index: np.ndarray
-    wheel: np.ndarray
-    crank_index: np.ndarray
-    crank_place: np.ndarray
-    cranks: np.ndarray
-    pin_place: np.ndarray
-    pins: np.ndarray
-    values: np.ndarray
-
-    @classmethod
-    def of(cls, cycloids) -> "Discs":
-        discs = [(e, j) for e in cycloids for j in range(len(e.disc))]
-        most_cranks = max((len(e.crank) for e in cycloids), default=0)
-        most_pins = max((e.geometry.pins for e in cycloids), default=0)
-        index = np.zeros((len(discs), 3), dtype=np.int64)
-        wheel = np.full((len(discs), 3), -1, dtype=np.int64)
-        crank_index = np.zeros((len(discs), most_cranks, 3), dtype=np.int64)
-        crank_place = np.zeros((len(discs), most_cranks, 2))
-        cranks = np.zeros(len(discs), dtype=np.int64)
-        pin_place = np.zeros((len(discs), most_pins, 2))
-        pins = np.zeros(len(discs), dtype=np.int64)
-        values = np.zeros((len(discs), 14))
-        for d, (e, j) in enumerate(discs):
-            g = e.geometry
-            index[d] = e.disc[j]
-            if e.wheel is not None:
-                wheel[d] = e.wheel
-            cranks[d] = len(e.crank)
-            crank_index[d, :cranks[d]] = e.crank
-            crank_place[d, :cranks[d]] = np.stack([np.cos(e.psi), np.sin(e.psi)], axis=-1)
-            angles = 2 * np.pi * np.arange(g.pins) / g.pins
-            pin_place[d, :g.pins] = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
-            pins[d] = g.pins
-            values[d] = (e.phases[j], e.omega_eccentric, e.omega_pins, g.K1, g.rolling_radius, g.pitch_radius,
-                         g.eccentricity, e.disc_mass * g.eccentricity * e.omega_orbit**2, e.needle_stiffness,
-                         e.needle_damping, e.pin_stiffness, e.pin_damping, e.clearance, e.carrier_radius)
-        return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
 
 
 GROUPS = {"couplings": Couplings, "discs": Discs}  # the compiled groups a turning element names (Turning.compiled)
@@ -189,37 +136,12 @@ STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's samples t, t + h/2, t 
 
 
 @njit(inline="always")
-def _pin(d, i, x, t, discs):
-    """Pin i of disc d at state x, time t: (compression, normal x, normal y, arm on the disc, arm on the wheel)."""
-    disc_index, wheel_index, _, _, _, pin_place, _, disc = discs
-    dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
-    phi = disc[d, 0] + disc[d, 1] * t
-    cp, sp = np.cos(phi), np.sin(phi)
-    rel = disc[d, 2] * t - phi  # pin 0's angle relative to the eccentric
-    cw, sw = np.cos(rel), np.sin(rel)
-    K1, rc, pitch = disc[d, 3], disc[d, 4], disc[d, 5]
-    ci, si = pin_place[d, i, 0], pin_place[d, i, 1]
-    cr, sr = ci * cw - si * sw, si * cw + ci * sw
-    norm = np.sqrt(1 + K1 * K1 - 2 * K1 * cr)
-    ex, ey = (cr - K1) / norm, sr / norm
-    nx, ny = cp * ex - sp * ey, sp * ex + cp * ey
-    arm = rc * ey
-    compression = nx * x[dx_] + ny * x[dy] + arm * x[dth] - disc[d, 12]
-    wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
-    if wx >= 0:
-        compression -= nx * x[wx] + ny * x[wy] + pitch * ey * x[wt]
-    return compression, nx, ny, arm, pitch * ey
-
-
-@njit(inline="always")
 def _acceleration(x, u, out, t, ti, to, k, e, de, pairs, matrices, meshes, couplings, discs):
     """q'' into ``out`` at state (x, u), time t, torques ti and to, the meshes' k, e, de and tooth pairs."""
     minv, F0, b_in, b_out = matrices.minv, matrices.load, matrices.b_in, matrices.b_out
     kp, ki, kx = matrices.K
     dp, di, dx = matrices.D
     (ap, ai, ax), c, half, backlash, relieved = meshes
-    coupling_index, coupling = couplings
-    disc_index, wheel_index, crank_index, crank_place, cranks, _, pins, disc = discs
     n = x.size
     for i in range(n):
         f = F0[i] + b_in[i] * ti + b_out[i] * to
@@ -250,60 +172,8 @@ def _acceleration(x, u, out, t, ti, to, k, e, de, pairs, matrices, meshes, coupl
         f = elastic + c[m] * (rate - de[m])
         for p in range(ap[m], ap[m + 1]):
             out[ai[p]] -= ax[p] * f
-    for w in range(coupling.shape[0]):  # radial couplings between turning frames
-        wa, wb, kc, cc = coupling[w, 0], coupling[w, 1], coupling[w, 2], coupling[w, 3]
-        i0, i1, i2, i3 = coupling_index[w, 0], coupling_index[w, 1], coupling_index[w, 2], coupling_index[w, 3]
-        phi = (wb - wa) * t
-        cs, sn = np.cos(phi), np.sin(phi)
-        va0, va1 = u[i0] - wa * x[i1], u[i1] + wa * x[i0]
-        vb0, vb1 = u[i2] - wb * x[i3], u[i3] + wb * x[i2]
-        p0 = kc * (x[i0] - (cs * x[i2] - sn * x[i3])) + cc * (va0 - (cs * vb0 - sn * vb1))
-        p1 = kc * (x[i1] - (sn * x[i2] + cs * x[i3])) + cc * (va1 - (sn * vb0 + cs * vb1))
-        out[i0] -= p0
-        out[i1] -= p1
-        out[i2] += cs * p0 + sn * p1
-        out[i3] += -sn * p0 + cs * p1
-    for d in range(disc.shape[0]):  # cycloid discs
-        dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
-        phi = disc[d, 0] + disc[d, 1] * t
-        cp, sp = np.cos(phi), np.sin(phi)
-        out[dx_] += disc[d, 7] * cp  # the orbit's centrifugal load
-        out[dy] += disc[d, 7] * sp
-        ecc, kn, cn, radius = disc[d, 6], disc[d, 8], disc[d, 9], disc[d, 13]
-        for kk in range(cranks[d]):  # needle bearings, x and y
-            c0, c1, c2 = crank_index[d, kk, 0], crank_index[d, kk, 1], crank_index[d, kk, 2]
-            ck, sk = crank_place[d, kk, 0], crank_place[d, kk, 1]
-            for axis in range(2):
-                if axis == 0:
-                    a0, a1, a2, b0, b1, b2 = ck, -sk, -ecc * sp, -1.0, 0.0, radius * sk
-                else:
-                    a0, a1, a2, b0, b1, b2 = sk, ck, ecc * cp, 0.0, -1.0, -radius * ck
-                dn = a0 * x[c0] + a1 * x[c1] + a2 * x[c2] + b0 * x[dx_] + b1 * x[dy] + b2 * x[dth]
-                rn = a0 * u[c0] + a1 * u[c1] + a2 * u[c2] + b0 * u[dx_] + b1 * u[dy] + b2 * u[dth]
-                f = kn * dn + cn * rn
-                out[c0] -= f * a0
-                out[c1] -= f * a1
-                out[c2] -= f * a2
-                out[dx_] -= f * b0
-                out[dy] -= f * b1
-                out[dth] -= f * b2
-        kp_, cp_ = disc[d, 10], disc[d, 11]
-        wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
-        for i in range(pins[d]):  # pin contacts, compression only
-            compression, nx, ny, arm, wheel_arm = _pin(d, i, x, t, discs)
-            if not compression > 0.0:
-                continue
-            rp = nx * u[dx_] + ny * u[dy] + arm * u[dth]
-            if wx >= 0:
-                rp -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
-            f = kp_ * compression + cp_ * rp
-            out[dx_] -= f * nx
-            out[dy] -= f * ny
-            out[dth] -= f * arm
-            if wx >= 0:
-                out[wx] += f * nx
-                out[wy] += f * ny
-                out[wt] += f * wheel_arm
+    coupling_forces(x, u, t, couplings, out)
+    disc_forces(x, u, t, discs, out)
     for i in range(n):
         out[i] *= minv[i]
 
@@ -339,7 +209,6 @@ def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
     samples of a (sub-)step of length ``span``, t at sample ``s`` (their gaps' rates from the three); a pin's rate
     leaves out its normal's turning."""
     (ap, ai, ax), c, half, backlash, relieved = meshes
-    disc_index, wheel_index, _, _, _, _, pins, _ = discs
     n = 0
     for m in range(c.size):
         j = relieved[m]
@@ -359,16 +228,7 @@ def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
             g[n], g[n + 1] = y - half[m], y + half[m]
             rate[n], rate[n + 1] = dy, dy
             n += 2
-    for d in range(pins.size):
-        dx_, dy_, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
-        wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
-        for i in range(pins[d]):
-            compression, nx, ny, arm, wheel_arm = _pin(d, i, x, t, discs)
-            g[n] = compression
-            rate[n] = nx * u[dx_] + ny * u[dy_] + arm * u[dth]
-            if wx >= 0:
-                rate[n] -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
-            n += 1
+    pin_switching(x, u, t, discs, g, rate, n)
 
 
 def switching_count(meshes: Meshes, discs: Discs, pairs_per_mesh: int) -> int:

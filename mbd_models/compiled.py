@@ -15,7 +15,10 @@ writes the model fields and the data that the Python loop writes, and calls MuJo
 model through its C library (``ctypes``), with the GIL released, so several twins run at once in threads
 (:func:`gearcheck.mbd_models.runner.simulate_mujoco_many`).
 
-The kernel is compiled on first use and cached by numba next to this file.
+The pin contacts of an RV reducer's discs come in their element's compiled form, beside the element's bodies
+and tendons (:mod:`gearcheck.mbd_models.elements.cycloid`: ``CompiledPins``, ``refresh_pins``,
+``pin_switching``, ``pin_forces_into``).  The kernel is compiled on first use and cached by numba next to its
+file.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ import mujoco
 import numba
 import numpy as np
 
-from gearcheck.mbd_models.elements.cycloid import PIN_BAND
+from gearcheck.mbd_models.elements.cycloid import pin_forces_into, pin_switching, refresh_pins
 from gearcheck.mbd_models.twin import TurningCoefficients
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
@@ -182,54 +185,6 @@ class Reader(NamedTuple):
     slides: np.ndarray
 
 
-class Pins(NamedTuple):
-    """Per pin tendon (in its rows' order): tendon, stiffness, damping, clearance, pin site, ``wrap_prm`` entries."""
-
-    tendons: np.ndarray
-    stiffness: np.ndarray
-    damping: np.ndarray
-    clearance: np.ndarray
-    site: np.ndarray
-    wraps: np.ndarray
-
-
-class Discs(NamedTuple):
-    """Per cycloid disc: body, pin wheel (-1: none), phase, lobes, eccentricity, pitch radius, first pin row, pins,
-    and its tendons' dofs (their number, and the dofs and qpos addresses, padded)."""
-
-    body: np.ndarray
-    wheel: np.ndarray
-    phase: np.ndarray
-    lobes: np.ndarray
-    eccentricity: np.ndarray
-    pitch_radius: np.ndarray
-    first: np.ndarray
-    count: np.ndarray
-    ndof: np.ndarray
-    dofs: np.ndarray
-    qadr: np.ndarray
-
-
-class PinWork(NamedTuple):
-    """Work space of the pin contacts: a Jacobian, the contact point, G, each row's compression, length and rate
-    of length (its coefficients held)."""
-
-    jacobian: np.ndarray
-    point: np.ndarray
-    G: np.ndarray
-    delta: np.ndarray
-    length: np.ndarray
-    speed: np.ndarray
-
-
-class Cycloid(NamedTuple):
-    """An RV reducer's pin contacts (:func:`cycloid_arrays`)."""
-
-    pins: Pins
-    discs: Discs
-    work: PinWork
-
-
 class Drive(NamedTuple):
     """The drive at each (sub-)step's stage times (axis 1: t, t + h/2, t + h, as
     :meth:`gearcheck.mbd_models.runner._Drive.steps` gives it), a row per (sub-)step: mesh stiffness, controls,
@@ -317,104 +272,6 @@ def _turning_rates(qpos, qvel, turning, coef, out):
         out[tendon[w]] += turned * qvel[carrier_qadr[w]] * qpos[slide_qadr[w]]
 
 
-def cycloid_arrays(contacts, nv: int) -> Cycloid:
-    """The twin's pin contacts (:attr:`gearcheck.mbd_models.twin.MbdModel.moving_contacts`: an RV reducer's
-    ``CycloidTwin``) as flat arrays for :func:`_pins`, every contact's tendons in their order; none: empty arrays
-    of the same types."""
-    rows, discs, stages, offset = [], [], [], 0
-    for c in contacts:  # each contact's stages, with where its tendons start among all
-        stages += [(g, offset) for g in c.stages]
-        offset += len(c.tendons)
-    width = max([g.dofs.shape[1] for g, _ in stages], default=6)
-    for g, offset in stages:
-        for i, body in enumerate(g.bodies):
-            first = offset + g.rows.start + i * len(g.sites)
-            dofs, qadr = np.full(width, -1), np.full(width, -1)
-            dofs[:g.dofs.shape[1]], qadr[:g.dofs.shape[1]] = g.dofs[i], g.qadr[i]
-            discs.append((body, g.wheel, g.phases[i], g.lobes, g.eccentricity, g.pitch_radius, first,
-                          len(g.sites), g.dofs.shape[1], dofs, qadr))
-            for p, site in enumerate(g.sites):
-                wraps = np.full(width, -1)
-                wraps[:g.dofs.shape[1]] = g.wraps[i, p]
-                rows.append((site, wraps))
-    i64, f64 = np.int64, np.float64
-    n_pins = len(rows)
-
-    def joined(name: str, kind) -> np.ndarray:
-        return np.concatenate([np.asarray(getattr(c, name), dtype=kind) for c in contacts] + [np.zeros(0, kind)])
-
-    pins = Pins(joined("tendons", i64), joined("stiffness", f64), joined("damping", f64), joined("clearance", f64),
-                np.array([r[0] for r in rows], dtype=i64),
-                np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
-    columns = list(zip(*discs)) if discs else [[]] * 11
-    types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
-    disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))
-    disc = Discs(*disc[:9], *(x.reshape(len(discs), width) for x in disc[9:]))
-    work = PinWork(np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins),
-                   np.zeros(n_pins))
-    return Cycloid(pins, disc, work)
-
-
-@numba.njit(cache=True)
-def _pins(kinematics, com_pos, jac, m, d, model, data, cycloid):
-    """``CycloidTwin.refresh(d)`` (a run's compression-only contacts): every pin tendon's coefficients, spring
-    lengths, stiffness and damping at the discs' present poses, from MuJoCo's kinematics and Jacobians."""
-    stiffness, lengthspring, wrap_prm, damping_model = (model.tendon_stiffness, model.tendon_lengthspring,
-                                                        model.wrap_prm, model.tendon_damping)
-    qpos, qvel, xpos, xmat, site_xpos = data.qpos, data.qvel, data.xpos, data.xmat, data.site_xpos
-    tendons, k_pin, c_pin, clearance, site, wraps = cycloid.pins
-    body, wheel, phase, lobes, ecc, pitch_radius, first, count, ndof, dofs, qadr = cycloid.discs
-    jacobian, point, G, delta, length, speed = cycloid.work
-    kinematics(m, d)
-    com_pos(m, d)
-    for i in range(body.size):
-        b, wh = body[i], wheel[i]
-        cx, cy = xpos[b, 0], xpos[b, 1]
-        if wh >= 0:
-            ox, oy = xpos[wh, 0], xpos[wh, 1]
-            w = math.atan2(xmat[wh, 3], xmat[wh, 0])
-        else:
-            ox, oy, w = 0.0, 0.0, 0.0
-        phi = phase[i] + (1 + lobes[i]) * w - lobes[i] * math.atan2(xmat[b, 3], xmat[b, 0])
-        ux, uy = math.cos(phi), math.sin(phi)
-        point[0] = ox + pitch_radius[i] * ux
-        point[1] = oy + pitch_radius[i] * uy
-        point[2] = xpos[b, 2]
-        jac(m, d, jacobian.ctypes.data, 0, point.ctypes.data, b)
-        for r in range(2):
-            for k in range(ndof[i]):
-                G[r, k] = jacobian[r, dofs[i, k]]
-        if wh >= 0:
-            jac(m, d, jacobian.ctypes.data, 0, point.ctypes.data, wh)
-            for r in range(2):
-                for k in range(ndof[i]):
-                    G[r, k] -= jacobian[r, dofs[i, k]]
-        vx, vy = cx - ox - ecc[i] * ux, cy - oy - ecc[i] * uy
-        for p in range(first[i], first[i] + count[i]):
-            nx, ny = site_xpos[site[p], 0] - point[0], site_xpos[site[p], 1] - point[1]
-            size = math.sqrt(nx * nx + ny * ny)
-            nx /= size
-            ny /= size
-            delta[p] = nx * vx + ny * vy
-            total = 0.0
-            rate = 0.0
-            for k in range(ndof[i]):
-                coef = nx * G[0, k] + ny * G[1, k]
-                wrap_prm[wraps[p, k]] = coef
-                total += coef * qpos[qadr[i, k]]
-                rate += coef * qvel[dofs[i, k]]
-            length[p] = total
-            speed[p] = rate
-    for p in range(tendons.size):
-        t = tendons[p]
-        compression = delta[p] - clearance[p]
-        top = length[p] - compression
-        lengthspring[t, 0] = top - PIN_BAND
-        lengthspring[t, 1] = top
-        stiffness[t] = k_pin[p]
-        damping_model[t] = c_pin[p] * (compression > 0.0)
-
-
 @numba.njit(cache=True)
 def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, contacts, work):
     """``_Stepper.set_stage``: stiffness, controls, spring lengths, tooth contacts, damping correction."""
@@ -497,13 +354,8 @@ def _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid):
     if flags.record_energy:
         energies[j, 0] = energy[0]
         energies[j, 1] = energy[1]
-    if flags.pin_contacts:  # CycloidTwin.pin_forces
-        tendons, ten_length, ten_velocity, damping = (cycloid.pins.tendons, data.ten_length, data.ten_velocity,
-                                                      model.tendon_damping)
-        for p in range(tendons.size):
-            t = tendons[p]
-            compression = ten_length[t] - lengthspring[t, 1]
-            pin_forces[j, p] = stiffness[t] * max(compression, 0.0) + damping[t] * ten_velocity[t]
+    if flags.pin_contacts:
+        pin_forces_into(pin_forces[j], model, data, cycloid)
 
 
 @numba.njit(cache=True)
@@ -512,7 +364,7 @@ def _drive_stage(s, r, drive, kinematics, com_pos, jac, pointers, model, data, t
     """Everything a stage sets from its own state: the pin tendons, the turned coefficients, the drive of row ``r``
     at stage time ``s``."""
     if flags.pin_contacts:
-        _pins(kinematics, com_pos, jac, pointers.model, pointers.data, model, data, cycloid)
+        refresh_pins(kinematics, com_pos, jac, pointers.model, pointers.data, model, data, cycloid)
     _refresh(data.qpos, model.wrap_prm, *turning.coefficients[:3], work.coef)
     _set_stage(drive.k[r, s], drive.u[r, s], drive.e[r, s], drive.de[r, s], drive.pairs[r, s],
                flags.transmission_error, flags.tooth_pairs, model, data, turning, contacts, work)
@@ -606,12 +458,8 @@ def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive
             rate[n], rate[n + 1] = speed, speed
             n += 2
     if flags.pin_contacts:
-        _pins(c[4], c[5], c[6], pointers.model, pointers.data, model, data, cycloid)
-        delta, speed, clearance = cycloid.work.delta, cycloid.work.speed, cycloid.pins.clearance
-        for p in range(delta.size):
-            g[n] = delta[p] - clearance[p]
-            rate[n] = speed[p]
-            n += 1
+        refresh_pins(c[4], c[5], c[6], pointers.model, pointers.data, model, data, cycloid)
+        pin_switching(cycloid, g, rate, n)
 
 
 @numba.njit(cache=True)

@@ -66,6 +66,7 @@ import mujoco
 import numpy as np
 
 from gearcheck.mbd_models import compiled
+from gearcheck.mbd_models.elements.cycloid import cycloid_arrays
 from gearcheck.mbd_models.forces import ForceReader
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
 from gearcheck.mbd_models.twin import MbdModel
@@ -377,7 +378,7 @@ class _CompiledStepper(_Stepper):
             compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n), np.zeros(n)),
             compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
                             np.ascontiguousarray(reader.slides, dtype=np.int64)),
-            compiled.cycloid_arrays(mb.moving_contacts, m.nv),
+            cycloid_arrays(mb.moving_contacts, m.nv),
             compiled.Stages.of(m))
         self.outputs = compiled.Outputs(self.sensors, self.forces,
                                         np.zeros((0, n)) if self.stiffness is None else self.stiffness,

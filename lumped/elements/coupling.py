@@ -5,8 +5,10 @@ translations; across frames that turn at different speeds, the radial part turns
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning
@@ -73,3 +75,37 @@ class TurningCoupling(Turning):
         out[..., self.b[0]] += on_b[..., 0]
         out[..., self.b[1]] += on_b[..., 1]
         return out
+
+
+class Couplings(NamedTuple):
+    """Radial couplings between turning frames: ``index`` (T, 4) the (a_x, a_y, b_x, b_y) coordinates, ``values``
+    (T, 4) their (Omega_a, Omega_b, stiffness, damping)."""
+
+    index: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, couplings) -> "Couplings":
+        return cls(np.array([[*e.a, *e.b] for e in couplings], dtype=np.int64).reshape(-1, 4),
+                   np.array([[e.omega_a, e.omega_b, e.stiffness, e.damping] for e in couplings],
+                            dtype=float).reshape(-1, 4))
+
+
+@njit(inline="always")
+def coupling_forces(x, u, t, couplings, out) -> None:
+    """The compiled steps' form of :meth:`TurningCoupling.forces`: every radial coupling between turning frames at
+    state (x, u), time t, added into ``out`` (:mod:`gearcheck.lumped.compiled_steps`)."""
+    coupling_index, coupling = couplings
+    for w in range(coupling.shape[0]):
+        wa, wb, kc, cc = coupling[w, 0], coupling[w, 1], coupling[w, 2], coupling[w, 3]
+        i0, i1, i2, i3 = coupling_index[w, 0], coupling_index[w, 1], coupling_index[w, 2], coupling_index[w, 3]
+        phi = (wb - wa) * t
+        cs, sn = np.cos(phi), np.sin(phi)
+        va0, va1 = u[i0] - wa * x[i1], u[i1] + wa * x[i0]
+        vb0, vb1 = u[i2] - wb * x[i3], u[i3] + wb * x[i2]
+        p0 = kc * (x[i0] - (cs * x[i2] - sn * x[i3])) + cc * (va0 - (cs * vb0 - sn * vb1))
+        p1 = kc * (x[i1] - (sn * x[i2] + cs * x[i3])) + cc * (va1 - (sn * vb0 + cs * vb1))
+        out[i0] -= p0
+        out[i1] -= p1
+        out[i2] += cs * p0 + sn * p1
+        out[i3] += -sn * p0 + cs * p1

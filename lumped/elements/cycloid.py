@@ -26,8 +26,10 @@ of t = 0 with the contact set of the static solution (like a turning coupling), 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning
@@ -246,3 +248,138 @@ class CycloidRows(Turning):
                 return active
             active = touching
         raise SolverError(f"{self.stage}: the static pin contact set did not settle")  # pragma: no cover
+
+
+# ------------------------------------------------------------------------- the compiled steps' form
+class Discs(NamedTuple):
+    """Cycloid discs, one row per disc of every cycloid stage: ``index`` (D, 3) its (x, y, theta), ``wheel`` (D, 3)
+    its pin wheel's (-1: fixed), ``crank_index`` (D, M, 3) its stage's cranks, ``crank_place`` (D, M, 2) cos and sin
+    of their places psi_k (padded), ``cranks`` (D,) their number, ``pin_place`` (D, Z, 2) cos and sin of
+    2 pi i / Z_p (padded), ``pins`` (D,) Z_p, and ``values`` (D, 14): phase, w_H - Omega, w_w - Omega, K1, r_c,
+    Z_p e, e, m e w_H^2, needle k and c, pin k and c, clearance, and the carrier radius."""
+
+    index: np.ndarray
+    wheel: np.ndarray
+    crank_index: np.ndarray
+    crank_place: np.ndarray
+    cranks: np.ndarray
+    pin_place: np.ndarray
+    pins: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, cycloids) -> "Discs":
+        discs = [(e, j) for e in cycloids for j in range(len(e.disc))]
+        most_cranks = max((len(e.crank) for e in cycloids), default=0)
+        most_pins = max((e.geometry.pins for e in cycloids), default=0)
+        index = np.zeros((len(discs), 3), dtype=np.int64)
+        wheel = np.full((len(discs), 3), -1, dtype=np.int64)
+        crank_index = np.zeros((len(discs), most_cranks, 3), dtype=np.int64)
+        crank_place = np.zeros((len(discs), most_cranks, 2))
+        cranks = np.zeros(len(discs), dtype=np.int64)
+        pin_place = np.zeros((len(discs), most_pins, 2))
+        pins = np.zeros(len(discs), dtype=np.int64)
+        values = np.zeros((len(discs), 14))
+        for d, (e, j) in enumerate(discs):
+            g = e.geometry
+            index[d] = e.disc[j]
+            if e.wheel is not None:
+                wheel[d] = e.wheel
+            cranks[d] = len(e.crank)
+            crank_index[d, :cranks[d]] = e.crank
+            crank_place[d, :cranks[d]] = np.stack([np.cos(e.psi), np.sin(e.psi)], axis=-1)
+            angles = 2 * np.pi * np.arange(g.pins) / g.pins
+            pin_place[d, :g.pins] = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+            pins[d] = g.pins
+            values[d] = (e.phases[j], e.omega_eccentric, e.omega_pins, g.K1, g.rolling_radius, g.pitch_radius,
+                         g.eccentricity, e.disc_mass * g.eccentricity * e.omega_orbit**2, e.needle_stiffness,
+                         e.needle_damping, e.pin_stiffness, e.pin_damping, e.clearance, e.carrier_radius)
+        return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
+
+
+@njit(inline="always")
+def pin(d, i, x, t, discs):
+    """Pin i of disc d at state x, time t: (compression, normal x, normal y, arm on the disc, arm on the wheel)."""
+    disc_index, wheel_index, _, _, _, pin_place, _, disc = discs
+    dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
+    phi = disc[d, 0] + disc[d, 1] * t
+    cp, sp = np.cos(phi), np.sin(phi)
+    rel = disc[d, 2] * t - phi  # pin 0's angle relative to the eccentric
+    cw, sw = np.cos(rel), np.sin(rel)
+    K1, rc, pitch = disc[d, 3], disc[d, 4], disc[d, 5]
+    ci, si = pin_place[d, i, 0], pin_place[d, i, 1]
+    cr, sr = ci * cw - si * sw, si * cw + ci * sw
+    norm = np.sqrt(1 + K1 * K1 - 2 * K1 * cr)
+    ex, ey = (cr - K1) / norm, sr / norm
+    nx, ny = cp * ex - sp * ey, sp * ex + cp * ey
+    arm = rc * ey
+    compression = nx * x[dx_] + ny * x[dy] + arm * x[dth] - disc[d, 12]
+    wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
+    if wx >= 0:
+        compression -= nx * x[wx] + ny * x[wy] + pitch * ey * x[wt]
+    return compression, nx, ny, arm, pitch * ey
+
+
+@njit(inline="always")
+def disc_forces(x, u, t, discs, out) -> None:
+    """The compiled steps' form of :meth:`CycloidRows.forces`: every disc's orbit load, needle bearings and pin
+    contacts at state (x, u), time t, added into ``out`` (:mod:`gearcheck.lumped.compiled_steps`)."""
+    disc_index, wheel_index, crank_index, crank_place, cranks, _, pins, disc = discs
+    for d in range(disc.shape[0]):
+        dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
+        phi = disc[d, 0] + disc[d, 1] * t
+        cp, sp = np.cos(phi), np.sin(phi)
+        out[dx_] += disc[d, 7] * cp  # the orbit's centrifugal load
+        out[dy] += disc[d, 7] * sp
+        ecc, kn, cn, radius = disc[d, 6], disc[d, 8], disc[d, 9], disc[d, 13]
+        for kk in range(cranks[d]):  # needle bearings, x and y
+            c0, c1, c2 = crank_index[d, kk, 0], crank_index[d, kk, 1], crank_index[d, kk, 2]
+            ck, sk = crank_place[d, kk, 0], crank_place[d, kk, 1]
+            for axis in range(2):
+                if axis == 0:
+                    a0, a1, a2, b0, b1, b2 = ck, -sk, -ecc * sp, -1.0, 0.0, radius * sk
+                else:
+                    a0, a1, a2, b0, b1, b2 = sk, ck, ecc * cp, 0.0, -1.0, -radius * ck
+                dn = a0 * x[c0] + a1 * x[c1] + a2 * x[c2] + b0 * x[dx_] + b1 * x[dy] + b2 * x[dth]
+                rn = a0 * u[c0] + a1 * u[c1] + a2 * u[c2] + b0 * u[dx_] + b1 * u[dy] + b2 * u[dth]
+                f = kn * dn + cn * rn
+                out[c0] -= f * a0
+                out[c1] -= f * a1
+                out[c2] -= f * a2
+                out[dx_] -= f * b0
+                out[dy] -= f * b1
+                out[dth] -= f * b2
+        kp_, cp_ = disc[d, 10], disc[d, 11]
+        wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
+        for i in range(pins[d]):  # pin contacts, compression only
+            compression, nx, ny, arm, wheel_arm = pin(d, i, x, t, discs)
+            if not compression > 0.0:
+                continue
+            rp = nx * u[dx_] + ny * u[dy] + arm * u[dth]
+            if wx >= 0:
+                rp -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
+            f = kp_ * compression + cp_ * rp
+            out[dx_] -= f * nx
+            out[dy] -= f * ny
+            out[dth] -= f * arm
+            if wx >= 0:
+                out[wx] += f * nx
+                out[wy] += f * ny
+                out[wt] += f * wheel_arm
+
+
+@njit(inline="always")
+def pin_switching(x, u, t, discs, g, rate, n) -> None:
+    """Every pin's compression at state (x, u), time t into g from index n on, and its rate into ``rate`` (its
+    normal's turning left out): the pins' switching functions (:mod:`gearcheck.lumped.compiled_steps`)."""
+    disc_index, wheel_index, _, _, _, _, pins, _ = discs
+    for d in range(pins.size):
+        dx_, dy_, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
+        wx, wy, wt = wheel_index[d, 0], wheel_index[d, 1], wheel_index[d, 2]
+        for i in range(pins[d]):
+            compression, nx, ny, arm, wheel_arm = pin(d, i, x, t, discs)
+            g[n] = compression
+            rate[n] = nx * u[dx_] + ny * u[dy_] + arm * u[dth]
+            if wx >= 0:
+                rate[n] -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
+            n += 1

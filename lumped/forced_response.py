@@ -22,7 +22,6 @@ from dataclasses import replace
 import numpy as np
 
 from gearcheck.lumped.assembly import LumpedModel, contact_sets, frozen_at
-from gearcheck.lumped.elements.cycloid import CycloidRows
 from gearcheck.lumped.fourier_response import ParametricProblem
 from gearcheck.lumped.static import mean_load
 from gearcheck.shared.errors import SolverError
@@ -39,37 +38,37 @@ def parametric_problem(model: LumpedModel, mesh_grid: int = 4096, eccentric_grid
     sets of each eccentric sample are recorded in, or taken from where it holds them (a derivative by
     differences of two problems is one at a fixed contact pattern)."""
     _check_linear(model)
-    cycloids = [e for e in model.turning if isinstance(e, CycloidRows)]
+    turning = model.turning  # every one on a clock (_check_linear)
     exc = model.excitation
     varies = exc.max_stiffness > exc.mean_stiffness * (1 + 1e-12)
     groups = _mesh_groups(exc.frequency, varies)
     clocks = [("mesh", 2 * math.pi * exc.frequency[g[0]], g) for g in groups]
-    if cycloids:
-        if len({round(e.omega_eccentric, 9) for e in cycloids}) > 1:
-            raise SolverError(f"{model.spec.name}: cycloid stages with different crank speeds need more than two "
-                              "clocks; use time marching")
-        clocks.append(("eccentric", abs(cycloids[0].omega_eccentric), None))
+    if turning:
+        if len({round(e.clock_speed, 9) for e in turning}) > 1:
+            raise SolverError(f"{model.spec.name}: {', '.join(dict.fromkeys(e.words for e in turning))} on clocks of "
+                              "different speeds need more than two clocks; use time marching")
+        clocks.append(("turning", turning[0].clock_speed, None))
     if not clocks or len(clocks) > 2:
         raise SolverError(f"{model.spec.name}: the harmonic methods take one or two clocks, this train has "
-                          f"{len(clocks)} (mesh groups {len(groups)}, cycloid stages {len(cycloids)}); use time "
+                          f"{len(clocks)} (mesh groups {len(groups)}, turning elements {len(turning)}); use time "
                           "marching")
-    owned = {name for e in cycloids for name in e.rows}
+    owned = {name for e in turning for name in e.rows}
     base = replace(model, rows=[r for r in model.rows if r.name not in owned])
     K_const = base.K_b + model.K_frame + model.K_mesh(np.where(varies, 0.0, exc.mean_stiffness))
     contacts = {} if contacts is None else contacts
-    parts = [_mesh_part(model, omega, group) if kind == "mesh" else _cycloid_part(model, cycloids, omega, contacts)
+    parts = [_mesh_part(model, omega, group) if kind == "mesh" else _turning_part(model, omega, contacts)
              for kind, omega, group in clocks]  # each angle -> (K, C) of its rows
-    F = mean_load(model) - sum((e.static_load for e in cycloids), np.zeros(model.n))
+    F = mean_load(model) - sum((e.static_load for e in turning), np.zeros(model.n))
     orbit = None
-    if cycloids:
+    if turning:
         omega = clocks[-1][1]
-        orbit = lambda theta: sum(e.orbit_force(theta[-1] / omega) for e in cycloids)  # noqa: E731
+        orbit = lambda theta: sum(e.orbit_force(theta[-1] / omega) for e in turning)  # noqa: E731
     return ParametricProblem(model.M, base.C + model.G,
                              lambda theta: K_const + sum(p(a)[0] for p, a in zip(parts, theta)),
                              tuple(omega for _, omega, _ in clocks), F,
                              grid=tuple(mesh_grid if kind == "mesh" else eccentric_grid for kind, _, _ in clocks),
                              separable=True, alias=alias,
-                             C_of=(lambda theta: sum(p(a)[1] for p, a in zip(parts, theta))) if cycloids else None,
+                             C_of=(lambda theta: sum(p(a)[1] for p, a in zip(parts, theta))) if turning else None,
                              F_of=orbit)
 
 
@@ -84,8 +83,7 @@ def _check_linear(model: LumpedModel) -> None:
         reasons.append("transmission error")
     if spec.operating.ripple or spec.operating.torque_function or spec.operating.torque_profile:
         reasons.append("a torque that varies")
-    if any(not isinstance(e, CycloidRows) for e in model.turning):
-        reasons.append("a radial coupling between frames that turn apart")
+    reasons.extend(dict.fromkeys(e.words for e in model.turning if e.clock_speed is None))
     reasons.extend(dict.fromkeys(zone for part in spec.parts for zone in part.dead_zones()))  # each named once
     if reasons:
         raise SolverError(f"{spec.name}: the harmonic methods solve a linear problem with constant load; this train "
@@ -119,9 +117,9 @@ def _mesh_part(model: LumpedModel, omega: float, group: list[int]):
     return part
 
 
-def _cycloid_part(model: LumpedModel, cycloids, omega: float, contacts: dict):
-    """(K, C) of the cycloid stages' rows (needle bearings, pins of the static contact set, or of ``contacts``)
-    at the eccentric angle: the rows turn with the eccentrics, their damping with them."""
+def _turning_part(model: LumpedModel, omega: float, contacts: dict):
+    """(K, C) of the turning elements' rows (a cycloid stage's needle bearings and pins, of the static contact set
+    or of ``contacts``) at their clock's angle: the rows turn with it, their damping with them."""
     cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
 
     def part(theta: float) -> tuple[np.ndarray, np.ndarray]:
@@ -129,7 +127,7 @@ def _cycloid_part(model: LumpedModel, cycloids, omega: float, contacts: dict):
         if key not in cache:
             frozen = frozen_at(model, theta / omega, contacts.get(key))
             contacts.setdefault(key, contact_sets(frozen))
-            names = {name for e in frozen.turning if isinstance(e, CycloidRows) for name in e.rows}
+            names = {name for e in frozen.turning for name in e.rows}
             rows = [r for r in frozen.rows if r.name in names]
             cache[key] = tuple(sum((getattr(r, attr) * np.outer(r.a, r.a) for r in rows), np.zeros((model.n,) * 2))
                                for attr in ("stiffness", "damping"))

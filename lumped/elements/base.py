@@ -98,6 +98,18 @@ class Turning:
     has_contacts: ClassVar[bool] = False  # rows that touch or not (their set is solved with the static state)
     smooth: ClassVar[bool] = True  # its forces are linear in the state (no contact switching)
     compiled: ClassVar[str | None] = None  # the group of the compiled steps that evaluates it (None: none)
+    words: ClassVar[str] = "rows that turn with time"  # what it is, in a sentence that refuses it
+
+    @property
+    def clock_speed(self) -> float | None:
+        """The speed (rad/s) of the one clock its rows turn with, for the harmonic methods
+        (:mod:`gearcheck.lumped.forced_response`), which then also take its :meth:`orbit_force` and its
+        ``static_load``; None: they cannot take it."""
+        return None
+
+    def orbit_force(self, t) -> np.ndarray:
+        """Its load that turns with its clock at time ``t``, beyond the static load the model holds."""
+        raise NotImplementedError
 
     def forces(self, t, q, v) -> np.ndarray:
         """Generalized forces (time along axis 0 allowed) of its rows at times ``t``."""

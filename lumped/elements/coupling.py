@@ -52,6 +52,7 @@ class TurningCoupling(Turning):
     damping: float
     rows: tuple[str, str]  # names of its t = 0 rows
     compiled = "couplings"
+    words = "a radial coupling between frames that turn apart"
 
     def forces(self, t, q, v) -> np.ndarray:
         """Generalized forces (time along axis 0 allowed) of the spring-damper between the two centres,

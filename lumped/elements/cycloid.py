@@ -67,6 +67,7 @@ class CycloidRows(Turning):
     has_contacts = True
     smooth = False
     compiled = "discs"
+    words = "a cycloid-pin stage"
 
     stage: str
     n: int  # coordinates of the model
@@ -89,6 +90,11 @@ class CycloidRows(Turning):
     rows: tuple[str, ...] = ()  # names of its rows in the model, those of time placed_at (forces() in time)
     placed_at: float = 0.0
     gap_load: np.ndarray | None = None  # (n,) sum of k gap a over the pins touching at placed_at
+
+    @property
+    def clock_speed(self) -> float:
+        """Its rows turn with the eccentrics in the carrier: |w_H - Omega|."""
+        return abs(self.omega_eccentric)
 
     @property
     def static_load(self) -> np.ndarray:

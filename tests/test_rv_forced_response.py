@@ -11,7 +11,7 @@ from gearcheck.lumped.forced_response import parametric_problem
 from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
 from gearcheck.train.loader import preset_text
 from gearcheck.lumped.static import static_solution
-from gearcheck.train.variants import edited
+from gearcheck.train.variants import chained, edited
 from gearcheck.shared.errors import SolverError
 
 TEXT = preset_text("rv-reducer")
@@ -111,3 +111,13 @@ def test_trains_the_harmonic_methods_cannot_hold_are_refused(train, edit, reason
     each."""
     with pytest.raises(SolverError, match=reason):
         parametric_problem(build_model(edited(train, [edit])))
+
+
+def test_rows_that_turn_off_any_clock_are_refused_by_what_they_say():
+    """A radial spline between two carriers that turn apart gives no clock the harmonic methods can sample (its
+    ``clock_speed`` is None): refused in the words the element gives of itself, not by its type."""
+    model = build_model(chained(2, radial_stiffness=1e8))
+    (coupling,) = model.turning
+    assert coupling.clock_speed is None
+    with pytest.raises(SolverError, match="a radial coupling between frames that turn apart: use time marching"):
+        parametric_problem(model)

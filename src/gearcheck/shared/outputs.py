@@ -11,7 +11,8 @@
 * on a clean exit the temporary folder replaces ``out``; on an error or an interruption it is removed,
   with any parents it made, and ``out`` stays as it was: the previous complete output, or nothing.
   Ctrl-C and SIGTERM wait while the folders are made, swapped or removed (a few milliseconds), so
-  neither can leave an unrecorded or half-removed folder behind; they take effect right after.
+  neither can leave an unrecorded or half-removed folder behind; they take effect right after.  One that comes
+  as the run leaves, before they are held, ends it as an interrupted run: the previous output stays.
 
 :func:`write_file` does the same for one file.
 """
@@ -114,8 +115,15 @@ class OutputDirectory:
         return self._tmp
 
     def __exit__(self, kind, error, trace) -> None:
-        with _signals_deferred():
-            self._finish(kind)
+        try:
+            with _signals_deferred():
+                self._finish(kind)
+        except BaseException:
+            if self._lock.closed:  # finished (or failed while finishing): the error stands as it is
+                raise
+            with _signals_deferred():  # interrupted on the way in, before the signals were held: as interrupted
+                self._finish(KeyboardInterrupt)
+            raise
 
     def _finish(self, kind) -> None:
         try:
@@ -148,17 +156,31 @@ class OutputDirectory:
 
 @contextlib.contextmanager
 def _signals_deferred():
-    """Hold SIGINT and SIGTERM back (delivered on leaving) where the process can block signals."""
-    held = {signal.SIGINT, signal.SIGTERM}
+    """Hold SIGINT and SIGTERM back, delivered on leaving: meanwhile their handlers only note them, so neither a
+    new one nor one that arrived just before but was not yet handled can break in (signals are the main
+    thread's: elsewhere nothing is held).  Installing a handler first runs any pending one, so an interruption can
+    still come on the way in, before anything here is done."""
+    noted = []
+    previous = {}
     try:
-        before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    except (AttributeError, ValueError):  # no POSIX signal masks here, or not the main thread
-        yield
-        return
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            previous[signum] = signal.signal(signum, lambda number, frame: noted.append(number))
+    except ValueError:  # not the main thread
+        pass
+    except BaseException:
+        _restore(previous)
+        raise
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+        _restore(previous)
+        for signum in dict.fromkeys(noted):
+            signal.raise_signal(signum)
+
+
+def _restore(handlers: dict) -> None:
+    for signum, handler in handlers.items():
+        signal.signal(signum, signal.SIG_DFL if handler is None else handler)
 
 
 def write_file(path, data: bytes | str, what: str = "-o") -> None:

@@ -251,8 +251,10 @@ class Outputs(NamedTuple):
 
 # ---------------------------------------------------------------------------------------------- the kernel
 @numba.njit(cache=True)
-def _refresh(qpos, wrap_prm, wraps, base, carrier_qadr, coef):
-    """The world-frame slide coefficients turned to the carriers' angles (``MbdModel.refresh``)."""
+def _refresh(qpos, wrap_prm, coefficients, coef):
+    """The world-frame slide coefficients (:class:`TurningCoefficients`) turned to the carriers' angles
+    (``MbdModel.refresh``)."""
+    wraps, base, carrier_qadr = coefficients.wraps, coefficients.base, coefficients.carrier_qadr
     for w in range(wraps.size):
         phi = qpos[carrier_qadr[w]]
         coef[w] = base[w, 0] * math.cos(phi) + base[w, 1] * math.sin(phi)
@@ -365,7 +367,7 @@ def _drive_stage(s, r, drive, kinematics, com_pos, jac, pointers, model, data, t
     at stage time ``s``."""
     if flags.pin_contacts:
         refresh_pins(kinematics, com_pos, jac, pointers.model, pointers.data, model, data, cycloid)
-    _refresh(data.qpos, model.wrap_prm, *turning.coefficients[:3], work.coef)
+    _refresh(data.qpos, model.wrap_prm, turning.coefficients, work.coef)
     _set_stage(drive.k[r, s], drive.u[r, s], drive.e[r, s], drive.de[r, s], drive.pairs[r, s],
                flags.transmission_error, flags.tooth_pairs, model, data, turning, contacts, work)
 
@@ -434,7 +436,7 @@ def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive
     ``span``.  A mesh's rate includes what its coefficients' turning adds (:func:`_turning_rates`)."""
     qpos, qvel, wrap_prm = data.qpos, data.qvel, model.wrap_prm
     tendons, wraps, qadr, dofs, starts, relieved, half, _ = switches
-    _refresh(qpos, wrap_prm, *turning.coefficients[:3], work.coef)
+    _refresh(qpos, wrap_prm, turning.coefficients, work.coef)
     _turning_rates(qpos, qvel, turning, work.coef, work.turning_rate)
     n = 0
     for i in range(tendons.size):

@@ -40,7 +40,8 @@ from pathlib import Path
 import numpy as np
 
 from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
-from gearcheck.shared.errors import TrainFileError
+from gearcheck.shared.errors import TrainFileError, shown
+from gearcheck.train.files import read_arrays
 
 SUFFIXES = (".mat", ".npz")
 KNOWN = {"coordinates", "M", "K", "C", "G", "K_omega", "F", "period", "K_samples", "K_cos", "K_sin", "orders",
@@ -54,9 +55,7 @@ def read_matrix_file(path) -> LinearModel:
     source = path.name
     if path.suffix not in SUFFIXES:
         raise TrainFileError(source, "", f"a model file is {' or '.join(SUFFIXES)}, not {path.suffix or 'no suffix'!r}")
-    if not path.is_file():
-        raise TrainFileError(source, "", f"no such file ({path})")
-    data = _load(path, source)
+    data = read_arrays(path, "model file", squeeze_me=True, chars_as_strings=True)
     matlab = path.suffix == ".mat"
     unknown = sorted(set(data) - KNOWN)
     if unknown:
@@ -64,7 +63,7 @@ def read_matrix_file(path) -> LinearModel:
     get = _Reader(source, data, matlab)
     units = get.string("units", "SI")
     if units != "SI":
-        raise TrainFileError(source, "units", f"{units!r}: give every matrix in SI units (kg, m, rad, N, s)")
+        raise TrainFileError(source, "units", f"{shown(units)}: give every matrix in SI units (kg, m, rad, N, s)")
     coordinates = get.strings("coordinates", required=True)
     n = len(coordinates)
     period = get.scalar("period") if any(k in data for k in ("K_samples", "K_cos", "K_sin", "F_samples")) or (
@@ -93,21 +92,6 @@ def read_matrix_file(path) -> LinearModel:
                        start=get.string("start", "static"), source=source)
 
 
-def _load(path: Path, source: str) -> dict:
-    try:
-        if path.suffix == ".npz":
-            with np.load(path, allow_pickle=False) as npz:
-                return {k: npz[k] for k in npz.files}
-        import scipy.io
-
-        return {k: v for k, v in scipy.io.loadmat(path, squeeze_me=True, chars_as_strings=True).items()
-                if not k.startswith("__")}
-    except NotImplementedError:  # MATLAB v7.3 files are HDF5
-        raise TrainFileError(source, "", "a MATLAB v7.3 (HDF5) file: save it with save(..., '-v7')") from None
-    except Exception as exc:  # the readers raise many kinds on a damaged file
-        raise TrainFileError(source, "", f"cannot be read as {path.suffix}: {str(exc).splitlines()[0]}") from None
-
-
 class _Reader:
     """Typed access to the file's variables, each failure one line naming the variable."""
 
@@ -122,6 +106,8 @@ class _Reader:
             if required:
                 raise self.fail(name, "missing")
             return None
+        if np.iscomplexobj(self.data[name]):
+            raise self.fail(name, "holds complex numbers; a model's matrices are real")
         try:
             return np.atleast_1d(np.asarray(self.data[name], dtype=float))
         except (TypeError, ValueError):
@@ -130,7 +116,7 @@ class _Reader:
     def scalar(self, name: str) -> float:
         value = self.array(name, required=True)
         if value.size != 1 or not np.isfinite(value[0]) or value[0] <= 0:
-            raise self.fail(name, f"{self.data[name]!r}: needs one positive number (s)")
+            raise self.fail(name, f"{shown(self.data[name])}: needs one positive number (s)")
         return float(value[0])
 
     def stack(self, name: str, shape: tuple, count: int | None = None) -> np.ndarray:
@@ -162,7 +148,7 @@ class _Reader:
             return default
         value = np.asarray(self.data[name], dtype=object).ravel()
         if value.size != 1 or not isinstance(value[0], str):
-            raise self.fail(name, f"{self.data[name]!r}: needs one string")
+            raise self.fail(name, f"{shown(self.data[name])}: needs one string")
         return value[0].strip()
 
 
@@ -179,14 +165,14 @@ def _meshes(get: _Reader, source: str, n: int, period: float | None) -> list[Mes
         raise TrainFileError(source, "mesh_rows", f"shape {np.shape(get.data['mesh_rows'])}, expected ({m}, {n})")
     rows = rows.reshape(m, n)
     k = get.array("mesh_stiffness", required=True)
-    k = k.reshape(m, -1) if k.size % m == 0 else None
+    k = k.reshape(m, -1) if k.size % m == 0 and k.size > 0 else None
     if k is None:
         raise TrainFileError(source, "mesh_stiffness", f"shape {np.shape(get.data['mesh_stiffness'])}, expected "
                              f"({m},) or ({m}, N)")
     c = get.array("mesh_damping")
-    c = np.zeros(m) if c is None else c
+    c = np.zeros(m) if c is None else c.reshape(-1)
     periods = get.array("mesh_period")
-    periods = np.full(m, period if period is not None else np.nan) if periods is None else periods
+    periods = np.full(m, period if period is not None else np.nan) if periods is None else periods.reshape(-1)
     for name, values in (("mesh_damping", c), ("mesh_period", periods)):
         if values.size != m:
             raise TrainFileError(source, name, f"{values.size} values for {m} meshes")

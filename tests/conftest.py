@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -10,6 +11,8 @@ from types import SimpleNamespace
 import pytest
 
 from gearcheck.train.loader import preset_names
+
+os.environ.setdefault("GEARCHECK_DEBUG", "1")  # a fault of gearcheck's own raises in a test, with its traceback
 
 
 @pytest.fixture(params=preset_names())

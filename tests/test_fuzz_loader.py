@@ -29,7 +29,8 @@ def paths(node, prefix=()):
 
 VALUES = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True), st.integers(min_value=-10**30, max_value=10**30),
-    st.sampled_from([0, -1, 1, 1e300, -1e300, 1e-300, 2**63, 0.5, 1e9, True, False, "", "x" * 300, "stage1.sun"]),
+    st.sampled_from([0, -1, 1, 1e300, -1e300, 1e-300, 5e-324, 2**63, 10**400, -10**400, 0.5, 1e9, True, False, "",
+                     "x" * 300, "stage1.sun"]),
     st.text(max_size=20), st.lists(st.floats(allow_nan=False), max_size=3), st.just({}), st.just([]),
     st.dictionaries(st.sampled_from(["model", "mean", "ratio", "x"]), st.floats(allow_nan=False), max_size=2),
 )

@@ -183,13 +183,13 @@ def garbage(tmp, name, read):
 
 
 BAD = [
-    pytest.param(lambda tmp: read_time_series(tmp / "nope.csv", SPEC, GOOD_MAP), ["nope.csv", "no such file"],
+    pytest.param(lambda tmp: read_time_series(tmp / "nope.csv", SPEC, GOOD_MAP), ["nope.csv", "no such data file"],
                  id="missing-file"),
     pytest.param(lambda tmp: series(tmp, "sim.xlsx"), ["sim.xlsx", "'.xlsx'", ".csv, .parquet, .mat"], id="suffix"),
     pytest.param(lambda tmp: garbage(tmp, "sim.parquet", lambda p: read_time_series(p, SPEC, GOOD_MAP)),
-                 ["sim.parquet", "cannot read it as .parquet"], id="unreadable-parquet"),
+                 ["sim.parquet", "cannot be read as .parquet"], id="unreadable-parquet"),
     pytest.param(lambda tmp: garbage(tmp, "sim.mat", lambda p: read_time_series(p, SPEC, GOOD_MAP)),
-                 ["sim.mat", "cannot read it as .mat"], id="unreadable-mat"),
+                 ["sim.mat", "cannot be read as .mat"], id="unreadable-mat"),
     pytest.param(lambda tmp: series(tmp, columns={**GOOD_MAP, "time": "time"}),
                  ["sim.csv", "column 'time'", "not in the file", "'ay'"], id="no-time-column"),
     pytest.param(lambda tmp: with_map(tmp, '[signals]\n"stage1.sun-planet1.force" = "ay"\n'),

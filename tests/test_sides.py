@@ -184,7 +184,7 @@ STUDIES = [  # a library call of a study, the same request on the command line, 
      "parameters=stages[0].crank.nothing: no such field", "--parameter stages[0].crank.nothing: no such field"),
     (lambda tmp: gearcheck.sensitivity("demo-3p", "stages[0].sun.mass", orders=(3, 2)),
      ["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--orders", "3", "2"],
-     "orders=(3, 2): give 1 non-negative number", "--orders (3, 2): give 1 non-negative number"),
+     "orders=(3, 2): give 1 whole non-negative number", "--orders (3, 2): give 1 whole non-negative number"),
 ]
 
 

@@ -166,7 +166,7 @@ def bad_files(tmp):
         (edit("mesh-rows", mesh_rows=np.zeros((6, 3))), "mesh_rows: shape (6, 3), expected (6, 18)"),
         (tmp / "broken.mat", "broken.mat: cannot be read as .mat"),
         (tmp / "model.txt", "a model file is .mat or .npz, not '.txt'"),
-        (tmp / "absent.npz", "absent.npz: no such file"),
+        (tmp / "absent.npz", "absent.npz: no such model file"),
     ]
 
 

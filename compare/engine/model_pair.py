@@ -143,7 +143,7 @@ def resolve_model(spec, model="general", against: str = "lumped", results=None, 
     if named == USER:
         if spec.user_model is None:
             raise GearcheckError(f"model=user: {spec.name} registers no user_model (train.user_model in its file)")
-        return UserPair(*with_lumped(user_side(spec.user_model, spec)))
+        return UserPair(*with_lumped(user_side(spec.user_model, spec, from_file=True)))
     if named is not None and ":" not in named and Path(named).suffix not in SUFFIXES:
         if Path(named).suffix:
             raise GearcheckError(f"model={named}: a model file is {' or '.join(SUFFIXES)}, "

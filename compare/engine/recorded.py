@@ -34,21 +34,19 @@ field or column and the value.
 
 from __future__ import annotations
 
+import io
 import math
-import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import scipy.io
-from scipy.io.matlab import MatReadError
 
 from gearcheck.lumped.assembly import build_model
-from gearcheck.train.files import read_toml
+from gearcheck.train.files import MAX_DATA_BYTES, read_arrays, read_bytes, read_toml
 from gearcheck.lumped.modal import central_coordinates
-from gearcheck.shared.errors import GearcheckError, TrainFileError, UnsupportedError, did_you_mean
+from gearcheck.shared.errors import GearcheckError, TrainFileError, UnsupportedError, did_you_mean, shown
 from gearcheck.shared.modal import ModalResult, energy_fractions, mode_types, multiplicities, rigid_or_elastic
 from gearcheck.shared.results import TimeResult, train_signals
 from gearcheck.shared.settings import RunSettings
@@ -111,7 +109,7 @@ def column_map(doc: Mapping, source: str = "column map") -> ColumnMap:
         raise TrainFileError(source, "time_unit", f"{time_unit!r} is not a time unit: use s or ms")
     entries = doc.get("signals")
     if not isinstance(entries, Mapping):
-        raise TrainFileError(source, "signals", f"a table of signal = column, got {_show(entries)}")
+        raise TrainFileError(source, "signals", f"a table of signal = column, got {shown(entries)}")
     if not entries:
         raise TrainFileError(source, "signals", "maps no signal")
     return ColumnMap({str(name): _column(entry, source, _key(name)) for name, entry in entries.items()},
@@ -122,7 +120,7 @@ def _column(entry, source: str, where: str) -> Column:
     if isinstance(entry, str):
         return Column(_name(entry, source, where))
     if not isinstance(entry, Mapping):
-        raise TrainFileError(source, where, f"a column name or a table {{column, scale, unit}}, got {_show(entry)}")
+        raise TrainFileError(source, where, f"a column name or a table {{column, scale, unit}}, got {shown(entry)}")
     unknown = sorted(set(entry) - {"column", "scale", "unit"})
     if unknown:
         raise TrainFileError(source, f"{where}.{unknown[0]}", "unknown key (known: column, scale, unit)")
@@ -130,16 +128,16 @@ def _column(entry, source: str, where: str) -> Column:
         raise TrainFileError(source, where, "names no column")
     scale = entry.get("scale", 1.0)
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not math.isfinite(scale) or scale == 0:
-        raise TrainFileError(source, f"{where}.scale", f"a finite non-zero number, got {_show(scale)}")
+        raise TrainFileError(source, f"{where}.scale", f"a finite non-zero number, got {shown(scale)}")
     unit = entry.get("unit")
     if unit is not None and not isinstance(unit, str):
-        raise TrainFileError(source, f"{where}.unit", f"a unit name, got {_show(unit)}")
+        raise TrainFileError(source, f"{where}.unit", f"a unit name, got {shown(unit)}")
     return Column(_name(entry["column"], source, f"{where}.column"), float(scale), unit)
 
 
 def _name(value, source: str, where: str) -> str:
     if not isinstance(value, str) or not value.strip():
-        raise TrainFileError(source, where, f"a column name, got {_show(value)}")
+        raise TrainFileError(source, where, f"a column name, got {shown(value)}")
     return value
 
 
@@ -274,7 +272,7 @@ def _labels(raw, source: str, known: list[str]) -> list[str]:
         if isinstance(item, np.ndarray):  # a MATLAB cell holds char arrays
             item = item.ravel()[0] if item.size == 1 else item
         if not isinstance(item, str):
-            raise TrainFileError(source, _field(source, "coordinates"), f"holds {_show(item)}, not a coordinate name")
+            raise TrainFileError(source, _field(source, "coordinates"), f"holds {shown(item)}, not a coordinate name")
         label = item.strip()
         if label not in known:
             raise TrainFileError(source, _field(source, "coordinates"), f"{label!r} is not a coordinate of the train"
@@ -323,34 +321,16 @@ def _read_table(path: Path, suffixes: tuple[str, ...]) -> dict:
     if suffix not in suffixes:
         raise TrainFileError(source, "", f"unknown file type {path.suffix or '(no suffix)'!r}: use "
                              f"{', '.join(suffixes)}")
-    if path.is_dir():
-        raise TrainFileError(source, "", "is a directory, not a data file")
-    if not path.is_file():
-        raise TrainFileError(source, "", "no such file")
-    if suffix == ".npz" and not zipfile.is_zipfile(path):
-        raise TrainFileError(source, "", "not an .npz archive")
+    if suffix in (".mat", ".npz"):
+        return read_arrays(path, "data file")
+    stream = io.BytesIO(read_bytes(path, "data file", MAX_DATA_BYTES))
     try:
-        if suffix == ".mat":
-            return {k: v for k, v in scipy.io.loadmat(path).items() if not k.startswith("__")}
-        if suffix == ".npz":
-            with np.load(path, allow_pickle=False) as archive:
-                return {k: _npz_entry(archive, k, source) for k in archive.files}
-        frame = pd.read_csv(path, skipinitialspace=True) if suffix == ".csv" else pd.read_parquet(path)
-    except GearcheckError:
-        raise
+        frame = pd.read_csv(stream, skipinitialspace=True) if suffix == ".csv" else pd.read_parquet(stream)
     except ImportError as exc:
         raise TrainFileError(source, "", f"cannot read {suffix} files: {_one_line(exc)}") from None
-    except (OSError, ValueError, NotImplementedError, MatReadError, zipfile.BadZipFile) as exc:
-        raise TrainFileError(source, "", f"cannot read it as {suffix}: {_one_line(exc)}") from None
+    except Exception as exc:  # pandas and pyarrow raise many kinds on a damaged file
+        raise TrainFileError(source, "", f"cannot be read as {suffix}: {_one_line(exc)}") from None
     return {str(c): frame[c].to_numpy() for c in frame.columns}
-
-
-def _npz_entry(archive, key: str, source: str) -> np.ndarray:
-    try:
-        return archive[key]
-    except ValueError:
-        raise TrainFileError(source, _field(source, key), "saved as Python objects: save names as a string array "
-                             "(np.array(names, dtype=str)) and numbers as numeric arrays") from None
 
 
 def _vector(data: dict, name: str, source: str, what: str) -> np.ndarray:
@@ -363,7 +343,7 @@ def _vector(data: dict, name: str, source: str, what: str) -> np.ndarray:
     if x.ndim > 1 and sorted(x.shape)[:-1] != [1] * (x.ndim - 1):
         raise TrainFileError(source, where, f"is a {'x'.join(map(str, x.shape))} array, not a vector")
     if x.dtype.kind in "US":
-        raise TrainFileError(source, where, f"holds text {_show(str(x.ravel()[0]) if x.size else '')}, not numbers")
+        raise TrainFileError(source, where, f"holds text {shown(str(x.ravel()[0]) if x.size else '')}, not numbers")
     if x.dtype.kind in "cV":
         raise TrainFileError(source, where, f"holds {x.dtype} values, not real numbers")
     return x.ravel()
@@ -375,7 +355,7 @@ def _finite(x: np.ndarray, source: str, field: str, item: str = "row") -> np.nda
     bad = ~np.isfinite(values)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise TrainFileError(source, field, f"{item} {i + 1} holds {_show(x[i])}, not a finite number")
+        raise TrainFileError(source, field, f"{item} {i + 1} holds {shown(x[i])}, not a finite number")
     return values
 
 
@@ -394,11 +374,6 @@ def _field(source: str, name: str) -> str:
 
 def _key(name) -> str:
     return f'signals."{name}"'
-
-
-def _show(value) -> str:
-    text = repr(value.item() if isinstance(value, np.generic) else value)
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _one_line(exc: BaseException) -> str:

@@ -32,6 +32,7 @@ from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.settings import MAX_STEPS
 
 MODE_SIZE = 0.05  # a mode shape's largest point displacement, as a fraction of the model's extent
 TRACE = (0.66, 0.76, 0.32, 0.2)  # mesh-force trace box: left, top, width, height (fractions of the frame)
@@ -195,10 +196,30 @@ def _write(path: Path, frames: list[Image.Image], fps: float) -> Path:
     return path
 
 
-def _frames(duration: float, fps: float) -> int:
-    if not (duration > 0 and fps > 0 and math.isfinite(duration * fps)):
-        raise GearcheckError(f"duration and fps must be positive, got {duration!r} and {fps!r}")
-    return max(1, round(duration * fps))
+MAX_FPS = 120.0  # beyond any display's refresh
+MAX_FRAMES = 1800  # two minutes at 15 fps: some 1 GB of 480 x 360 frames, all held until they are written
+MAX_SIDE = 4096  # pixels: a 4K frame
+
+
+def _frames(duration: float, fps: float, width: int, height: int) -> int:
+    """The frame count of a ``duration`` s animation at ``fps`` of ``width`` x ``height`` pixels, each bounded."""
+    if not (0 < duration < math.inf and 0 < fps <= MAX_FPS):
+        raise GearcheckError(f"duration={duration!r}, fps={fps!r}: a positive playback length and a frame rate "
+                             f"from 0 to {MAX_FPS:g} per second")
+    for name, side in (("width", width), ("height", height)):
+        if isinstance(side, bool) or not isinstance(side, (int, np.integer)) or not 16 <= side <= MAX_SIDE:
+            raise GearcheckError(f"{name}={side!r}: a whole number of pixels from 16 to {MAX_SIDE}")
+    n = max(1, round(duration * fps))
+    if n > MAX_FRAMES:
+        raise GearcheckError(f"duration={duration:g} s at fps={fps:g} is {n} frames, more than the {MAX_FRAMES} an "
+                             "animation holds in memory: shorten it or lower the frame rate")
+    return n
+
+
+def _factor(name: str, value: float) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1e12:
+        raise GearcheckError(f"{name}={value!r}: a positive factor below 1e12")
+    return float(value)
 
 
 def animate(train, path, duration: float = 4.0, fps: float = 15.0, magnify: float = 1000.0,
@@ -211,12 +232,16 @@ def animate(train, path, duration: float = 4.0, fps: float = 15.0, magnify: floa
     steps); magnify: the joints' displacement from the rigid-body motion times this; mesh: which entry of
     ``spec.meshes`` the force overlay shows; progress: callable(fraction).  Returns the path written."""
     path = check_output(path)
-    n = _frames(duration, fps)
+    n = _frames(duration, fps, width, height)
+    slow_motion, magnify = _factor("slow_motion", slow_motion), _factor("magnify", magnify)
     mb = _twin(train)
-    rend = renderer(mb.model, width, height)
     if not 0 <= mesh < len(mb.spec.meshes):
         raise GearcheckError(f"mesh must be 0..{len(mb.spec.meshes) - 1}, got {mesh}")
     every = max(1, round(1.0 / (fps * slow_motion * mb.default_step)))
+    if n * every > MAX_STEPS:
+        raise GearcheckError(f"slow_motion={slow_motion:g}: {n} frames of {every} steps each is {n * every:.3g} "
+                             f"steps, more than the {MAX_STEPS:.0e} gearcheck runs in one go: raise it")
+    rend = renderer(mb.model, width, height)
     with stepping_model(mb, mb.default_step):
         player = TwinPlayer(mb, n)
         for i in range(n):
@@ -296,9 +321,8 @@ def animate_mode(train, path, mode: int, solver: str = "mujoco", modal: ModalRes
     ModalResult (mbd_models does not compute lumped modes); for "mujoco" it is optional (the twin's own).
     Returns the path written."""
     path = check_output(path)
-    n = _frames(duration, fps)
-    if not period > 0:
-        raise GearcheckError(f"period must be positive, got {period!r}")
+    n = _frames(duration, fps, width, height)
+    period = _factor("period", period)
     mb = _twin(train)
     shape, freq, kind = mode_shape(mb, mode, solver, modal)
     amplitude = _shape_scale(mb, shape)

@@ -1,17 +1,23 @@
-"""Writing a calibration: the calibrated train file, calibration.json and calibration.md."""
+"""Writing a calibration: the calibrated train file (with the files it names), calibration.json and
+calibration.md."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
+from gearcheck.train.files import read_bytes
+
 
 def write_calibration(result, name: str, out: Path, final: Path | None = None) -> list[str]:
-    """Write the files into the folder ``out``, which will be ``final`` (the calibrated train file's
-    references are written relative to it; default ``out``); return the lines printed on the console."""
+    """Write the files into the folder ``out``, which will be ``final`` (named in the lines; default ``out``): the
+    calibrated train file with copies of the files it names, the calibration; return the lines printed on the
+    console."""
     final = out if final is None else final
     train = out / f"{name}-calibrated.toml"
-    train.write_text(result.text(final), encoding="utf-8")
+    train.write_text(result.text(), encoding="utf-8")
+    for copy_name, original in result.files().items():
+        (out / copy_name).write_bytes(read_bytes(original, "file the train file names"))
     rows = result.rows()
     data = {
         "schema": "gearcheck.calibration", "schema_version": 1, "train": name, "runs": result.evaluations,

@@ -49,7 +49,7 @@ from statistics import median
 
 import pandas as pd
 
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, shown
 
 SCHEMA = "gearcheck.history"
 SCHEMA_VERSION = 1
@@ -79,6 +79,21 @@ CREATE TABLE metrics (
     PRIMARY KEY (commit_id, train, item, metric),
     FOREIGN KEY (commit_id, train) REFERENCES runs(commit_id, train)) WITHOUT ROWID;
 """
+
+
+def _columns() -> dict[str, set[str]]:
+    """Each table's columns, as _TABLES makes them (read back from a store made in memory)."""
+    con = sqlite3.connect(":memory:")
+    try:
+        con.executescript(_TABLES)
+        tables = [row[0] for row in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")]
+        return {t: {row[1] for row in con.execute(f"PRAGMA table_info({t})")} for t in tables}
+    finally:
+        con.close()
+
+
+COLUMNS = _columns()
+MAX_COMMIT = 200  # characters of a commit id: a git hash is 40, a tag or build name a few dozen
 _ORDERED = "(SELECT commit_id, date, row_number() OVER (ORDER BY date, seq) - 1 AS place FROM commits)"
 _RUN_COLUMNS = ("verdict", "failures", "unresolved", "moved", "steady_state", "duration_s", "input_speed_rpm",
                 "gearcheck_version", "mujoco_version", "numpy_version", "python", "machine", "git_revision",
@@ -93,15 +108,25 @@ def check_store(store) -> None:
             pass
 
 
+def checked_commit(store, commit) -> str:
+    """``commit`` stripped, or GearcheckError unless it is one line of printable characters (checked before a run
+    that will record under it)."""
+    if not isinstance(commit, str) or not commit.strip():
+        raise GearcheckError(f"history store {store}: a commit id is required to record a run, got {shown(commit)}")
+    commit = commit.strip()
+    if len(commit) > MAX_COMMIT or not commit.isprintable():
+        raise GearcheckError(f"history store {store}: commit id {shown(commit)}: one line of at most {MAX_COMMIT} "
+                             "printable characters (a revision, tag or build name)")
+    return commit
+
+
 def append(store, data: dict, commit: str, date: str | None = None, machine: str | None = None) -> None:
     """Record the cross-check ``data`` (a report.json dict) of ``commit`` in the SQLite file ``store``
     (made if missing), in one transaction; a record of the same commit and train is replaced.
 
     ``date``: the commit's date, ISO 8601 (default: now; a commit already recorded keeps its date unless
     one is given); ``machine``: where it ran (default: the report's provenance)."""
-    if not isinstance(commit, str) or not commit.strip():
-        raise GearcheckError(f"history store {store}: a commit id is required to record a run, got {commit!r}")
-    commit = commit.strip()
+    commit = checked_commit(store, commit)
     kind = (data.get("schema"), data.get("schema_version")) if isinstance(data, dict) else type(data).__name__
     if kind != (REPORT_SCHEMA, REPORT_SCHEMA_VERSION):
         raise GearcheckError(f"history store {store}: records {REPORT_SCHEMA} version {REPORT_SCHEMA_VERSION} "
@@ -164,8 +189,22 @@ def runs(store) -> pd.DataFrame:
             f"{', '.join('r.' + c for c in _RUN_COLUMNS)} "
             f"FROM runs r JOIN {_ORDERED} c USING (commit_id) ORDER BY c.place, r.train", con)
     for column in ("failures", "unresolved", "moved"):
-        frame[column] = [json.loads(v) if v is not None else None for v in frame[column]]
+        frame[column] = [_json_list(v, store, column, commit) for v, commit in zip(frame[column], frame["commit"])]
     return frame
+
+
+def _json_list(text, store, column: str, commit: str) -> list | None:
+    """A recorded JSON list (None where none was recorded); GearcheckError naming the record otherwise."""
+    if text is None:
+        return None
+    try:
+        value = json.loads(text)
+    except (TypeError, ValueError):
+        value = None
+    if not isinstance(value, list):
+        raise GearcheckError(f"history store {store}: runs.{column} of commit {shown(commit)} is not a JSON list: "
+                             f"{shown(text)}")
+    return value
 
 
 def commits(store) -> list[str]:
@@ -288,7 +327,7 @@ def _connect(store, write: bool = False):
             con = sqlite3.connect(path.absolute().as_uri() + "?mode=ro", uri=True, timeout=30)
             _check(con, store)
         yield con
-    except sqlite3.Error as exc:
+    except (sqlite3.Error, pd.errors.DatabaseError) as exc:
         raise GearcheckError(f"history store {store}: cannot be {'written' if write else 'read'} ({exc})") from None
     finally:
         if con is not None:
@@ -304,3 +343,10 @@ def _check(con: sqlite3.Connection, store) -> None:
     if meta.get("schema") != SCHEMA or meta.get("schema_version") != str(SCHEMA_VERSION):
         raise GearcheckError(f"history store {store}: schema {meta.get('schema')} version "
                              f"{meta.get('schema_version')}, this gearcheck reads {SCHEMA} version {SCHEMA_VERSION}")
+    for table, columns in COLUMNS.items():  # each table with the columns this version reads
+        found = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
+        if not found:
+            raise GearcheckError(f"history store {store}: the table {table} is missing")
+        if columns - found:
+            raise GearcheckError(f"history store {store}: the table {table} lacks the column "
+                                 f"{sorted(columns - found)[0]}")

@@ -34,10 +34,12 @@ import numpy as np
 from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.diagnosis import KINDS
 from gearcheck.compare.presentation.html_page import page
+from gearcheck.train.files import read_text
 from gearcheck.train.json_schema import DRAFT
 from gearcheck.train.loader import preset_text
 from gearcheck.train.schema import MEASUREMENT
 from gearcheck.shared.citations import cite
+from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.side import display_name
 
 SCHEMA = "gearcheck.crosscheck"
@@ -90,8 +92,8 @@ def calibration(spec) -> dict | None:
     (the file's own parameters; also when the file can no longer be read as the run read it)."""
     name = spec.path.removeprefix("preset:")
     try:
-        text = preset_text(name) if spec.path.startswith("preset:") else Path(spec.path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        text = preset_text(name) if spec.path.startswith("preset:") else read_text(spec.path, "train file")
+    except (OSError, GearcheckError):
         return None
     if hashlib.sha256(text.encode("utf-8")).hexdigest() != spec.text_hash:
         return None

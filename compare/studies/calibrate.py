@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import re
 import tomllib
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import tomli_w
@@ -99,6 +99,9 @@ class FitParameter:
         node[self.keys[-1]] = value
 
 
+REFERENCES = (("train", "measurements_file"), ("train", "user_model"), ("operating", "torque_csv"))  # named files
+
+
 @dataclass
 class Calibration:
     names: list[str]
@@ -115,14 +118,26 @@ class Calibration:
     source: str  # where the original came from (its relative file references are resolved from there)
     header: str
 
-    def text(self, directory=None) -> str:
-        """The calibrated train file; file references rewritten relative to ``directory`` if given."""
+    def files(self) -> dict[str, Path]:
+        """The files the train file names (measurements, a user model, a torque table) by the names the calibrated
+        file gives them: their own names, beside it (:meth:`text`), so that the calibrated file is whole in its
+        folder (a train file names no file outside its folder unless the user allows it)."""
+        named = {}
+        for table, key in REFERENCES:
+            name = self.document.get(table, {}).get(key)
+            if name is not None and (":" not in name or name.rpartition(":")[0].endswith(".py")):
+                path = beside(self.source, name.rpartition(":")[0] if ":" in name else name)
+                named[path.name if path.name not in named else f"{key}-{path.name}"] = path
+        return named
+
+    def text(self) -> str:
+        """The calibrated train file, naming the files of :meth:`files` by their names there."""
         doc = copy.deepcopy(self.document)
-        if directory is not None:
-            for table, key in (("train", "measurements_file"), ("train", "user_model"), ("operating", "torque_csv")):
-                name = doc.get(table, {}).get(key)
-                if name is not None and ":" not in name:  # a file, not module:factory
-                    doc[table][key] = os.path.relpath(beside(self.source, name), directory)
+        given = iter(self.files())
+        for table, key in REFERENCES:
+            name = doc.get(table, {}).get(key)
+            if name is not None and (":" not in name or name.rpartition(":")[0].endswith(".py")):
+                doc[table][key] = next(given) + (":" + name.rpartition(":")[2] if ":" in name else "")
         return self.header + tomli_w.dumps(doc)
 
     def rows(self) -> list[dict]:

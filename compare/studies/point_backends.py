@@ -13,18 +13,48 @@ import contextlib
 import multiprocessing
 import os
 import re
+import select
 import signal
 import sys
+import threading
+import time
 
 from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.trust import GRANTS
 
 CONNECT_TIMEOUT = "10s"  # to a Dask scheduler
 
 
-def _worker_init() -> None:
-    """Workers leave Ctrl-C to the parent, which cancels the pending points and ends them."""
+def _worker_init(grants: dict[str, str | None], parent: int) -> None:
+    """Workers leave Ctrl-C to the parent, which cancels the pending points and ends them; they end as soon as the
+    parent does (killed outright, it cannot end them: a watch on its process does, and the fork server, whose
+    children they are, then ends too); they run with the parent's grants (:mod:`gearcheck.shared.trust`), whatever
+    the fork server's environment was when it started."""
+    threading.Thread(target=_end_with, args=(parent,), daemon=True, name="end with the parent").start()
+    for variable, value in grants.items():
+        if value is None:
+            os.environ.pop(variable, None)
+        else:
+            os.environ[variable] = value
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked since the fork server (_workers_starting)
+
+
+def _end_with(pid: int) -> None:
+    """End this process when the process ``pid`` ends: a wait on its pidfd (Linux), else a check every second."""
+    try:
+        fd = os.pidfd_open(pid)
+        select.select([fd], [], [])  # readable once it has ended
+    except (AttributeError, OSError):  # no pidfd here, or the parent is already gone
+        while True:
+            try:
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                break
+            except PermissionError:  # alive, another user's: cannot be ours
+                pass
+            time.sleep(1.0)
+    os._exit(1)
 
 
 def run_pool(run, pending, workers: int, finished) -> None:
@@ -35,7 +65,8 @@ def run_pool(run, pending, workers: int, finished) -> None:
 
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload([run.__module__])
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init)
+    grants = {variable: os.environ.get(variable) for variable in GRANTS}
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init, initargs=(grants, os.getpid()))
     _closed_pipes_raise()
     try:
         run_futures(pool, run, pending, finished, start=_workers_starting)

@@ -14,6 +14,8 @@ and its derivative follows from dQ_h by Eq. (13) without further approximation.
 
 from __future__ import annotations
 
+import math
+
 import tomllib
 from dataclasses import dataclass, replace
 
@@ -39,6 +41,7 @@ from gearcheck.shared.errors import GearcheckError, did_you_mean
 
 METHODS = ("harmonic balance", "Fourier series")
 ORDERS = (3, 2)  # harmonics kept per clock by default: the mesh's, then an RV reducer's eccentrics'
+MAX_UNKNOWNS = 20_000  # a dense complex system of 20 000 unknowns is 6.4 GB
 STEP = 1e-4  # relative: the matrices are linear in most numbers, so round-off (1e-12) rules, not the step
 CHECK_STEP = 3e-3  # relative, of the whole response's differences: its round-off is 1e-10 of |dQ_h| x step
 MAP_GRIDS = {"mesh_grid": 1024, "eccentric_grid": 512, "alias": 1e-2}  # a map's samples per clock: 1e-2 aliasing
@@ -130,10 +133,15 @@ def lattice(problem: ParametricProblem, orders) -> tuple[int, ...]:
     if orders is None:
         return ORDERS[:problem.dim]
     orders = tuple(orders)
-    if len(orders) != problem.dim or min(orders) < 0:
-        raise GearcheckError(f"orders={orders}: give {problem.dim} non-negative number"
+    if len(orders) != problem.dim or not all(isinstance(o, (int, np.integer)) and not isinstance(o, bool)
+                                             and o >= 0 for o in orders) or not any(orders):
+        raise GearcheckError(f"orders={orders}: give {problem.dim} whole non-negative number"
                              f"{'s' if problem.dim > 1 else ''}, one per clock of this train (mesh"
-                             f"{', eccentrics' if problem.dim > 1 else ''})")
+                             f"{', eccentrics' if problem.dim > 1 else ''}), not all 0")
+    unknowns = problem.M.shape[0] * math.prod(2 * o + 1 for o in orders)
+    if unknowns > MAX_UNKNOWNS:
+        raise GearcheckError(f"orders={orders}: {unknowns} complex unknowns (coordinates times harmonics), more than "
+                             f"the {MAX_UNKNOWNS} whose dense system fits in memory: keep fewer orders")
     return orders
 
 

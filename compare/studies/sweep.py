@@ -70,6 +70,7 @@ from gearcheck.compare.engine.plan import TrainPlan
 from gearcheck.compare.studies.sweep_lines import counted, measured
 from gearcheck.train.loader import load_text, load_train, read_train_text
 from gearcheck.lumped.side import LumpedSide
+from gearcheck.train.files import MAX_DATA_BYTES, read_bytes
 from gearcheck.train.spec import TrainSpec, beside
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
@@ -85,9 +86,10 @@ SOLVERS = ("lumped", "mujoco")
 DURATION = 0.5  # s simulated per point and solver
 HARMONICS = 3
 STATISTICS = ("mean", "rms", "peak_to_peak")
-MAX_POINTS = 1_000_000
+MAX_POINTS = 100_000  # each point carries its edited train file (some 10 kB): 1 GB of points at most
 MAX_REFINE = 64
 
+KEY = "gearcheck.point"  # a point table's metadata: the point's key (Point.key), checked when read from the cache
 POINT_SCHEMA = pa.schema([
     ("solver", pa.string()), ("quantity", pa.string()), ("kind", pa.string()), ("unit", pa.string()),
     ("metric", pa.string()), ("mesh", pa.string()), ("order", pa.int64()), ("frequency_hz", pa.float64()),
@@ -264,14 +266,15 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
     document = tomllib.loads(text)
     grid, laws = _varied_fields(document, fields, distributions, samples)
     speeds = _checked_speeds(speeds, list(grid) + list(laws))
+    count = ((32 if samples is None else samples) if laws else math.prod(map(len, grid.values()))) * \
+        (len(speeds) if speeds else 1)
+    if count > MAX_POINTS:  # before the grid is built
+        raise GearcheckError(f"{count} points: more than the {MAX_POINTS} a sweep holds")
     if laws:
         sets = draw_samples(laws, 32 if samples is None else samples, seed)
     else:
         sets = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
         seed = None
-    count = len(sets) * (len(speeds) if speeds else 1)
-    if count > MAX_POINTS:
-        raise GearcheckError(f"{count} points: more than the {MAX_POINTS} a sweep holds")
     common = dict(source=source, solvers=solvers, duration=float(duration), harmonics=harmonics, seed=seed,
                   extra=_files_digest(document, source), check=integration_check, refine=refine)
     points = _points(document, base, sets, speeds, "distributions" if laws else "fields", common)
@@ -412,8 +415,8 @@ def _files_digest(document: dict, source: str) -> str:
     if not isinstance(name, str):
         return ""
     try:
-        return hashlib.sha256(Path(beside(source, name)).read_bytes()).hexdigest()
-    except OSError:
+        return hashlib.sha256(read_bytes(beside(source, name), "torque profile")).hexdigest()
+    except GearcheckError:  # the train file's own check names the problem
         return ""
 
 
@@ -477,7 +480,7 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
             continue
         reduce_run(result, plan, lines, rows, solver, check, model.excitation.switch_times)
     sink = io.BytesIO()
-    pq.write_table(rows.table(), sink, compression="zstd")
+    pq.write_table(rows.table().replace_schema_metadata({KEY: point.key}), sink, compression="zstd")
     return sink.getvalue(), time.perf_counter() - started, time.process_time() - cpu
 
 
@@ -559,11 +562,12 @@ def execute(points, *, workers: int | None = None, scheduler=None, executor=None
     cache = None if cache is None else Path(cache)
     if cache is not None:
         for key in unique:
-            path = cache / f"{key}.parquet"
-            if path.is_file():
-                data = path.read_bytes()
-                if _readable(data):
-                    tables[key] = data
+            try:
+                data = read_bytes(cache / f"{key}.parquet", "sweep cache file", MAX_DATA_BYTES)
+            except GearcheckError:  # none yet, or not a file that it can be
+                continue
+            if _readable(data, key):
+                tables[key] = data
     cached = len(tables)
     pending = [todo[k] for k in unique if k not in tables]
     done = [cached]
@@ -608,9 +612,12 @@ def _workers(workers) -> int:
     return workers
 
 
-def _readable(data: bytes) -> bool:
+def _readable(data: bytes, key: str) -> bool:
+    """Whether ``data`` is a point's table, and the table of the point ``key`` (its inputs' hash, which every point
+    table carries: a cache file renamed or copied over another is run again, never read as the other point)."""
     try:
-        return pq.read_table(io.BytesIO(data)).schema.equals(POINT_SCHEMA)
+        schema = pq.read_table(io.BytesIO(data)).schema
+        return schema.equals(POINT_SCHEMA) and (schema.metadata or {}).get(KEY.encode()) == key.encode()
     except Exception:  # a damaged cache file is run again
         return False
 

@@ -25,7 +25,9 @@ The front door:
 * :func:`sweep` -- speed sweeps, parameter studies and Monte Carlo, cached, on local processes or Dask;
 * :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check;
 * :func:`describe`, :func:`pin_loads`, :func:`calibrate`, :func:`dashboard` -- what a train derives from its file,
-  an RV reducer's static pin loads, a least-squares calibration to measurements, the regression dashboard.
+  an RV reducer's static pin loads, a least-squares calibration to measurements, the regression dashboard;
+* :func:`trust`, :func:`allow_data` -- a train file is data: the Python code it names runs only from modules you
+  trust, and the files it names lie beside it or in folders you allow.
 
 Every command of the command line is one of these (``ste``, ``animate``, ``view`` and ``stiffness`` are
 :class:`Train` methods).
@@ -36,12 +38,18 @@ presentation), :mod:`gearcheck.shared` (what every package shares).
 """
 
 import os
-from importlib import metadata
+from importlib import metadata, util
+from pathlib import Path
+
+from gearcheck.shared.compiled_cache import ensure_cache_folder
 
 # MuJoCo picks its OpenGL platform when it is imported: without a display, offscreen rendering (animations)
 # goes through EGL unless the user chose otherwise
 if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
     os.environ["MUJOCO_GL"] = "egl"
+
+# before the compiled kernels are defined: a read-only install still imports
+ensure_cache_folder(Path(util.find_spec("gearcheck.lumped").submodule_search_locations[0]))
 
 from gearcheck.api import (  # noqa: E402
                            SOLVERS,
@@ -74,11 +82,12 @@ from gearcheck.train.variants import edited
 from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
+from gearcheck.shared.trust import allow_data, trust
 
 __version__ = metadata.version("gearcheck")
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "GearcheckError", "LinearModel", "Mesh",
            "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",
-           "__version__", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "edited", "export_model",
-           "harmonic_response", "kinematics", "load", "load_text", "mjcf", "mode_pairing", "modes", "pin_loads",
-           "preset_text", "presets", "sensitivity", "simulate", "sweep", "write_report"]
+           "__version__", "allow_data", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "edited",
+           "export_model", "harmonic_response", "kinematics", "load", "load_text", "mjcf", "mode_pairing", "modes",
+           "pin_loads", "preset_text", "presets", "sensitivity", "simulate", "sweep", "trust", "write_report"]

@@ -3,7 +3,8 @@
 Exit status: 0 done (a cross-check passed), 1 a cross-check failed (a tolerance exceeded or a
 baseline metric moved), 3 a cross-check inconclusive (no steady state reached, or an integration
 error estimate as large as a tolerance), 2 bad input (one line on stderr naming the file, field or option, and the
-value; nothing written), 130 interrupted (SIGINT), 143 terminated (SIGTERM); a closed pipe ends the
+value; nothing written; also a full disk and memory run out), 70 an internal error (one line; ``GEARCHECK_DEBUG=1``
+shows its traceback), 130 interrupted (SIGINT), 143 terminated (SIGTERM); a closed pipe ends the
 program quietly, as other command-line tools do.  Outputs are written whole or not at all
 (:class:`~gearcheck.shared.outputs.OutputDirectory`).
 """
@@ -11,6 +12,7 @@ program quietly, as other command-line tools do.  Outputs are written whole or n
 from __future__ import annotations
 
 import argparse
+import errno
 import json
 import math
 import os
@@ -32,7 +34,11 @@ from gearcheck.compare.presentation.summary import summary_row, write_summary
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError, did_you_mean
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
+from gearcheck.shared.trust import granted
 from gearcheck.shared.units import checked_rpm
+
+
+FULL = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}  # a disk full, a quota, a read-only file system
 
 
 class Terminated(Exception):
@@ -62,7 +68,8 @@ FLAGS = {  # a library error's Python parameter -> this command line's flag
     "measurements": "--measurements", "solver": "--solver", "method": "--method", "coordinate": "--coordinate",
     "samples": "--samples", "seed": "--seed", "harmonics": "--harmonics", "refine": "--refine", "workers": "--workers",
     "scheduler": "--scheduler", "speeds": "--speeds", "cache": "--cache", "fit": "--fit", "parameter": "--parameter",
-    "orders": "--orders",
+    "orders": "--orders", "trust": "--trust", "data_root": "--data-root", "fps": "--fps",
+    "slow_motion": "--slow-motion", "magnify": "--magnify",
     # a parameter that the command line names otherwise: a repeatable flag gives one entry of its list or dict
     "fields": "--set", "distributions": "--vary", "parameters": "--parameter", "quantities": "--quantity"}
 _PARAMETER = re.compile(rf"(?<![.\]-])\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
@@ -79,9 +86,16 @@ def main(argv: list[str] | None = None) -> int:
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         args = _parser().parse_args(argv)
-        return args.func(args)
+        with granted(args.trust, args.data_root):
+            return args.func(args)
     except GearcheckError as exc:
-        print(f"gearcheck: error: {as_flags(str(exc))}", file=sys.stderr)
+        print(f"gearcheck: error: {as_flags(' '.join(str(exc).splitlines()))}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        if exc.errno not in FULL:
+            raise
+        print(f"gearcheck: error: {exc.filename or 'an output'}: cannot be written ({exc.strerror}); the previous "
+              "output stays as it was", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("gearcheck: interrupted", file=sys.stderr)
@@ -89,6 +103,16 @@ def main(argv: list[str] | None = None) -> int:
     except Terminated:
         print("gearcheck: terminated", file=sys.stderr)
         return 143
+    except MemoryError:
+        print("gearcheck: error: out of memory (the inputs ask for more than this machine has)", file=sys.stderr)
+        return 2
+    except Exception as exc:  # a fault of gearcheck's own that an input found: one line, and how to see the rest
+        if os.environ.get("GEARCHECK_DEBUG"):
+            raise
+        print(f"gearcheck: error: internal error, {type(exc).__name__}: {' '.join(str(exc).split())[:300]} (a bug "
+              "in gearcheck: please report it with the command; GEARCHECK_DEBUG=1 shows the traceback)",
+              file=sys.stderr)
+        return 70
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -144,17 +168,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-class Command:
-    """A command of the command line: the function that runs it (each calls the front door), its help line and its
-    arguments, as :func:`arg` writes them."""
-
-    def __init__(self, run: Callable[[argparse.Namespace], int], help: str, *arguments: tuple):
-        self.run, self.help, self.arguments = run, help, arguments
-
-
 def arg(*flags: str, **options) -> tuple:
     """An argument of a command: ``argparse``'s flags and options."""
     return flags, options
+
+
+GRANTS = (  # every command's: what a train file may do beyond numbers (gearcheck.shared.trust)
+    arg("--trust", action="append", default=[], metavar="MODULE",
+        help="run the Python code a train file names from MODULE (a module, package or .py file); a train file is "
+             "data and runs no code otherwise (repeatable)"),
+    arg("--data-root", action="append", default=[], metavar="DIR",
+        help="let train files name files inside DIR, besides their own folder (repeatable)"),
+)
+
+
+class Command:
+    """A command of the command line: the function that runs it (each calls the front door), its help line and its
+    arguments, as :func:`arg` writes them (and :data:`GRANTS`)."""
+
+    def __init__(self, run: Callable[[argparse.Namespace], int], help: str, *arguments: tuple):
+        self.run, self.help, self.arguments = run, help, (*arguments, *GRANTS)
 
 
 TRAIN = arg("train", metavar="TRAIN", help="preset name or path to a train TOML file")
@@ -536,14 +569,12 @@ def cmd_calibrate(args) -> int:
 def _read_distributions(path) -> dict[str, str]:
     """The ``[distributions]`` table of the TOML file ``--distributions`` names: ``"FIELD" = "normal(mean, sd)"``, one
     per field."""
-    import tomllib
+    from gearcheck.train.files import read_toml
 
     try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise GearcheckError(f"--distributions {path}: cannot be read ({exc.strerror or exc})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise GearcheckError(f"--distributions {path}: not TOML ({exc})") from None
+        data = read_toml(path, "distributions file")
+    except GearcheckError as exc:
+        raise GearcheckError(f"--distributions {exc}") from None
     table = data.get("distributions")
     if not isinstance(table, dict) or not table:
         raise GearcheckError(f"--distributions {path}: needs a [distributions] table of \"FIELD\" = "
@@ -632,7 +663,7 @@ def cmd_crosscheck(args) -> int:
     commit = None
     if args.history is not None:
         history.check_store(args.history)
-        commit = args.commit or os.environ.get("GITHUB_SHA") or head_commit()
+        commit = history.checked_commit(args.history, args.commit or os.environ.get("GITHUB_SHA") or head_commit())
     with OutputDirectory(args.out) as place:
         for name in names:
             bar = ProgressBar(f"crosscheck {name}")

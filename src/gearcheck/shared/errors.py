@@ -39,6 +39,16 @@ class DivergenceError(SolverError):
         super().__init__(f"diverged at t = {time:.6g} s: {message}")
 
 
+def shown(value, width: int = 40) -> str:
+    """A value as a message shows it: its repr cut to ``width`` characters, an integer too long to print in
+    full (Python refuses past 4300 digits) by its size."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 128:
+        return f"an integer of some {int(value.bit_length() * 0.30103) + 1} digits"
+    text = " ".join(repr(value.item() if hasattr(value, "item") and getattr(value, "shape", None) == () else value)
+                    .split())
+    return text if len(text) <= width else text[:width - 3] + "..."
+
+
 def did_you_mean(name: str, choices, listing: str = "", *, n: int = 1, cutoff: float = 0.6) -> str:
     """The hint that follows an unknown ``name``: `` (did you mean 'x'?)`` with the entry of ``choices``
     closest to it (up to ``n`` of them, as near as ``cutoff``: :func:`difflib.get_close_matches`); with

@@ -4,12 +4,16 @@
 
 * on entry it refuses a place that cannot be written (``out`` is a file, an ancestor is a file, the
   nearest existing ancestor is not writable) and a folder it must not replace (one that holds files
-  and is no earlier output: every output carries a ``MARKER`` file), and takes a lock on ``out`` (a file
-  lock in the system's temporary folder, so nothing is written near ``out`` yet): a second run into the
-  same folder is refused at once, naming the process that holds it;
+  and is no earlier output: every output carries a ``MARKER`` file), and takes a lock on ``out``'s real path
+  (symbolic links resolved: two paths to one folder are one lock), a file in the user's own folder of locks
+  (:func:`lock_folder`, so nothing is written near ``out`` yet, and no other user's file or link is ever opened):
+  a second run into the same folder is refused at once, naming the process that holds it.  Holding the lock, it
+  clears what a killed run left beside ``out`` (a temporary ``.partial`` folder; a ``.previous`` output put back
+  if ``out`` is gone), saying so;
 * ``.path`` is a temporary folder beside ``out``, made (with any missing parents) when first asked for;
-* on a clean exit the temporary folder replaces ``out``; on an error or an interruption it is removed,
-  with any parents it made, and ``out`` stays as it was: the previous complete output, or nothing.
+* on a clean exit the temporary folder replaces ``out`` (exchanged in one step where the system can,
+  ``renameat2``; else two renames); on an error or an interruption it is removed, with any parents it made, and
+  ``out`` stays as it was: the previous complete output, or nothing.
   Ctrl-C and SIGTERM wait while the folders are made, swapped or removed (a few milliseconds), so
   neither can leave an unrecorded or half-removed folder behind; they take effect right after.  One that comes
   as the run leaves, before they are held, ends it as an interrupted run: the previous output stays.
@@ -20,11 +24,15 @@
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import fcntl
 import hashlib
 import os
+import re
 import shutil
 import signal
+import stat
+import sys
 import tempfile
 from pathlib import Path
 
@@ -51,6 +59,55 @@ def check_place(out: Path, what: str, folder: bool = True) -> None:
             pass
     except OSError as exc:
         raise GearcheckError(f"{named}: {ancestor} is not writable ({exc.strerror or exc})") from None
+
+
+def lock_folder() -> Path:
+    """The user's own folder of output locks: ``$XDG_RUNTIME_DIR/gearcheck``, else ``gearcheck-UID`` in the
+    system's temporary folder; made mode 0700 and refused unless it is a real folder of this user's that nobody
+    else may write (a folder or link planted there by another user is never followed)."""
+    runtime = os.environ.get("XDG_RUNTIME_DIR")
+    if runtime and os.path.isdir(runtime):
+        folder = Path(runtime) / "gearcheck"
+    else:
+        folder = Path(tempfile.gettempdir()) / f"gearcheck-{os.getuid()}"
+    with contextlib.suppress(FileExistsError):
+        folder.mkdir(mode=0o700)
+    info = os.lstat(folder)
+    if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid() or info.st_mode & 0o022:
+        raise GearcheckError(f"{folder}: the folder for gearcheck's locks is not a private folder of this user "
+                             "(a link, or another user's, or writable by others): remove it")
+    return folder
+
+
+def _lock_file(out: Path):
+    """The lock of the output folder ``out``, open for reading and writing, never through a link."""
+    key = hashlib.sha256(str(out).encode()).hexdigest()[:24]
+    fd = os.open(lock_folder() / f"{key}.lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    return os.fdopen(fd, "r+")
+
+
+LEFTOVER = r"\.{name}\.[a-z0-9_]{{8}}\.(partial|previous)"  # mkdtemp's names beside an output (OutputDirectory.path)
+
+
+def _clear_leftovers(out: Path) -> list[str]:
+    """What killed runs left beside ``out`` (the caller holds its lock, so no run is writing them): temporary
+    folders removed, and a previous output put back where ``out`` is gone (a kill between two renames).  Returns
+    what was done, in words."""
+    done = []
+    pattern = re.compile(LEFTOVER.format(name=re.escape(out.name)))
+    if not out.parent.is_dir():
+        return done
+    for path in sorted(out.parent.iterdir()):
+        kind = pattern.fullmatch(path.name)
+        if kind is None or path.is_symlink() or not path.is_dir():
+            continue
+        if kind[1] == "previous" and not os.path.lexists(out):
+            os.rename(path, out)
+            done.append(f"put back {out.name}, the output a killed run had set aside as {path.name}")
+        else:
+            shutil.rmtree(path, ignore_errors=True)
+            done.append(f"removed {path.name}, left by a killed run")
+    return done
 
 
 def _make_parents(path: Path) -> list[Path]:
@@ -82,8 +139,12 @@ class OutputDirectory:
             found = ", ".join(sorted(p.name for p in self.out.iterdir())[:3])
             raise GearcheckError(f"{self.what} {self.given}: holds files that gearcheck did not write ({found}, ...), "
                                  "which a run would replace: give a new or empty folder, or an earlier output")
-        key = hashlib.sha256(str(self.out.absolute()).encode()).hexdigest()[:24]
-        self._lock = open(Path(tempfile.gettempdir()) / f"gearcheck-{key}.lock", "a+")
+        self.out = Path(os.path.realpath(self.out))  # the folder itself: one lock whatever the path to it
+        try:
+            self._lock = _lock_file(self.out)
+        except OSError as exc:
+            raise GearcheckError(f"{self.what} {self.given}: cannot take the output's lock ({exc.strerror or exc})"
+                                 ) from None
         try:
             fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -96,6 +157,9 @@ class OutputDirectory:
         self._lock.truncate()
         self._lock.write(str(os.getpid()))
         self._lock.flush()
+        with _signals_deferred():
+            for line in _clear_leftovers(self.out):
+                print(f"gearcheck: {self.given}: {line}", file=sys.stderr)
         return self
 
     @property
@@ -143,6 +207,9 @@ class OutputDirectory:
         if not self.out.exists():
             os.rename(self._tmp, self.out)
             return
+        if _exchange(self._tmp, self.out):  # the new output in place, the previous one now at the temporary name
+            shutil.rmtree(self._tmp, ignore_errors=True)
+            return
         old = self._tmp.with_name(self._tmp.name[:-len(".partial")] + ".previous")
         os.rename(self.out, old)
         try:
@@ -152,6 +219,18 @@ class OutputDirectory:
             shutil.rmtree(self._tmp, ignore_errors=True)
             raise
         shutil.rmtree(old, ignore_errors=True)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths in one step (Linux's ``renameat2`` with ``RENAME_EXCHANGE``); False where the system or the
+    file system cannot."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    return renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0
 
 
 @contextlib.contextmanager

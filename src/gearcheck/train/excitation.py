@@ -8,11 +8,12 @@ with tip relief sums its tooth pairs instead of k(t) (:meth:`Excitation.tooth_pa
 
 from __future__ import annotations
 
-import importlib
 import math
 
 import numpy as np
 
+from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.trust import named_code
 from gearcheck.train.kinematics import Kinematics
 from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.mesh_stiffness import ConstantStiffness, stiffness_model
@@ -50,11 +51,8 @@ class Excitation:
         op = spec.operating
         # torque ripple harmonics: (member "input" | "output", amplitude, angular frequency rad/s, phase rad)
         self.ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
-        self._function = None
+        self._function = None  # the torque function, imported on first use (:meth:`torque_function`)
         self._profile = None if op.torque_profile is None else tuple(np.asarray(x) for x in op.torque_profile)
-        if op.torque_function:
-            module, _, name = op.torque_function.partition(":")
-            self._function = getattr(importlib.import_module(module), name)
 
     # ------------------------------------------------------------------ meshes
     def mesh_position(self, t, mesh: int | None = None) -> np.ndarray:
@@ -113,10 +111,32 @@ class Excitation:
             times = self._profile[0]
             freqs.append(np.array([1.0 / (times[-1] - times[0])]))
         op = self.spec.operating
-        aperiodic = [] if self._function is None else [f"the torque function {op.torque_function}"]
+        aperiodic = [f"the torque function {op.torque_function}"] if op.torque_function else []
         if op.ramp > 0:
             aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
         return np.concatenate(freqs), meshes, aperiodic
+
+    def torque_function(self, t) -> np.ndarray:
+        """The train file's ``operating.torque_function`` at times t, in N·m: code, so imported only when the user
+        trusts its module (:func:`~gearcheck.shared.trust.named_code`), and each value checked to be a finite
+        torque."""
+        ref = self.spec.operating.torque_function
+        label = f"{self.spec.path}: operating.torque_function"
+        if self._function is None:
+            self._function = named_code(ref, label, from_file=True)
+        values = []
+        for time in np.ravel(t):
+            try:
+                value = self._function(float(time))
+            except (Exception, SystemExit) as exc:  # a wrong signature, or an error inside the user's function
+                raise GearcheckError(f"{label}: {ref}({float(time)!r}) raised {type(exc).__name__}: {exc} (it must "
+                                     "map a time in s to a torque in N·m)") from None
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                    or not math.isfinite(value):
+                raise GearcheckError(f"{label}: {ref}({float(time)!r}) returned {value!r}; it must return a finite "
+                                     "torque in N·m")
+            values.append(float(value))
+        return np.reshape(values, np.shape(t))
 
     @property
     def has_transmission_error(self) -> bool:
@@ -183,8 +203,8 @@ class Excitation:
                 t_in = t_in + t_in_mean * wave
             else:
                 t_out = t_out + t_out_mean * wave
-        if self._function is not None:
-            t_in = t_in + np.vectorize(self._function, otypes=[float])(t)
+        if op.torque_function:
+            t_in = t_in + self.torque_function(t)
         if self._profile is not None:
             times, values = self._profile
             phase = times[0] + np.mod(t - times[0], times[-1] - times[0])

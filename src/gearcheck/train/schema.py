@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from gearcheck.shared.citations import REFERENCES
-from gearcheck.shared.errors import TrainFileError, did_you_mean
+from gearcheck.shared.errors import TrainFileError, did_you_mean, shown
 from gearcheck.shared.units import MAX_RPM, RAD_S_PER_RPM, SUFFIXES
 
 REQUIRED = object()
@@ -55,8 +55,11 @@ class Number:
 
     def parse(self, value, path: str, ctx: Context) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ctx.fail(path, f"must be a number, got {value!r}")
-        value = float(value)
+            raise ctx.fail(path, f"must be a number, got {shown(value)}")
+        try:
+            value = float(value)
+        except OverflowError:  # a TOML integer past the largest float
+            raise ctx.fail(path, f"must be finite, got {shown(value)}") from None
         unit = f" {self.unit}" if self.unit not in ("", "-") else ""
         if not math.isfinite(value):
             raise ctx.fail(path, f"must be finite, got {value}")
@@ -97,6 +100,18 @@ LIMITS = {
 }
 
 
+FLOORS = {
+    # name: (lower bound in SI, why): below it the solvers' steps (sqrt(m/k)) and matrices degenerate
+    "mass": (1e-9, "kg: a microgram, lighter than any gear of the finest module allowed"),
+    "inertia": (1e-18, "kg·m²: a microgram at a micrometre"),
+}
+
+
+def floor(name: str) -> float:
+    """The lower bound :data:`FLOORS` sets for a quantity, in SI."""
+    return FLOORS[name][0]
+
+
 def bound(name: str, unit_in_si: float = 1.0) -> float:
     """The upper bound :data:`LIMITS` sets for a quantity, in a unit worth ``unit_in_si`` SI units."""
     return LIMITS[name][0] / unit_in_si
@@ -124,11 +139,11 @@ class Integer:
 
     def parse(self, value, path: str, ctx: Context) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ctx.fail(path, f"must be an integer, got {value!r}")
+            raise ctx.fail(path, f"must be an integer, got {shown(value)}")
         if self.minimum is not None and value < self.minimum:
-            raise ctx.fail(path, f"must be an integer >= {self.minimum}, got {value}")
+            raise ctx.fail(path, f"must be an integer >= {self.minimum}, got {shown(value)}")
         if self.maximum is not None and value > self.maximum:
-            raise ctx.fail(path, f"must be an integer <= {self.maximum}, got {value}")
+            raise ctx.fail(path, f"must be an integer <= {self.maximum}, got {shown(value)}")
         return value
 
     def type_name(self) -> str:
@@ -150,12 +165,12 @@ class Text:
 
     def parse(self, value, path: str, ctx: Context) -> str:
         if not isinstance(value, str):
-            raise ctx.fail(path, f"must be a string, got {value!r}")
+            raise ctx.fail(path, f"must be a string, got {shown(value)}")
         if self.choices is not None and value not in self.choices:
-            raise ctx.fail(path, f"must be one of {', '.join(self.choices)}; got {value!r}"
+            raise ctx.fail(path, f"must be one of {', '.join(self.choices)}; got {shown(value)}"
                                  + did_you_mean(value, self.choices))
         if self.pattern is not None and not re.fullmatch(self.pattern, value):
-            raise ctx.fail(path, f"{value!r} is not of the form {self.pattern}")
+            raise ctx.fail(path, f"{shown(value)} is not of the form {self.pattern}")
         return value
 
     def type_name(self) -> str:
@@ -174,7 +189,7 @@ class ListOf:
 
     def parse(self, value, path: str, ctx: Context) -> list:
         if not isinstance(value, list):
-            raise ctx.fail(path, f"must be a list, got {value!r}")
+            raise ctx.fail(path, f"must be a list, got {shown(value)}")
         if len(value) < self.min_length or (self.max_length is not None and len(value) > self.max_length):
             count = (f"{self.min_length}" if self.max_length == self.min_length
                      else f"at least {self.min_length}" if self.max_length is None
@@ -182,7 +197,7 @@ class ListOf:
             raise ctx.fail(path, f"needs {count} entries, got {len(value)}")
         items = [self.item.parse(v, f"{path}[{i}]", ctx) for i, v in enumerate(value)]
         if self.increasing and any(b <= a for a, b in zip(items, items[1:])):
-            raise ctx.fail(path, f"must increase, got {value}")
+            raise ctx.fail(path, f"must increase, got {shown(value, 80)}")
         return items
 
     def type_name(self) -> str:
@@ -203,7 +218,7 @@ class Table:
 
     def parse(self, value, path: str, ctx: Context) -> dict:
         if not isinstance(value, dict):
-            raise ctx.fail(path, f"must be a table, got {value!r}")
+            raise ctx.fail(path, f"must be a table, got {shown(value)}")
         out: dict[str, Any] = {}
         for key, raw in value.items():
             sub = f"{path}.{key}" if path else key
@@ -251,7 +266,7 @@ class TableList:
 
     def parse(self, value, path: str, ctx: Context) -> list[dict]:
         if not isinstance(value, list):
-            raise ctx.fail(path, f"must be an array of tables ([[{path}]]), got {value!r}")
+            raise ctx.fail(path, f"must be an array of tables ([[{path}]]), got {shown(value)}")
         if len(value) < self.min_length:
             raise ctx.fail(path, f"needs at least {self.min_length} entries, got {len(value)}")
         return [self.table.parse(v, f"{path}[{i}]", ctx) for i, v in enumerate(value)]
@@ -318,11 +333,11 @@ GEOMETRY = {
 }
 
 BODY = {
-    "mass": Number("mass; from `density` when not given", "kg", None, 1e-9, False, bound("mass")),
-    "inertia": Number("polar moment of inertia about the rotation axis", "kg·m²", None, 1e-18, False,
+    "mass": Number("mass; from `density` when not given", "kg", None, floor("mass"), False, bound("mass")),
+    "inertia": Number("polar moment of inertia about the rotation axis", "kg·m²", None, floor("inertia"), False,
                       bound("inertia")),
     "inertia_over_r2": Number("I/r² with r the base radius (carrier: carrier radius); give this or `inertia`", "kg",
-                              None, 1e-9, False, bound("mass")),
+                              None, floor("mass"), False, bound("mass")),
     "density": Positive("material density: mass and inertia of an annulus, m = rho pi (r_o² - r_i²) b, "
                         "I = m (r_o² + r_i²)/2, wherever `mass` or `inertia` is not given (a given mass keeps "
                         "the annulus's radius of gyration)", "kg/m³", None,
@@ -445,9 +460,9 @@ def _bearing(doc: str) -> Table:
 
 CRANK = Table(
     {
-        "mass": Positive("mass of one crankshaft", "kg", REQUIRED, bound("mass")),
-        "inertia": Positive("polar moment of inertia of one crankshaft about its axis", "kg·m²", REQUIRED,
-                            bound("inertia")),
+        "mass": Number("mass of one crankshaft", "kg", REQUIRED, floor("mass"), False, bound("mass")),
+        "inertia": Number("polar moment of inertia of one crankshaft about its axis", "kg·m²", REQUIRED,
+                          floor("inertia"), False, bound("inertia")),
         "eccentricity_mm": Positive("eccentricity e of its eccentrics: the radius of the cycloid discs' orbit", "mm",
                                     REQUIRED, bound("length", MM)),
         "bearing": _bearing("the crankshaft's support bearings in the carrier, taken together"),
@@ -481,8 +496,9 @@ CYCLOID = Table(
         "pin_radius_mm": Positive("radius of a pin (or of its roller), r_rp", "mm", REQUIRED, bound("length", MM)),
         "thickness_mm": Positive("thickness of a disc: the length of each pin contact", "mm", REQUIRED,
                                  bound("length", MM)),
-        "mass": Positive("mass of one disc", "kg", REQUIRED, bound("mass")),
-        "inertia": Positive("polar moment of inertia of one disc", "kg·m²", REQUIRED, bound("inertia")),
+        "mass": Number("mass of one disc", "kg", REQUIRED, floor("mass"), False, bound("mass")),
+        "inertia": Number("polar moment of inertia of one disc", "kg·m²", REQUIRED, floor("inertia"), False,
+                          bound("inertia")),
         "bearing": _bearing("the needle (turning-arm) bearing between each eccentric and its disc"),
         "contact": Table(
             {
@@ -505,8 +521,9 @@ CYCLOID = Table(
 
 PIN_WHEEL = Table(
     {
-        "mass": Positive("mass of the pin wheel with its pins", "kg", REQUIRED, bound("mass")),
-        "inertia": Positive("polar moment of inertia of the pin wheel", "kg·m²", REQUIRED, bound("inertia")),
+        "mass": Number("mass of the pin wheel with its pins", "kg", REQUIRED, floor("mass"), False, bound("mass")),
+        "inertia": Number("polar moment of inertia of the pin wheel", "kg·m²", REQUIRED, floor("inertia"), False,
+                          bound("inertia")),
         "support": SUPPORT,
     },
     "the pin wheel (the housing's pins) on a support; without this table it is rigid and fixed",
@@ -570,7 +587,8 @@ OPERATING = Table(
             "(omit for a torque-driven input with a rigid-body mode)", "N·m/rad", None, bound("stiffness")),
         "input_shaft_damping": NonNegative("damping of the input shaft", "N·m·s/rad", 0.0, bound("damping")),
         "ripple": TableList(RIPPLE, "torque ripple harmonics", default=()),
-        "torque_function": Text("Python `module:function` f(t) -> N·m added to the input torque", None,
+        "torque_function": Text("Python `module:function` f(t) -> N·m added to the input torque: code, run only "
+                                "with `--trust MODULE` (a table or `ripple` needs none)", None,
                                 pattern=r"[A-Za-z_][\w.]*:[A-Za-z_]\w*"),
         "torque_csv": Text("CSV file (relative to the train file) of time [s], torque [N·m] added to the input "
                            "torque, repeated with the file's period", None),
@@ -632,7 +650,8 @@ TRAIN_TABLE = Table(
         "measurements_file": Text("a TOML file of [[measurements]] (relative to the train file) shown in every "
                                   "cross-check and used by calibrate", None),
         "user_model": Text("your own model of this train, checked by `crosscheck --model user`: a .mat or .npz "
-                           "file of matrices (relative to the train file) or `module:factory`", None),
+                           "file of matrices (relative to the train file), or `module:factory` or "
+                           "`file.py:factory` (code, run only with `--trust`)", None),
     },
     "identification and power flow",
 )

@@ -9,7 +9,6 @@ of a planetary stage is checked here with an error that names the file and the f
 
 from __future__ import annotations
 
-import importlib
 import math
 from dataclasses import dataclass, field, replace
 from math import gcd
@@ -24,7 +23,8 @@ from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geom
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.schema import Context, parse_measurements
-from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
+from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean, shown
+from gearcheck.shared.trust import inside_roots
 
 MIN_TEETH = 6
 MAX_BACKLASH = 0.5  # modules: beyond, the backlash is more than the tooth space leaves
@@ -391,8 +391,6 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         if (r["order"] is None) == (r["frequency_hz"] is None):
             raise fail(f"operating.ripple[{j}]", "give exactly one of order or frequency_hz")
         ripples.append(Ripple(r["member"], r["order"], r["frequency_hz"], r["amplitude"], r["phase"]))
-    if op["torque_function"] is not None:
-        _check_torque_function(op["torque_function"], fail)
     profile = _torque_profile(op["torque_csv"], source, fail) if op["torque_csv"] is not None else None
     if op["input_torque"] is not None and op["output_torque"] is not None:
         raise fail("operating.input_torque", "give input_torque or output_torque, not both")
@@ -411,8 +409,11 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         operating=operating, text_hash=text_hash, references=tuple(train["references"]),
         measurements=tuple(_measurements(data, source, fail)),
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
-        user_model=_user_model(train["user_model"], source),
+        user_model=_user_model(train["user_model"], source, fail),
     )
+
+
+MAX_KEY_DEPTH = 16  # dotted parts of a tolerance key: the longest quantity name and its metric have 6
 
 
 def flat_tolerances(table: dict, fail) -> dict[str, float]:
@@ -420,35 +421,50 @@ def flat_tolerances(table: dict, fail) -> dict[str, float]:
     each a positive finite number."""
     flat = {}
 
-    def walk(node, prefix):
+    def walk(node, prefix, depth):
         for key, value in node.items():
             name = f"{prefix}.{key}" if prefix else key
             if isinstance(value, dict):
-                walk(value, name)
-            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                if depth >= MAX_KEY_DEPTH:
+                    raise fail(name[:80] + "...", f"a key of more than {MAX_KEY_DEPTH} dotted parts names no quantity")
+                walk(value, name, depth + 1)
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not -math.inf < value < math.inf \
                     or not 0 < value <= MAX_TOLERANCE:
-                raise fail(name, f"must be a positive number up to {MAX_TOLERANCE:g}, got {value!r}")
+                raise fail(name, f"must be a positive number up to {MAX_TOLERANCE:g}, got {shown(value)}")
             elif "." not in name:
                 raise fail(name, "expected KIND.METRIC or QUANTITY.METRIC")
             else:
                 flat[name] = float(value)
 
-    walk(table, "")
+    walk(table, "", 1)
     return flat
 
 
-def beside(source: str, name: str):
-    """A file named in a train file: relative to that file (presets and their edited variants: the presets
-    folder)."""
-    base = Path(__file__).parent / "presets" if source.startswith("preset:") else Path(source).parent
-    return base / name
+def beside(source: str, name: str) -> Path:
+    """The file ``name`` that the train file ``source`` names: relative to the train file (presets and their
+    edited variants: the presets folder), and inside its folder or a folder the user allows
+    (:func:`~gearcheck.shared.trust.inside_roots`); GearcheckError otherwise."""
+    home = Path(__file__).parent / "presets" if source.startswith("preset:") else Path(source).parent
+    path = home / name
+    if not inside_roots(path, home):
+        raise GearcheckError(f"{name!r} lies outside the train file's folder {home.resolve()}; a train file "
+                             "names files beside it, unless you allow a folder: --data-root DIR "
+                             "(gearcheck.allow_data(DIR) in Python)")
+    return path
 
 
-def _user_model(name: str | None, source: str) -> str | None:
-    """train.user_model: a file of matrices named relative to the train file, or ``module:factory`` as given."""
-    if name is None or ":" in name:
+def _user_model(name: str | None, source: str, fail) -> str | None:
+    """train.user_model: a file of matrices or ``file.py:factory``, named relative to the train file, or
+    ``module:factory`` as given (code: run only when trusted, :mod:`gearcheck.shared.trust`)."""
+    if name is None:
+        return None
+    where, colon, factory = name.rpartition(":")
+    if colon and not where.endswith(".py"):
         return name
-    return str(beside(source, name))
+    try:
+        return f"{beside(source, where)}:{factory}" if colon else str(beside(source, name))
+    except GearcheckError as exc:
+        raise fail("train.user_model", str(exc)) from None
 
 
 def _measurements(data: dict, source: str, fail) -> list[dict]:
@@ -457,8 +473,8 @@ def _measurements(data: dict, source: str, fail) -> list[dict]:
     entries = list(data["measurements"])
     name = data["train"]["measurements_file"]
     if name is not None:
-        path = beside(source, name)
         try:
+            path = beside(source, name)
             document = read_toml(path, "measurements file")
         except TrainFileError:
             raise
@@ -470,8 +486,8 @@ def _measurements(data: dict, source: str, fail) -> list[dict]:
 
 def _torque_profile(name: str, source: str, fail):
     """Read a two-column CSV (time s, torque N·m; a header line allowed) next to the train file."""
-    path = beside(source, name)
     try:
+        path = beside(source, name)
         lines = read_text(path, "torque profile").splitlines()
     except GearcheckError as exc:
         raise fail("operating.torque_csv", str(exc)) from None
@@ -494,25 +510,6 @@ def _numbers(line: str) -> bool:
         return True
     except ValueError:
         return False
-
-
-def _check_torque_function(ref: str, fail):
-    """The function must import and map a time in s to a finite torque in N·m: it is called once at t = 0."""
-    module, _, func = ref.partition(":")
-    try:
-        obj = getattr(importlib.import_module(module), func)
-    except Exception as exc:  # whatever the user's module raises on import
-        raise fail("operating.torque_function", f"cannot import {ref!r}: {type(exc).__name__}: {exc}") from None
-    if not callable(obj):
-        raise fail("operating.torque_function", f"{ref!r} is not callable")
-    try:
-        value = obj(0.0)
-    except Exception as exc:  # a wrong signature, or an error inside the user's function
-        raise fail("operating.torque_function", f"{ref}(0.0) raised {type(exc).__name__}: {exc} (it must map a time "
-                                                "in s to a torque in N·m)") from None
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
-            or not math.isfinite(value):
-        raise fail("operating.torque_function", f"{ref}(0.0) returned {value!r}; it must return a finite torque in N·m")
 
 
 def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:

@@ -1,0 +1,44 @@
+"""Where numba keeps gearcheck's compiled kernels.
+
+numba caches a kernel beside its source (``__pycache__``) or, where that is read-only, in the user's cache folder;
+with neither writable (a read-only install used by a user without a writable home) it refuses to define the
+kernel at all ("cannot cache function: no locator available"), and gearcheck could not be imported.  There
+:func:`ensure_cache_folder` points numba at a private folder of this user in the system's temporary folder, and the
+kernels compile there once per machine instead.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import tempfile
+from pathlib import Path
+
+
+def _writable(folder: Path) -> bool:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            return True
+    except OSError:
+        return False
+
+
+def ensure_cache_folder(sources: Path) -> Path | None:
+    """Give numba a cache folder when neither ``sources``' ``__pycache__`` nor the user's cache folder can be
+    written (and the user named none, ``NUMBA_CACHE_DIR``); returns the folder given, or None."""
+    from numba.core import config
+    from numba.misc.appdirs import AppDirs
+
+    if config.CACHE_DIR or _writable(sources / "__pycache__") or \
+            _writable(Path(AppDirs(appname="numba", appauthor=False).user_cache_dir)):
+        return None
+    folder = Path(tempfile.gettempdir()) / f"gearcheck-numba-{os.getuid()}"
+    with contextlib.suppress(OSError):
+        folder.mkdir(mode=0o700)
+    info = os.lstat(folder) if os.path.lexists(folder) else None
+    if info is None or not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid() or info.st_mode & 0o022:
+        folder = Path(tempfile.mkdtemp(prefix="gearcheck-numba-"))  # that one is not this user's own: a new one
+    config.CACHE_DIR = str(folder)
+    return folder

@@ -1,4 +1,4 @@
-"""How often :func:`gearcheck.compare.engine.diagnosis.diagnose` names the term that was broken.
+"""How often :func:`gearcheck.compare.engine.diagnose` names the term that was broken.
 
     python examples/diagnose_broken_models.py [docs/bring-your-own-model/diagnosis.md]
 
@@ -40,8 +40,8 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 import gearcheck  # noqa: E402
-from gearcheck.compare.engine.diagnosis import COEFFICIENT_FLOOR, Evidence, diagnose  # noqa: E402
-from gearcheck.train.spec import AXIAL  # noqa: E402
+from gearcheck.compare.engine import COEFFICIENT_FLOOR, Evidence, diagnose  # noqa: E402
+from gearcheck.train import AXIAL  # noqa: E402
 
 PRESETS = ("demo-3p", "demo-4p", "hub-drive", "double-planet", "helical-planetary")
 CLASSES = ("dropped coupling", "sign error", "wrong inertia", "missing gyroscopic")

@@ -28,7 +28,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 import gearcheck
-from gearcheck.compare.studies.uncertainty import NOMINAL, band, drivers, uncertainty_study  # no front door yet
+from gearcheck.compare.studies import NOMINAL, band, drivers, uncertainty_study
 
 G = 9.8  # m/s^2 per g, as the paper
 FITS = ["stages[0].mesh.ste[0].amplitude_um=0.2:20", "operating.output_torque=20:20000"]

@@ -13,11 +13,8 @@ from dataclasses import fields, replace
 import numpy as np
 
 import gearcheck
-from gearcheck.lumped import time_solver
-from gearcheck.lumped.elements.cycloid import CycloidRows
-from gearcheck.lumped.forced_response import parametric_problem
-from gearcheck.lumped.fourier_response import harmonic_balance_response
-from gearcheck.shared.settings import RunSettings
+from gearcheck.lumped import CycloidRows, harmonic_balance_response, parametric_problem, simulate
+from gearcheck.shared import RunSettings
 
 DURATION, WINDOW, GRID = 0.16, 0.04, 2048
 COORDINATES = ("rv.sun.theta", "rv.carrier.theta", "rv.crank1.theta", "rv.planet1.tangential", "rv.disc1.x")
@@ -52,7 +49,7 @@ held = replace(model, turning=[HeldPins(**{f.name: getattr(e, f.name) for f in f
                                if isinstance(e, CycloidRows) else e for e in model.turning])
 labels = model.dofs.labels()
 for name, marched in (("compression-only pins", model), ("static pattern held", held)):
-    run = time_solver.simulate(marched, RunSettings(duration=DURATION), method="rk4-stages")
+    run = simulate(marched, RunSettings(duration=DURATION), method="rk4-stages")
     window = run.t > DURATION - WINDOW
     q = balance.at(run.t[window])
     gaps = [np.sqrt(np.mean((q[:, labels.index(c)] - run.raw[c][window]) ** 2)) / np.std(run.raw[c][window])

@@ -11,8 +11,7 @@ Yang, Chen & Wang (2018) Eqs. 5-6.
 import numpy as np
 
 import gearcheck
-from gearcheck.lumped.forced_response import parametric_problem
-from gearcheck.lumped.fourier_response import fourier_series_response, harmonic_balance_response
+from gearcheck.lumped import fourier_series_response, harmonic_balance_response, parametric_problem
 
 DURATION, WINDOW = 0.16, 0.04
 COORDINATES = ("rv.sun.theta", "rv.carrier.theta", "rv.crank1.theta", "rv.planet1.tangential", "rv.disc1.x",

@@ -3,7 +3,7 @@
 demo-3p's rectangular mesh stiffness switches twice a mesh cycle, so the mesh forces and the bodies' accelerations
 jump there.  The lumped solver runs the train at 1500 rpm for 0.5 s at 2, 1, 1/2, 1/4 and 1/8 times its default
 step h; the steady half of each run is projected on the first three mesh harmonics, once by the plain Hann-windowed
-sum and once with the jumps at the stiffness switches corrected (:func:`gearcheck.compare.engine.line_projection.harmonics`).
+sum and once with the jumps at the stiffness switches corrected (:func:`gearcheck.compare.engine.harmonics`).
 The plain lines converge at first order in the step (the jumps alias onto them: the step divides the mesh period),
 the corrected ones sit on their limit from the default step on.  Writes line_aliasing.png and line_aliasing.json.
 
@@ -20,7 +20,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import gearcheck
-from gearcheck.compare.engine.line_projection import harmonics  # what this example shows at work
+from gearcheck.compare.engine import harmonics  # what this example shows at work
 
 TRAIN, SPEED, DURATION = "demo-3p", 1500.0, 0.5
 QUANTITIES = ("stage1.planet1.sun.force", "stage1.sun.alpha")

@@ -44,8 +44,7 @@ def reference_linear_model(spec, samples: int = SAMPLES) -> LinearModel:
         k += exc.mean_stiffness[j] - k.mean()
         meshes.append(Mesh(mesh.id, model.mesh_rows[j], Periodic(period, samples=k, interpolation="hold"),
                            float(model.mesh_damping[j])))
-    constant = not (exc.has_transmission_error or exc.ripple or spec.operating.ramp > 0
-                    or spec.operating.torque_function or spec.operating.torque_profile is not None)
+    constant = not (exc.has_transmission_error or spec.operating.ramp > 0 or spec.operating.torque_varies)
 
     def forcing(t):
         t_in, t_out = exc.torques(t)

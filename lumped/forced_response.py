@@ -81,7 +81,7 @@ def _check_linear(model: LumpedModel) -> None:
         reasons.append("tip relief")
     if exc.has_transmission_error:
         reasons.append("transmission error")
-    if spec.operating.ripple or spec.operating.torque_function or spec.operating.torque_profile:
+    if spec.operating.torque_varies:
         reasons.append("a torque that varies")
     reasons.extend(dict.fromkeys(e.words for e in model.turning if e.clock_speed is None))
     reasons.extend(dict.fromkeys(zone for part in spec.parts for zone in part.dead_zones()))  # each named once

@@ -267,6 +267,7 @@ OPTIONS = [
     (["run", "demo-3p", "--duration", "1e9"], "steps, more than the 2e+08 gearcheck runs in one go"),
     (["run", "demo-3p", "--dt", "1e-15"], "steps, more than the 2e+08 gearcheck runs in one go"),
     (["run", "hub-drive", "--duration", "100"], "GiB of series of the lumped model of hub-drive"),
+    (["run", "demo-3p", "--output-dt", "1e308"], "--output-dt 1e+308: a sampling interval longer than the duration"),
     (["run", "demo-3p", "--output-dt", "-1"], "argument --output-dt: must be a positive number of seconds, got -1"),
     (["run", "demo-3p", "--dt", "-1e-6"], "argument --dt: must be a positive number of seconds, got -1e-6"),
     (["run", "demo-3p", "--dt", "1e-3"], "time step 0.001 s is unstable for the lumped model of demo-3p"),

@@ -247,6 +247,24 @@ def test_the_teaching_notebooks_use_the_front_door_only():
         assert not re.findall(r"gearcheck\.\w+\.\w", code), path.name
 
 
+def test_the_examples_use_public_names_only():
+    """Every example imports ``gearcheck`` and, beyond it, only names a package lists as public (its ``__all__``,
+    :func:`gearcheck.shared.public.public`): no module path, no internal name."""
+    import ast
+    import importlib
+
+    for path in sorted((README.parent / "examples").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                assert all(a.name == "gearcheck" for a in node.names if a.name.startswith("gearcheck")), path.name
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("gearcheck"):
+                package = importlib.import_module(node.module)
+                assert hasattr(package, "__path__"), f"{path.name}: {node.module} is a module, not a package"
+                for alias in node.names:
+                    assert alias.name in package.__all__, f"{path.name}: {node.module}.{alias.name} is not public"
+                    assert getattr(package, alias.name) is not None
+
+
 def test_every_command_of_the_command_line_is_in_the_front_door():
     """Each command is a function of ``import gearcheck`` or a method of a Train session, which it calls."""
     from gearcheck.cli import _parser

@@ -291,6 +291,14 @@ def test_every_size_has_a_bound(argv, said, tmp_path, monkeypatch, capsys):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_long_run_is_said_before_it_starts(capsys):
+    from gearcheck.shared.errors import LongRunWarning
+    from gearcheck.shared.settings import RunSettings
+
+    with pytest.warns(LongRunWarning, match=r"is 1.5e\+07 steps: a run of minutes"):
+        assert RunSettings(0.15).check_work(1e-8, 10, "test model") == (15_000_000, 1)
+
+
 def test_a_damaged_history_store_is_one_line(tmp_path, capsys):
     import sqlite3
 

@@ -19,6 +19,7 @@ import os
 import re
 import signal
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -69,7 +70,7 @@ FLAGS = {  # a library error's Python parameter -> this command line's flag
     "samples": "--samples", "seed": "--seed", "harmonics": "--harmonics", "refine": "--refine", "workers": "--workers",
     "scheduler": "--scheduler", "speeds": "--speeds", "cache": "--cache", "fit": "--fit", "parameter": "--parameter",
     "orders": "--orders", "trust": "--trust", "data_root": "--data-root", "fps": "--fps",
-    "slow_motion": "--slow-motion", "magnify": "--magnify",
+    "slow_motion": "--slow-motion", "magnify": "--magnify", "output_dt": "--output-dt",
     # a parameter that the command line names otherwise: a repeatable flag gives one entry of its list or dict
     "fields": "--set", "distributions": "--vary", "parameters": "--parameter", "quantities": "--quantity"}
 _PARAMETER = re.compile(rf"(?<![.\]-])\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
@@ -81,9 +82,15 @@ def as_flags(message: str) -> str:
     return _PARAMETER.sub(lambda m: FLAGS[m[1]] + (" " if m[2] else ""), message)
 
 
+def _note(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as the command line says it: one line, ``gearcheck: note: ...``."""
+    print(f"gearcheck: note: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `gearcheck show | head`: end quietly, like other tools
     previous = signal.signal(signal.SIGTERM, _terminate)
+    shown_before, warnings.showwarning = warnings.showwarning, _note
     try:
         args = _parser().parse_args(argv)
         with granted(args.trust, args.data_root):
@@ -115,6 +122,7 @@ def main(argv: list[str] | None = None) -> int:
         return 70
     finally:
         signal.signal(signal.SIGTERM, previous)
+        warnings.showwarning = shown_before
 
 
 def _number(kind: str, positive: bool = True, minimum: float | None = None):

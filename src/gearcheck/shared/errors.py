@@ -39,6 +39,10 @@ class DivergenceError(SolverError):
         super().__init__(f"diverged at t = {time:.6g} s: {message}")
 
 
+class LongRunWarning(UserWarning):
+    """A run that will take minutes, said before it starts (the command line prints it as a note)."""
+
+
 def shown(value, width: int = 40) -> str:
     """A value as a message shows it: its repr cut to ``width`` characters, an integer too long to print in
     full (Python refuses past 4300 digits) by its size."""

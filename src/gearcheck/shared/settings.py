@@ -10,11 +10,13 @@ ramp and half the duration).  Every solver turns a step into the same sample gri
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
-from gearcheck.shared.errors import SolverError
+from gearcheck.shared.errors import LongRunWarning, SolverError
 
 MAX_STEPS = 2e8  # about an hour of the slowest solver: longer runs are refused, not started
+LONG_STEPS = 1e7  # a few minutes of the slowest solver: said before the run starts
 MAX_OUTPUT_BYTES = 4 * 2**30  # what one run may hold in memory for its samples
 
 
@@ -36,6 +38,9 @@ class RunSettings:
         _positive("duration", self.duration, False)
         _positive("dt", self.dt, True)
         _positive("output_dt", self.output_dt, True)
+        if self.output_dt is not None and self.output_dt > self.duration:
+            raise SolverError(f"output_dt={self.output_dt:g}: a sampling interval longer than the duration "
+                              f"{self.duration:g} s; sample at least once in the run")
         if self.settle is not None and not (isinstance(self.settle, (int, float)) and 0 <= self.settle
                                             and math.isfinite(self.settle)):
             raise SolverError(f"settle must be a number of seconds >= 0, got {self.settle!r}")
@@ -49,7 +54,8 @@ class RunSettings:
     def check_work(self, dt: float, columns: int, model: str) -> tuple[int, int]:
         """(steps, steps between samples) for the step ``dt``, refused before anything is allocated when the
         run would take more than ``MAX_STEPS`` steps or its ``columns`` sampled series more than
-        ``MAX_OUTPUT_BYTES``; ``model`` names the model in the message."""
+        ``MAX_OUTPUT_BYTES``, and a :class:`~gearcheck.shared.errors.LongRunWarning` past ``LONG_STEPS``; ``model``
+        names the model in the messages."""
         steps = self.duration / dt
         if steps > MAX_STEPS:
             raise SolverError(f"duration {self.duration:g} s at the step {dt:.4g} s of the {model} is {steps:.3g} "
@@ -60,6 +66,9 @@ class RunSettings:
             raise SolverError(f"duration {self.duration:g} s sampled every {every * dt:.4g} s would hold "
                               f"{size / 2**30:.1f} GiB of series of the {model} (at most {MAX_OUTPUT_BYTES / 2**30:g} "
                               "GiB): sample less often (output_dt) or shorten the duration")
+        if steps > LONG_STEPS:
+            warnings.warn(f"duration {self.duration:g} s at the step {dt:.4g} s of the {model} is {steps:.3g} steps: "
+                          "a run of minutes", LongRunWarning, stacklevel=2)
         return n_steps, every
 
     def settle_time(self, ramp: float) -> float:

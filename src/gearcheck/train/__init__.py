@@ -15,3 +15,10 @@
 It imports only :mod:`gearcheck.shared`; :mod:`gearcheck.lumped` and :mod:`gearcheck.mbd_models` both
 import it and never each other (the import contracts in ``pyproject.toml``).
 """
+
+from gearcheck.shared.public import public  # noqa: E402
+
+# the public names: the axial coordinate's name
+__all__, __getattr__, __dir__ = public(__name__, {
+    "AXIAL": "spec",
+})

@@ -14,6 +14,7 @@ import numpy as np
 
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.trust import named_code
+from gearcheck.train.expression import Expression
 from gearcheck.train.kinematics import Kinematics
 from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.mesh_stiffness import ConstantStiffness, stiffness_model
@@ -53,6 +54,8 @@ class Excitation:
         self.ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
         self._function = None  # the torque function, imported on first use (:meth:`torque_function`)
         self._profile = None if op.torque_profile is None else tuple(np.asarray(x) for x in op.torque_profile)
+        self._expression = None if op.torque_expression is None else \
+            Expression(op.torque_expression, f"{spec.path}: operating.torque_expression")
 
     # ------------------------------------------------------------------ meshes
     def mesh_position(self, t, mesh: int | None = None) -> np.ndarray:
@@ -111,7 +114,7 @@ class Excitation:
             times = self._profile[0]
             freqs.append(np.array([1.0 / (times[-1] - times[0])]))
         op = self.spec.operating
-        aperiodic = [f"the torque function {op.torque_function}"] if op.torque_function else []
+        aperiodic = [op.aperiodic_torque] if op.aperiodic_torque else []
         if op.ramp > 0:
             aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
         return np.concatenate(freqs), meshes, aperiodic
@@ -205,6 +208,8 @@ class Excitation:
                 t_out = t_out + t_out_mean * wave
         if op.torque_function:
             t_in = t_in + self.torque_function(t)
+        if op.torque_expression:
+            t_in = t_in + self._expression(t)
         if self._profile is not None:
             times, values = self._profile
             phase = times[0] + np.mod(t - times[0], times[-1] - times[0])

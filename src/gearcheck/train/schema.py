@@ -590,6 +590,9 @@ OPERATING = Table(
         "torque_function": Text("Python `module:function` f(t) -> N·m added to the input torque: code, run only "
                                 "with `--trust MODULE` (a table or `ripple` needs none)", None,
                                 pattern=r"[A-Za-z_][\w.]*:[A-Za-z_]\w*"),
+        "torque_expression": Text("f(t) -> N·m added to the input torque, written as an expression of t in s: "
+                                  "numbers, + - * / **, comparisons, sin cos tan exp log sqrt abs tanh sign floor "
+                                  "min max, pi, e (data, not code: no --trust)", None),
         "torque_csv": Text("CSV file (relative to the train file) of time [s], torque [N·m] added to the input "
                            "torque, repeated with the file's period", None),
         "ramp_s": NonNegative("duration of the smooth start-up ramp of the load torque (0 = start at the "

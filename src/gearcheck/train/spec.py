@@ -17,6 +17,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from gearcheck.train.expression import Expression
 from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, min_curvature_radius, palmgren_stiffness
 from gearcheck.train.files import read_text, read_toml
 from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
@@ -195,6 +196,19 @@ class Operating:
     torque_profile: tuple[tuple[float, ...], tuple[float, ...]] | None  # (times, torques) from torque_csv
     ramp: float
     input_torque: float | None = None  # N·m, as the train file gave it
+    torque_expression: str | None = None  # of t in s, N·m (gearcheck.train.expression)
+
+    @property
+    def torque_varies(self) -> bool:
+        """Whether a torque varies in time beyond the start-up ramp (ripple, a table, a function, an expression)."""
+        return bool(self.ripple or self.torque_function or self.torque_expression or self.torque_profile is not None)
+
+    @property
+    def aperiodic_torque(self) -> str | None:
+        """The added input torque that has no period (a function or an expression), in words; None if none."""
+        if self.torque_function:
+            return f"the torque function {self.torque_function}"
+        return f"the torque expression {self.torque_expression!r}" if self.torque_expression else None
 
 
 @dataclass(frozen=True)
@@ -398,9 +412,14 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         if cyc.contact_stiffness is None and not (op["output_torque"] or op["input_torque"]):
             raise fail(f"stages[{names.index(cyc.stage)}].cycloid.contact.stiffness",
                        "missing: give it, or a load (operating.output_torque) to linearise Palmgren's law at")
+    if op["torque_expression"] is not None:
+        try:
+            Expression(op["torque_expression"], "")(0.0)  # its grammar, and a finite value at the start
+        except GearcheckError as exc:
+            raise fail("operating.torque_expression", str(exc).removeprefix(": ")) from None
     operating = Operating(op["input_speed"], op["output_torque"] or 0.0, op["input_shaft_stiffness"],
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
-                          op["input_torque"])
+                          op["input_torque"], op["torque_expression"])
 
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,

@@ -138,15 +138,20 @@ def span_period(element: CycloidRows, span: str = "pitch") -> float:
     return 2.0 * math.pi / (pins * abs(rate))
 
 
+MAX_TIMES = 10_000  # frozen times: each is a static contact solution (some milliseconds)
+
+
 def pin_loads(model, times=None, *, span: str = "pitch", samples: int = 16, stage: str | None = None) -> PinLoads:
     """Static pin forces of every disc and pin at ``times`` (s), by default ``samples`` times evenly over one
     ``span`` (:func:`span_period`) from t = 0: each time frozen and solved statically under the mean load."""
     element = cycloid_element(model, stage)
     if times is None:
-        if samples < 1:
-            raise GearcheckError(f"samples={samples}: need at least one frozen time")
+        if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not 1 <= samples <= MAX_TIMES:
+            raise GearcheckError(f"samples={samples!r}: a whole number of frozen times from 1 to {MAX_TIMES}")
         times = np.arange(samples) * span_period(element, span) / samples
     times = np.atleast_1d(np.asarray(times, dtype=float))
+    if times.ndim != 1 or not 1 <= times.size <= MAX_TIMES or not np.all(np.isfinite(times)):
+        raise GearcheckError(f"times: 1 to {MAX_TIMES} finite times in s, got {times.size}")
     g = element.geometry
     n_discs, n_pins = len(element.disc), g.pins
     where = {f"{element.stage}.disc{j + 1}.pin{i + 1}": (j, i) for j in range(n_discs) for i in range(n_pins)}

@@ -319,7 +319,7 @@ OPTIONS = [
     (["sensitivity", "rv-reducer", "--parameter", "stages[0].sun.mass", "--speeds", "0:1000:3"],
      "--speeds: every speed must be a positive number of rpm, got 0"),
     (["pins", "demo-3p"], "demo-3p has no cycloid-pin stage"),
-    (["pins", "rv-reducer", "--samples", "0"], "--samples 0: need at least one frozen time"),
+    (["pins", "rv-reducer", "--samples", "0"], "--samples 0: a whole number of frozen times from 1 to 10000"),
 ]
 
 

@@ -143,6 +143,17 @@ def test_a_fifo_or_a_device_is_refused_without_blocking(tmp_path, capsys):
             "/dev/zero: is not a regular file")
 
 
+@pytest.mark.parametrize("argv", [["stiffness", "demo-3p", "-o"], ["animate", "demo-3p", "--duration", "0.2", "-o"],
+                                  ["mjcf", "demo-3p", "-o"]], ids=["png", "gif", "xml"])
+def test_an_output_file_that_is_a_device_or_fifo_is_never_replaced(argv, tmp_path, capsys):
+    """As root, ``-o /dev/null`` replaced the device node with a PNG (found by the option probe): a file output
+    must be a regular file or nothing.  A FIFO stands in for the device here."""
+    fifo = tmp_path / ("out" + {"stiffness": ".png", "animate": ".gif", "mjcf": ".xml"}[argv[0]])
+    os.mkfifo(fifo)
+    refused(argv + [fifo], capsys, "is not a regular file (a device, FIFO or socket); gearcheck writes files")
+    assert fifo.is_fifo() and sorted(p.name for p in tmp_path.iterdir()) == [fifo.name]
+
+
 def npz_declaring(shape, dtype="<f8") -> bytes:
     """An .npz whose one member's header declares ``shape`` but holds 64 bytes."""
     header = {"descr": dtype, "fortran_order": False, "shape": shape}
@@ -276,7 +287,10 @@ def test_a_side_that_returns_garbage_is_one_line(capsys):
 @pytest.mark.parametrize("argv, said", [
     (["animate", "demo-3p", "--fps", "1e9", "-o", "a.gif"], "--fps 1000000000.0: a positive playback length and a "
                                                              "frame rate from 0 to 120"),
-    (["animate", "demo-3p", "--duration", "1e9", "-o", "a.gif"], "15000000000 frames, more than the 1800"),
+    (["animate", "demo-3p", "--duration", "1e9", "-o", "a.gif"], "1.5e+10 frames, more than the 1800"),
+    (["animate", "demo-3p", "--duration", "1e308", "-o", "a.gif"], "inf frames, more than the 1800"),
+    (["pins", "rv-reducer", "--samples", "99999999999999999999", "-o", "p.png"],
+     "--samples 99999999999999999999: a whole number of frozen times from 1 to 10000"),
     (["animate", "demo-3p", "--slow-motion", "1e-9", "-o", "a.gif"], "steps, more than the 2e+08"),
     (["sensitivity", "rv-reducer", "--parameter", "stages[0].sun.mass", "--orders", "100000", "100000"],
      "complex unknowns (coordinates times harmonics), more than the 20000"),
@@ -284,10 +298,13 @@ def test_a_side_that_returns_garbage_is_one_line(capsys):
     (["sweep", "demo-3p", "--set", "stages[0].sun.mass=1:2:100000", "--set", "stages[0].planet.mass=1:2:100000"],
      "10000000000 points: more than the 100000 a sweep holds"),
     (["crosscheck", "demo-3p", "--history", "h.sqlite", "--commit", "abc\ndef"], "commit id 'abc\\ndef': one line"),
-], ids=["fps", "frames", "steps", "orders", "orders-zero", "grid", "commit-newline"])
+    (["sweep", "demo-3p", "--speeds", "1000,1100", "--out", ""], "--out: give a path, not an empty string"),
+], ids=["fps", "frames", "frames-inf", "pin-times", "steps", "orders", "orders-zero", "grid", "commit-newline",
+        "empty-out"])
 def test_every_size_has_a_bound(argv, said, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    refused(argv + ["--out", "o"] if argv[0] in ("sweep", "sensitivity", "crosscheck") else argv, capsys, said)
+    needs_out = argv[0] in ("sweep", "sensitivity", "crosscheck") and "--out" not in argv
+    refused(argv + ["--out", "o"] if needs_out else argv, capsys, said)
     assert list(tmp_path.iterdir()) == []
 
 

@@ -13,10 +13,12 @@ carrier), each slide at zero.  Translations thus show the whole deflection, rota
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import shutil
 import subprocess
+import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -32,6 +34,7 @@ from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.outputs import check_place, write_file
 from gearcheck.shared.settings import MAX_STEPS
 
 MODE_SIZE = 0.05  # a mode shape's largest point displacement, as a fraction of the model's extent
@@ -55,6 +58,7 @@ def check_output(path) -> Path:
         raise GearcheckError(f"{path}: writing MP4 needs ffmpeg on PATH, which is missing; write a .gif instead")
     if suffix not in (".gif", ".mp4"):
         raise GearcheckError(f"{path}: an animation is written as .gif or .mp4, not {suffix or 'no suffix'!r}")
+    check_place(path, "-o", folder=False)
     return path
 
 
@@ -182,17 +186,23 @@ def _overlay(pixels: np.ndarray, lines: list[str], trace: np.ndarray | None = No
 
 
 def _write(path: Path, frames: list[Image.Image], fps: float) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
+    """The frames as a GIF (Pillow) or an MP4 (ffmpeg), written whole or not at all (:func:`write_file`)."""
     if path.suffix.lower() == ".gif":
         palette = frames[0].quantize(colors=255, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
         first, *rest = (f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames)
-        first.save(path, save_all=True, append_images=rest, duration=round(1000 / fps), loop=0, optimize=False)
+        sink = io.BytesIO()
+        first.save(sink, format="GIF", save_all=True, append_images=rest, duration=round(1000 / fps), loop=0,
+                   optimize=False)
+        write_file(path, sink.getvalue())
         return path
     w, h = frames[0].size
-    cmd = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}",
-           "-r", f"{fps:g}", "-i", "-", "-pix_fmt", "yuv420p", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-           "-vcodec", "libx264", "-bitexact", str(path)]
-    subprocess.run(cmd, input=b"".join(f.tobytes() for f in frames), check=True)
+    with tempfile.TemporaryDirectory() as folder:
+        video = Path(folder) / "animation.mp4"
+        cmd = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}",
+               "-r", f"{fps:g}", "-i", "-", "-pix_fmt", "yuv420p", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+               "-vcodec", "libx264", "-bitexact", str(video)]
+        subprocess.run(cmd, input=b"".join(f.tobytes() for f in frames), check=True)
+        write_file(path, video.read_bytes())
     return path
 
 
@@ -209,11 +219,11 @@ def _frames(duration: float, fps: float, width: int, height: int) -> int:
     for name, side in (("width", width), ("height", height)):
         if isinstance(side, bool) or not isinstance(side, (int, np.integer)) or not 16 <= side <= MAX_SIDE:
             raise GearcheckError(f"{name}={side!r}: a whole number of pixels from 16 to {MAX_SIDE}")
-    n = max(1, round(duration * fps))
-    if n > MAX_FRAMES:
-        raise GearcheckError(f"duration={duration:g} s at fps={fps:g} is {n} frames, more than the {MAX_FRAMES} an "
-                             "animation holds in memory: shorten it or lower the frame rate")
-    return n
+    frames = duration * fps
+    if not frames < MAX_FRAMES + 0.5:
+        raise GearcheckError(f"duration={duration:g} s at fps={fps:g} is {frames:.3g} frames, more than the "
+                             f"{MAX_FRAMES} an animation holds in memory: shorten it or lower the frame rate")
+    return max(1, round(frames))
 
 
 def _factor(name: str, value: float) -> float:

@@ -141,6 +141,13 @@ def _number(kind: str, positive: bool = True, minimum: float | None = None):
 
 
 SECONDS, RPM, HZ = _number("seconds"), _number("rpm"), _number("Hz")
+
+
+def PATH(text: str) -> Path:
+    """An argparse type: a path, not an empty string (which names the current folder by accident)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("give a path, not an empty string")
+    return Path(text)
 RPM_OR_ZERO = _number("rpm >= 0", positive=False, minimum=0.0)
 
 
@@ -748,7 +755,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="N input speeds from A to B rpm (0 <= A < B, N >= 2)"),
         arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both"),
         arg("--harmonics", type=int, default=3, metavar="H", help="mesh harmonics drawn (default 3)"),
-        arg("--out", type=Path, default=Path("out/campbell"), metavar="DIR",
+        arg("--out", type=PATH, default=Path("out/campbell"), metavar="DIR",
             help="writes campbell.png and campbell.json (default out/campbell)"),
     ),
     "mac": Command(
@@ -758,7 +765,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--model", metavar="MODEL",
             help="your model: a .mat/.npz file of matrices, module:factory or file.py:factory"),
         arg("--against", default="lumped", choices=("lumped", "mujoco"), help="what --model is paired with"),
-        arg("--out", type=Path, default=Path("out/mac"), metavar="DIR",
+        arg("--out", type=PATH, default=Path("out/mac"), metavar="DIR",
             help="writes mac.png and mac.json (default out/mac)"),
     ),
     "ste": Command(
@@ -768,7 +775,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="also the loaded STE peak-to-peak for N tip relief amounts from A to B um (every tip relief of the "
                  "train, lengths as given)"),
         arg("--slices", type=int, metavar="N", help="slices across a helical face (default 400)"),
-        arg("--out", type=Path, default=Path("out/ste"), metavar="DIR",
+        arg("--out", type=PATH, default=Path("out/ste"), metavar="DIR",
             help="writes ste.png, ste.json (and relief_sweep.png) (default out/ste)"),
     ),
     "run": Command(
@@ -783,7 +790,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--format", choices=("parquet", "csv"), default="parquet",
             help="time series file format: parquet (default: full precision, compressed, units in its metadata) or "
                  "csv"),
-        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+        arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "crosscheck": Command(
         cmd_crosscheck, "run both solvers, compare them, write a report; exit 1 when a tolerance is exceeded or a "
@@ -801,40 +808,40 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
                         "file.py:factory, or 'user' (the train file's train.user_model), checked against --against"),
         arg("--against", default="lumped", choices=("lumped", "mujoco"),
             help="what your own model is checked against: the reference lumped model (default) or the MuJoCo twin"),
-        arg("--results", type=Path, metavar="FILE",
+        arg("--results", type=PATH, metavar="FILE",
             help="another solver's time series as the model checked (.csv, .parquet, .mat)"),
-        arg("--columns", type=Path, metavar="FILE", help="TOML map of --results' columns to signals"),
-        arg("--modes", type=Path, metavar="FILE",
+        arg("--columns", type=PATH, metavar="FILE", help="TOML map of --results' columns to signals"),
+        arg("--modes", type=PATH, metavar="FILE",
             help="with --results: its natural frequencies and mode shapes (.npz, .mat, .csv)"),
         arg("--dt-lumped", type=SECONDS, metavar="S", help="lumped RK4 step (default: derived)"),
         arg("--dt-mujoco", type=SECONDS, metavar="S", help="MuJoCo step (default: derived)"),
-        arg("--tolerances", type=Path, metavar="FILE", help="TOML file with a [tolerances] table"),
+        arg("--tolerances", type=PATH, metavar="FILE", help="TOML file with a [tolerances] table"),
         arg("--sensor-band", type=HZ, nargs=2, metavar=("LOW", "HIGH"),
             help="accelerometer chain: band-pass both solvers' accelerations to LOW-HIGH Hz"),
-        arg("--measurements", type=Path, metavar="FILE", help="TOML file with [[measurements]]"),
+        arg("--measurements", type=PATH, metavar="FILE", help="TOML file with [[measurements]]"),
         arg("--baseline", type=str, metavar="FILE", nargs="?", const="shipped",
             help="compare with a stored baseline (without FILE: the shipped one of the preset)"),
         arg("--update-baseline", action="store_true", help="rewrite the baseline instead of checking it"),
-        arg("--junit", type=Path, metavar="FILE",
+        arg("--junit", type=PATH, metavar="FILE",
             help="also write the verdicts as JUnit XML: a testcase per gated quantity and mode, for any CI"),
-        arg("--history", type=Path, metavar="STORE",
+        arg("--history", type=PATH, metavar="STORE",
             help="append each run's metrics, versions and wall times to this history store (SQLite), one record per "
                  "commit and train (a rerun replaces it); draw it with `gearcheck dashboard`"),
         arg("--commit", metavar="SHA",
             help="the commit --history records (default: $GITHUB_SHA, else `git rev-parse HEAD` here)"),
-        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+        arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "calibrate": Command(
         cmd_calibrate, "least-squares fit of train-file parameters to measured amplitudes",
         TRAIN,
         arg("--fit", action="append", required=True, metavar="PATH[=LOW:HIGH]",
             help="a train-file field in its own units, e.g. stages[0].mesh.ste[0].amplitude_um=0.05:20"),
-        arg("--measurements", type=Path, metavar="FILE",
+        arg("--measurements", type=PATH, metavar="FILE",
             help="TOML file with [[measurements]] (default: the train file's)"),
         arg("--fit-speed", type=RPM, action="append", metavar="RPM",
             help="use only the measurements at this speed for the fit; the others are predicted"),
         arg("--duration", type=SECONDS, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)"),
-        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+        arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "sweep": Command(
         cmd_sweep, "speed sweeps, parameter studies and Monte Carlo: many runs reduced to one Parquet table of "
@@ -848,7 +855,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--vary", action="append", default=[], metavar="FIELD=DIST",
             help="Monte Carlo: a field's distribution, normal(mean,sd), uniform(low,high) or "
                  "lognormal(median,factor) (repeatable)"),
-        arg("--distributions", type=Path, metavar="FILE",
+        arg("--distributions", type=PATH, metavar="FILE",
             help="Monte Carlo: a TOML file with a [distributions] table, \"FIELD\" = \"normal(mean, sd)\""),
         arg("--samples", type=int, metavar="N", help="Monte Carlo draws (default 32)"),
         arg("--seed", type=int, default=0, metavar="S", help="Monte Carlo seed (default 0)"),
@@ -865,13 +872,13 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="local worker processes (default: the cores available; 1 runs in this process)"),
         arg("--scheduler", metavar="ADDRESS",
             help="run the points on a Dask distributed cluster, e.g. tcp://scheduler.example.org:8786"),
-        arg("--cache", type=Path, metavar="DIR",
+        arg("--cache", type=PATH, metavar="DIR",
             help="finished points, one Parquet file per input hash: a rerun skips them (default OUT.cache)"),
         arg("--no-cache", action="store_true", help="keep no cache"),
         arg("--quantity", action="append", metavar="NAME",
             help="a quantity to plot (repeatable; default: carrier and ring accelerations and the first sun and ring "
                  "mesh forces of each stage)"),
-        arg("--out", type=Path, default=Path("out/sweep"), metavar="DIR",
+        arg("--out", type=PATH, default=Path("out/sweep"), metavar="DIR",
             help="writes sweep.parquet, sweep.json and the figures (default out/sweep)"),
     ),
     "sensitivity": Command(
@@ -889,7 +896,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="harmonics kept per clock (mesh, then an RV reducer's eccentrics), default 3 2"),
         arg("--speeds", type=SPEED_RANGE, metavar="A:B:N",
             help="a map over input speeds (rpm) instead of the train's speed"),
-        arg("--out", type=Path, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
+        arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "pins": Command(
         cmd_pins, "an RV reducer's static pin loads over a pin pitch or an eccentric turn (PNG)",
@@ -897,18 +904,18 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--span", choices=("pitch", "turn"), default="pitch",
             help="frozen configurations over one pin pitch (default) or a whole turn of the eccentrics"),
         arg("--samples", type=int, default=16, metavar="N", help="frozen times (default 16)"),
-        arg("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-pins.png)"),
+        arg("-o", "--output", type=PATH, metavar="FILE", help="PNG file (default out/TRAIN-pins.png)"),
     ),
     "stiffness": Command(
         cmd_stiffness, "plot the mesh stiffness over the mesh cycle (PNG)",
         TRAIN,
-        arg("-o", "--output", type=Path, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)"),
+        arg("-o", "--output", type=PATH, metavar="FILE", help="PNG file (default out/TRAIN-stiffness.png)"),
     ),
     "animate": Command(
         cmd_animate, "render the MuJoCo twin running (or a mode shape) offscreen as a GIF or MP4, vibration "
                      "magnified, with time and mesh-force overlays",
         TRAIN,
-        arg("-o", "--output", type=Path, required=True, metavar="FILE", help="the .gif (or .mp4, with ffmpeg)"),
+        arg("-o", "--output", type=PATH, required=True, metavar="FILE", help="the .gif (or .mp4, with ffmpeg)"),
         arg("--duration", type=SECONDS, default=4.0, metavar="S", help="playback length (default 4 s)"),
         arg("--fps", type=float, default=15.0, metavar="N", help="frames per second (default 15)"),
         arg("--slow-motion", type=float, default=100.0, metavar="X",
@@ -928,20 +935,20 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
     "dashboard": Command(
         cmd_dashboard, "draw a history store as a static site: each metric over commits with its tolerance and "
                        "change points, wall times, what changed last",
-        arg("store", type=Path, metavar="STORE", help="the history store (crosscheck --history)"),
-        arg("-o", "--output", type=Path, default=Path("site"), metavar="DIR",
+        arg("store", type=PATH, metavar="STORE", help="the history store (crosscheck --history)"),
+        arg("-o", "--output", type=PATH, default=Path("site"), metavar="DIR",
             help="the site's folder (default site/); open DIR/index.html"),
     ),
     "export": Command(
         cmd_export, "write the reference lumped model as a file of matrices (.mat or .npz): the layout --model "
                     "reads, with every convention of gearcheck's coordinates",
         TRAIN,
-        arg("-o", "--output", type=Path, required=True, metavar="FILE", help="output .mat or .npz file"),
+        arg("-o", "--output", type=PATH, required=True, metavar="FILE", help="output .mat or .npz file"),
     ),
     "mjcf": Command(
         cmd_mjcf, "write the MuJoCo model (MJCF) of a train",
         TRAIN,
-        arg("-o", "--output", type=Path, metavar="FILE", help="output file (default: standard output)"),
+        arg("-o", "--output", type=PATH, metavar="FILE", help="output file (default: standard output)"),
     ),
 }
 

@@ -49,6 +49,8 @@ def check_place(out: Path, what: str, folder: bool = True) -> None:
     named = f"{what}{out}" if what.endswith("=") else f"{what} {out}"
     if out.exists() and out.is_dir() != folder:
         raise GearcheckError(f"{named}: exists and is {'a folder' if out.is_dir() else 'not a folder'}")
+    if not folder and out.exists() and not out.is_file():  # replaced whole, a device node would be gone
+        raise GearcheckError(f"{named}: is not a regular file (a device, FIFO or socket); gearcheck writes files")
     ancestor = out.absolute().parent
     while not ancestor.exists():
         ancestor = ancestor.parent

@@ -85,6 +85,12 @@ from gearcheck.shared.results import TimeResult
 from gearcheck.shared.trust import allow_data, trust
 
 __version__ = metadata.version("gearcheck")
+_PACKAGES = ("train", "lumped", "mbd_models", "compare", "shared")
+
+
+def __dir__() -> list[str]:
+    """The front door and the packages beneath it, not the modules this file imports (``os``, ``metadata``)."""
+    return sorted({*__all__, *_PACKAGES})
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "GearcheckError", "LinearModel", "Mesh",
            "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",

@@ -300,6 +300,7 @@ OPTIONS = [
      "baseline of demo-3p was taken at 1500 rpm over 0.05 s"),
     (["crosscheck", "demo-3p", "--tolerances", "none.toml"], "none.toml: no such tolerances file"),
     (["crosscheck", "no-such-train"], "no-such-train: no such train file or preset"),
+    (["show", "demo3p"], "demo3p: no such train file or preset (did you mean 'demo-3p'?)"),
     (["calibrate", "demo-3p", "--fit", "stages[0].mass"], "calibrate needs measurements"),
     (["calibrate", "hub-drive", "--fit", "stages[0].nothing"], "--fit stages[0].nothing: no such field"),
     (["calibrate", "hub-drive", "--fit", "stages[0].mesh.ste[0].amplitude_um=5:1"], "need 0 < LOW < HIGH"),

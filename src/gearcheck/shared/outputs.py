@@ -159,9 +159,16 @@ class OutputDirectory:
         self._lock.truncate()
         self._lock.write(str(os.getpid()))
         self._lock.flush()
-        with _signals_deferred():
-            for line in _clear_leftovers(self.out):
-                print(f"gearcheck: {self.given}: {line}", file=sys.stderr)
+        try:
+            with _signals_deferred():
+                for line in _clear_leftovers(self.out):
+                    print(f"gearcheck: {self.given}: {line}", file=sys.stderr)
+        except BaseException as exc:  # entered no further: the lock goes with it
+            self._lock.close()
+            if isinstance(exc, OSError):
+                raise GearcheckError(f"{self.what} {self.given}: what a killed run left beside it cannot be cleared "
+                                     f"({exc.strerror or exc})") from None
+            raise
         return self
 
     @property

@@ -14,7 +14,7 @@ from gearcheck.train import schema
 from gearcheck.train.files import parse_toml, read_text
 from gearcheck.train.kinematics import kinematics
 from gearcheck.train.spec import TrainSpec, build_spec
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean
 from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
 
 PRESET_PACKAGE = "gearcheck.train.presets"
@@ -61,6 +61,6 @@ def read_train_text(train: str | Path) -> tuple[str, str]:
         return preset_text(name), f"preset:{name}"
     path = Path(name)
     if not path.exists():
-        known = ", ".join(preset_names())
-        raise GearcheckError(f"{name}: no such train file or preset (presets: {known})")
+        raise GearcheckError(f"{name}: no such train file or preset"
+                             + did_you_mean(name, preset_names(), "presets", cutoff=0.7))
     return read_text(path, "train file"), str(path)

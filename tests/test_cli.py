@@ -1,12 +1,14 @@
 """The command line: listing, showing, modes as JSON, a lumped run writing its files."""
 
 import json
+import re
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from gearcheck.cli import main
+from gearcheck.train.loader import preset_text
 from gearcheck.shared.results import units_of
 
 
@@ -51,3 +53,12 @@ def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
     np.testing.assert_allclose(csv.to_numpy(), df.to_numpy(), rtol=1e-8, atol=1e-12 * np.abs(df.to_numpy()).max())
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["solver"] == "lumped" and summary["info"]["method"] == "rk4"
+
+
+def test_show_leaves_out_a_source_the_file_does_not_give(tmp_path, capsys):
+    text = preset_text("demo-3p")
+    path = tmp_path / "t.toml"
+    path.write_text(re.sub(r'^source = .*$', 'source = ""', text, count=1, flags=re.M), encoding="utf-8")
+    assert main(["show", str(path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == f"  file: {path}" and not any("source:" in line for line in lines)

@@ -227,7 +227,7 @@ def cmd_show(args) -> int:
         print(json.dumps(info, indent=2))
         return 0
     print(f"{info['train']}: {info['description']}")
-    print(f"  source: {info['source']}    file: {info['file']}")
+    print(f"  source: {info['source']}    file: {info['file']}" if info["source"] else f"  file: {info['file']}")
     if info["references"]:
         print("  references: " + ", ".join(info["references"]))
     print(f"  input {info['input']} at {info['input_speed_rpm']:.6g} rpm, {info['input_torque_nm']:.6g} N·m; "

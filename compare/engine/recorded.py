@@ -46,7 +46,7 @@ import pandas as pd
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.files import MAX_DATA_BYTES, read_arrays, read_bytes, read_toml
 from gearcheck.lumped.modal import central_coordinates
-from gearcheck.shared.errors import GearcheckError, TrainFileError, UnsupportedError, did_you_mean, shown
+from gearcheck.shared.errors import GearcheckError, TrainFileError, UnsupportedError, did_you_mean, one_line, shown
 from gearcheck.shared.modal import ModalResult, energy_fractions, mode_types, multiplicities, rigid_or_elastic
 from gearcheck.shared.results import TimeResult, train_signals
 from gearcheck.shared.settings import RunSettings
@@ -327,9 +327,9 @@ def _read_table(path: Path, suffixes: tuple[str, ...]) -> dict:
     try:
         frame = pd.read_csv(stream, skipinitialspace=True) if suffix == ".csv" else pd.read_parquet(stream)
     except ImportError as exc:
-        raise TrainFileError(source, "", f"cannot read {suffix} files: {_one_line(exc)}") from None
+        raise TrainFileError(source, "", f"cannot read {suffix} files: {one_line(exc)}") from None
     except Exception as exc:  # pandas and pyarrow raise many kinds on a damaged file
-        raise TrainFileError(source, "", f"cannot be read as {suffix}: {_one_line(exc)}") from None
+        raise TrainFileError(source, "", f"cannot be read as {suffix}: {one_line(exc)}") from None
     return {str(c): frame[c].to_numpy() for c in frame.columns}
 
 
@@ -375,10 +375,6 @@ def _field(source: str, name: str) -> str:
 def _key(name) -> str:
     return f'signals."{name}"'
 
-
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text if len(text) <= 200 else text[:197] + "..."
 
 
 class RecordedSide(Side):

@@ -20,7 +20,7 @@ import numpy as np
 from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.matrix_file import SUFFIXES, read_matrix_file
 from gearcheck.lumped.side import LinearSide
-from gearcheck.shared.errors import GearcheckError, shown
+from gearcheck.shared.errors import GearcheckError, one_line, shown
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.side import Side
@@ -121,7 +121,7 @@ class AdoptedSide(Side):
                 raise
             except (Exception, SystemExit) as exc:  # the user's code, failing in its own way (sys.exit too)
                 raise GearcheckError(f"model={self.given}: its {name}() raised {type(exc).__name__}: "
-                                     f"{' '.join(str(exc).split())[:200]}") from None
+                                     f"{one_line(exc)}") from None
             if not check(value):
                 raise GearcheckError(f"model={self.given}: its {name}() returned {shown(value)}, not {words}")
             return value

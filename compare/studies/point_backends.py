@@ -19,7 +19,7 @@ import sys
 import threading
 import time
 
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, one_line
 from gearcheck.shared.trust import GRANTS
 
 CONNECT_TIMEOUT = "10s"  # to a Dask scheduler
@@ -173,8 +173,7 @@ def connect(scheduler):
     try:
         return distributed.Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False), True
     except Exception as exc:  # OSError, TimeoutError, ValueError: whatever stops the connection
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise GearcheckError(f"scheduler={scheduler}: cannot reach the Dask scheduler ({reason})") from None
+        raise GearcheckError(f"scheduler={scheduler}: cannot reach the Dask scheduler ({one_line(exc)})") from None
 
 
 def run_dask(run, pending, scheduler, finished) -> None:

@@ -33,7 +33,7 @@ from gearcheck.compare.presentation.progress import ProgressBar
 from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.presentation.summary import summary_row, write_summary
 from gearcheck.shared.citations import REFERENCES
-from gearcheck.shared.errors import GearcheckError, did_you_mean
+from gearcheck.shared.errors import GearcheckError, did_you_mean, one_line
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
 from gearcheck.shared.trust import granted
 from gearcheck.shared.units import checked_rpm
@@ -116,9 +116,8 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # a fault of gearcheck's own that an input found: one line, and how to see the rest
         if os.environ.get("GEARCHECK_DEBUG"):
             raise
-        print(f"gearcheck: error: internal error, {type(exc).__name__}: {' '.join(str(exc).split())[:300]} (a bug "
-              "in gearcheck: please report it with the command; GEARCHECK_DEBUG=1 shows the traceback)",
-              file=sys.stderr)
+        print(f"gearcheck: error: internal error, {type(exc).__name__}: {one_line(exc, 300)} (a bug in gearcheck: "
+              "please report it with the command; GEARCHECK_DEBUG=1 shows the traceback)", file=sys.stderr)
         return 70
     finally:
         signal.signal(signal.SIGTERM, previous)

@@ -43,6 +43,12 @@ class LongRunWarning(UserWarning):
     """A run that will take minutes, said before it starts (the command line prints it as a note)."""
 
 
+def one_line(exc: BaseException, width: int = 200) -> str:
+    """An exception's message as one line of at most ``width`` characters (its type's name when it has none)."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= width else text[:width - 3] + "..."
+
+
 def shown(value, width: int = 40) -> str:
     """A value as a message shows it: its repr cut to ``width`` characters, an integer too long to print in
     full (Python refuses past 4300 digits) by its size."""

@@ -24,7 +24,7 @@ import os
 from contextlib import contextmanager
 from pathlib import Path
 
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, one_line
 
 TRUST = "GEARCHECK_TRUST"
 DATA_ROOTS = "GEARCHECK_DATA_ROOTS"
@@ -110,11 +110,8 @@ def named_code(reference: str, label: str, from_file: bool):
             module = importlib.import_module(where)
     except GearcheckError:
         raise
-    except BaseException as exc:  # the user's code may fail in any way while it loads, SystemExit too
-        if isinstance(exc, KeyboardInterrupt):
-            raise
-        raise GearcheckError(f"{label}: importing {where} failed: {type(exc).__name__}: "
-                             f"{str(exc).splitlines()[0] if str(exc) else ''}") from None
+    except (Exception, SystemExit) as exc:  # the user's code may fail in any way while it loads, sys.exit too
+        raise GearcheckError(f"{label}: importing {where} failed: {type(exc).__name__}: {one_line(exc)}") from None
     obj = getattr(module, name, None)
     if not callable(obj):
         raise GearcheckError(f"{label}: {where} has no callable {name!r}")

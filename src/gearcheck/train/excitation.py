@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, one_line, shown
 from gearcheck.shared.trust import named_code
 from gearcheck.train.expression import Expression
 from gearcheck.train.kinematics import Kinematics
@@ -132,12 +132,12 @@ class Excitation:
             try:
                 value = self._function(float(time))
             except (Exception, SystemExit) as exc:  # a wrong signature, or an error inside the user's function
-                raise GearcheckError(f"{label}: {ref}({float(time)!r}) raised {type(exc).__name__}: {exc} (it must "
-                                     "map a time in s to a torque in N·m)") from None
+                raise GearcheckError(f"{label}: {ref}({float(time)!r}) raised {type(exc).__name__}: {one_line(exc)} "
+                                     "(it must map a time in s to a torque in N·m)") from None
             if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
                     or not math.isfinite(value):
-                raise GearcheckError(f"{label}: {ref}({float(time)!r}) returned {value!r}; it must return a finite "
-                                     "torque in N·m")
+                raise GearcheckError(f"{label}: {ref}({float(time)!r}) returned {shown(value)}; it must return a "
+                                     "finite torque in N·m")
             values.append(float(value))
         return np.reshape(values, np.shape(t))
 

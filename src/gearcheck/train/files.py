@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gearcheck.shared.errors import GearcheckError, TrainFileError
+from gearcheck.shared.errors import GearcheckError, TrainFileError, one_line
 
 MAX_BYTES = 16 * 1024 * 1024
 """Text files (train, measurements, torque tables, baselines): the largest shipped train file is some 10 kB."""
@@ -91,8 +91,7 @@ def read_arrays(path: str | Path, what: str, limit: int = MAX_DATA_BYTES, **load
     except NotImplementedError:  # MATLAB v7.3 files are HDF5
         raise TrainFileError(str(path), "", "a MATLAB v7.3 (HDF5) file: save it with save(..., '-v7')") from None
     except Exception as exc:  # the readers raise many kinds on a damaged file
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise TrainFileError(str(path), "", f"cannot be read as {path.suffix}: {first}") from None
+        raise TrainFileError(str(path), "", f"cannot be read as {path.suffix}: {one_line(exc)}") from None
 
 
 def _npz_sizes(stream, path: Path) -> int:

@@ -20,7 +20,7 @@ import threading
 import time
 
 from gearcheck.shared.errors import GearcheckError, one_line
-from gearcheck.shared.trust import GRANTS
+from gearcheck.shared import trust
 
 CONNECT_TIMEOUT = "10s"  # to a Dask scheduler
 
@@ -31,11 +31,7 @@ def _worker_init(grants: dict[str, str | None], parent: int) -> None:
     children they are, then ends too); they run with the parent's grants (:mod:`gearcheck.shared.trust`), whatever
     the fork server's environment was when it started."""
     threading.Thread(target=_end_with, args=(parent,), daemon=True, name="end with the parent").start()
-    for variable, value in grants.items():
-        if value is None:
-            os.environ.pop(variable, None)
-        else:
-            os.environ[variable] = value
+    trust.restore(grants)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked since the fork server (_workers_starting)
 
@@ -65,8 +61,8 @@ def run_pool(run, pending, workers: int, finished) -> None:
 
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload([run.__module__])
-    grants = {variable: os.environ.get(variable) for variable in GRANTS}
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init, initargs=(grants, os.getpid()))
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init,
+                               initargs=(trust.grants(), os.getpid()))
     _closed_pipes_raise()
     try:
         run_futures(pool, run, pending, finished, start=_workers_starting)

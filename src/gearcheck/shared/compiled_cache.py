@@ -9,11 +9,11 @@ kernels compile there once per machine instead.
 
 from __future__ import annotations
 
-import contextlib
 import os
-import stat
 import tempfile
 from pathlib import Path
+
+from gearcheck.shared.outputs import private_folder
 
 
 def _writable(folder: Path) -> bool:
@@ -35,10 +35,7 @@ def ensure_cache_folder(sources: Path) -> Path | None:
             _writable(Path(AppDirs(appname="numba", appauthor=False).user_cache_dir)):
         return None
     folder = Path(tempfile.gettempdir()) / f"gearcheck-numba-{os.getuid()}"
-    with contextlib.suppress(OSError):
-        folder.mkdir(mode=0o700)
-    info = os.lstat(folder) if os.path.lexists(folder) else None
-    if info is None or not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid() or info.st_mode & 0o022:
+    if not private_folder(folder):
         folder = Path(tempfile.mkdtemp(prefix="gearcheck-numba-"))  # that one is not this user's own: a new one
     config.CACHE_DIR = str(folder)
     return folder

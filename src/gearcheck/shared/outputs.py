@@ -63,19 +63,27 @@ def check_place(out: Path, what: str, folder: bool = True) -> None:
         raise GearcheckError(f"{named}: {ancestor} is not writable ({exc.strerror or exc})") from None
 
 
+def private_folder(folder: Path) -> bool:
+    """Make ``folder`` (mode 0700) if it is missing; whether it is a real folder of this user's that nobody else
+    may write (a folder or link planted there by another user is never taken)."""
+    with contextlib.suppress(OSError):
+        folder.mkdir(mode=0o700)
+    try:
+        info = os.lstat(folder)
+    except OSError:
+        return False
+    return stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and not info.st_mode & 0o022
+
+
 def lock_folder() -> Path:
     """The user's own folder of output locks: ``$XDG_RUNTIME_DIR/gearcheck``, else ``gearcheck-UID`` in the
-    system's temporary folder; made mode 0700 and refused unless it is a real folder of this user's that nobody
-    else may write (a folder or link planted there by another user is never followed)."""
+    system's temporary folder; refused unless it is a :func:`private_folder`."""
     runtime = os.environ.get("XDG_RUNTIME_DIR")
     if runtime and os.path.isdir(runtime):
         folder = Path(runtime) / "gearcheck"
     else:
         folder = Path(tempfile.gettempdir()) / f"gearcheck-{os.getuid()}"
-    with contextlib.suppress(FileExistsError):
-        folder.mkdir(mode=0o700)
-    info = os.lstat(folder)
-    if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid() or info.st_mode & 0o022:
+    if not private_folder(folder):
         raise GearcheckError(f"{folder}: the folder for gearcheck's locks is not a private folder of this user "
                              "(a link, or another user's, or writable by others): remove it")
     return folder

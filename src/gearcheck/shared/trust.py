@@ -62,30 +62,41 @@ def allow_data(*folders: str | os.PathLike) -> None:
     _grant(DATA_ROOTS, entries)
 
 
+def grants() -> dict[str, str | None]:
+    """The grants in force, as :func:`restore` takes them (a sweep hands them to its workers)."""
+    return {variable: os.environ.get(variable) for variable in GRANTS}
+
+
+def restore(given: dict[str, str | None]) -> None:
+    """Put the grants of :func:`grants` in force, and only them."""
+    for variable, value in given.items():
+        if value is None:
+            os.environ.pop(variable, None)
+        else:
+            os.environ[variable] = value
+
+
 @contextmanager
 def granted(modules=(), folders=()):
     """:func:`trust` ``modules`` and :func:`allow_data` ``folders`` while the block runs (the command line's
     ``--trust`` and ``--data-root``); the grants before it afterwards."""
-    before = {v: os.environ.get(v) for v in GRANTS}
+    before = grants()
     try:
         trust(*modules)
         allow_data(*folders)
         yield
     finally:
-        for variable, value in before.items():
-            if value is None:
-                os.environ.pop(variable, None)
-            else:
-                os.environ[variable] = value
+        restore(before)
 
 
 def trusted(module: str) -> bool:
     """Whether the user trusts ``module`` (a dotted name: itself or a package above it; a ``.py`` path: that
     file, resolved)."""
+    given = _granted(TRUST)
     if module.endswith(".py"):
-        return str(Path(module).resolve()) in _granted(TRUST)
+        return str(Path(module).resolve()) in given
     parts = module.split(".")
-    return any(".".join(parts[:n]) in _granted(TRUST) for n in range(1, len(parts) + 1))
+    return any(".".join(parts[:n]) in given for n in range(1, len(parts) + 1))
 
 
 def named_code(reference: str, label: str, from_file: bool):

@@ -33,7 +33,7 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.train.kinematics import kinematics
 from gearcheck.train.loader import load_text, load_train
 from gearcheck.lumped.modal import settling_time
-from gearcheck.train.spec import beside
+from gearcheck.train.spec import beside, named_file
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.settings import RunSettings
@@ -118,26 +118,30 @@ class Calibration:
     source: str  # where the original came from (its relative file references are resolved from there)
     header: str
 
-    def files(self) -> dict[str, Path]:
-        """The files the train file names (measurements, a user model, a torque table) by the names the calibrated
-        file gives them: their own names, beside it (:meth:`text`), so that the calibrated file is whole in its
-        folder (a train file names no file outside its folder unless the user allows it)."""
-        named = {}
+    def _named_files(self) -> list[tuple[str, str, str, Path, str]]:
+        """(table, key, the copy's name, the original, what follows the file) of each file the train file names
+        (measurements, a user model, a torque table): the copy takes the original's name (its key's before it
+        where two names meet)."""
+        out = []
         for table, key in REFERENCES:
-            name = self.document.get(table, {}).get(key)
-            if name is not None and (":" not in name or name.rpartition(":")[0].endswith(".py")):
-                path = beside(self.source, name.rpartition(":")[0] if ":" in name else name)
-                named[path.name if path.name not in named else f"{key}-{path.name}"] = path
-        return named
+            named = named_file(self.document.get(table, {}).get(key))
+            if named is not None:
+                path = beside(self.source, named[0])
+                copy_name = path.name if path.name not in {o[2] for o in out} else f"{key}-{path.name}"
+                out.append((table, key, copy_name, path, named[1]))
+        return out
+
+    def files(self) -> dict[str, Path]:
+        """The files the train file names by the names the calibrated file gives them, beside it (:meth:`text`),
+        so that the calibrated file is whole in its folder (a train file names no file outside its folder unless
+        the user allows it)."""
+        return {copy_name: path for _, _, copy_name, path, _ in self._named_files()}
 
     def text(self) -> str:
         """The calibrated train file, naming the files of :meth:`files` by their names there."""
         doc = copy.deepcopy(self.document)
-        given = iter(self.files())
-        for table, key in REFERENCES:
-            name = doc.get(table, {}).get(key)
-            if name is not None and (":" not in name or name.rpartition(":")[0].endswith(".py")):
-                doc[table][key] = next(given) + (":" + name.rpartition(":")[2] if ":" in name else "")
+        for table, key, copy_name, _, rest in self._named_files():
+            doc[table][key] = copy_name + rest
         return self.header + tomli_w.dumps(doc)
 
     def rows(self) -> list[dict]:

@@ -472,16 +472,25 @@ def beside(source: str, name: str) -> Path:
     return path
 
 
+def named_file(value: str | None) -> tuple[str, str] | None:
+    """(the file, what follows it) of a train file's value that names a file: ``data.csv`` is ("data.csv", ""),
+    ``model.py:factory`` ("model.py", ":factory"); None for no value or ``module:factory``."""
+    if value is None:
+        return None
+    where, colon, rest = value.rpartition(":")
+    if not colon:
+        return value, ""
+    return (where, f":{rest}") if where.endswith(".py") else None
+
+
 def _user_model(name: str | None, source: str, fail) -> str | None:
     """train.user_model: a file of matrices or ``file.py:factory``, named relative to the train file, or
     ``module:factory`` as given (code: run only when trusted, :mod:`gearcheck.shared.trust`)."""
-    if name is None:
-        return None
-    where, colon, factory = name.rpartition(":")
-    if colon and not where.endswith(".py"):
+    named = named_file(name)
+    if named is None:
         return name
     try:
-        return f"{beside(source, where)}:{factory}" if colon else str(beside(source, name))
+        return f"{beside(source, named[0])}{named[1]}"
     except GearcheckError as exc:
         raise fail("train.user_model", str(exc)) from None
 

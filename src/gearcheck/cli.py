@@ -140,6 +140,7 @@ def _number(kind: str, positive: bool = True, minimum: float | None = None):
 
 
 SECONDS, RPM, HZ = _number("seconds"), _number("rpm"), _number("Hz")
+RPM_OR_ZERO = _number("rpm >= 0", positive=False, minimum=0.0)
 
 
 def PATH(text: str) -> Path:
@@ -147,7 +148,6 @@ def PATH(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError("give a path, not an empty string")
     return Path(text)
-RPM_OR_ZERO = _number("rpm >= 0", positive=False, minimum=0.0)
 
 
 def _range(unit: str):

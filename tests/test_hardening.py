@@ -128,6 +128,7 @@ def test_the_files_a_train_file_names_stay_in_its_folder(tmp_path, capsys):
     assert main(["show", str(path), "--data-root", str(outside)]) == 0  # allowed by the user
     assert "GEARCHECK_DATA_ROOTS" not in os.environ
     refused(["show", path, "--data-root", str(tmp_path / "none")], capsys, "--data-root", "not a folder")
+    refused(["show", path, "--data-root", ""], capsys, "--data-root '': not a folder")  # not the current folder
 
 
 # ----------------------------------------------------------------------------- every read bounded
@@ -206,6 +207,20 @@ def test_a_planted_link_cannot_redirect_the_lock(tmp_path, monkeypatch, capsys):
     (folder / f"{hashlib.sha256(str(out).encode()).hexdigest()[:24]}.lock").symlink_to(victim / "precious")
     refused(["run", "demo-3p", "--duration", "0.001", "--out", out], capsys, "cannot take the output's lock")
     assert (victim / "precious").read_text(encoding="utf-8") == "root's own" and not out.exists()
+
+
+def test_outputs_take_the_umasks_permissions(tmp_path):
+    """Written through temporary files and folders (made 0600 and 0700), outputs end with the permissions any
+    file the user makes has: 0644 and 0755 under the umask 022."""
+    before = os.umask(0o022)
+    try:
+        assert main(["run", "demo-3p", "--duration", "0.002", "--out", str(tmp_path / "o")]) == 0
+        assert main(["stiffness", "demo-3p", "-o", str(tmp_path / "k.png")]) == 0
+    finally:
+        os.umask(before)
+    assert (tmp_path / "o").stat().st_mode & 0o777 == 0o755
+    assert (tmp_path / "o" / "summary.json").stat().st_mode & 0o777 == 0o644
+    assert (tmp_path / "k.png").stat().st_mode & 0o777 == 0o644
 
 
 def test_two_paths_to_one_folder_are_one_lock(tmp_path, capsys):

@@ -120,6 +120,13 @@ def _clear_leftovers(out: Path) -> list[str]:
     return done
 
 
+def _umask() -> int:
+    """The process's umask (read by setting it, and put back at once)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _make_parents(path: Path) -> list[Path]:
     """mkdir -p, returning the folders it made (deepest last)."""
     made = []
@@ -188,6 +195,7 @@ class OutputDirectory:
                     self._made = _make_parents(self.out)
                     self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.", suffix=".partial",
                                                       dir=self.out.parent))
+                    os.chmod(self._tmp, 0o777 & ~_umask())  # the output's, not the temporary folder's 0700
                     (self._tmp / MARKER).write_text("gearcheck output: the next gearcheck run into this folder "
                                                     "replaces it whole\n", encoding="utf-8")
                 except OSError as exc:
@@ -291,6 +299,7 @@ def write_file(path, data: bytes | str, what: str = "-o") -> None:
         except OSError as exc:
             raise GearcheckError(f"{what} {path}: cannot be written ({exc.strerror or exc})") from None
         try:
+            os.fchmod(fd, 0o666 & ~_umask())  # the file's, not the temporary file's 0600
             with os.fdopen(fd, "wb") as f:
                 f.write(data.encode("utf-8") if isinstance(data, str) else data)
             os.replace(tmp, path)

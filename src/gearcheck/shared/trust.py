@@ -56,7 +56,7 @@ def allow_data(*folders: str | os.PathLike) -> None:
     entries = []
     for folder in folders:
         path = Path(folder).resolve()
-        if not path.is_dir():
+        if not str(folder).strip() or not path.is_dir():  # "" would allow the current folder by accident
             raise GearcheckError(f"data_root={str(folder)!r}: not a folder")
         entries.append(str(path))
     _grant(DATA_ROOTS, entries)

@@ -40,6 +40,7 @@ confirm it and is marked at once.
 from __future__ import annotations
 
 import contextlib
+import functools
 import datetime as _dt
 import json
 import math
@@ -81,8 +82,9 @@ CREATE TABLE metrics (
 """
 
 
-def _columns() -> dict[str, set[str]]:
-    """Each table's columns, as _TABLES makes them (read back from a store made in memory)."""
+@functools.cache
+def columns() -> dict[str, set[str]]:
+    """Each table's columns, as _TABLES makes them (read back from a store made in memory, when first asked)."""
     con = sqlite3.connect(":memory:")
     try:
         con.executescript(_TABLES)
@@ -91,8 +93,6 @@ def _columns() -> dict[str, set[str]]:
     finally:
         con.close()
 
-
-COLUMNS = _columns()
 MAX_COMMIT = 200  # characters of a commit id: a git hash is 40, a tag or build name a few dozen
 _ORDERED = "(SELECT commit_id, date, row_number() OVER (ORDER BY date, seq) - 1 AS place FROM commits)"
 _RUN_COLUMNS = ("verdict", "failures", "unresolved", "moved", "steady_state", "duration_s", "input_speed_rpm",
@@ -343,10 +343,10 @@ def _check(con: sqlite3.Connection, store) -> None:
     if meta.get("schema") != SCHEMA or meta.get("schema_version") != str(SCHEMA_VERSION):
         raise GearcheckError(f"history store {store}: schema {meta.get('schema')} version "
                              f"{meta.get('schema_version')}, this gearcheck reads {SCHEMA} version {SCHEMA_VERSION}")
-    for table, columns in COLUMNS.items():  # each table with the columns this version reads
+    for table, expected in columns().items():  # each table with the columns this version reads
         found = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
         if not found:
             raise GearcheckError(f"history store {store}: the table {table} is missing")
-        if columns - found:
+        if expected - found:
             raise GearcheckError(f"history store {store}: the table {table} lacks the column "
-                                 f"{sorted(columns - found)[0]}")
+                                 f"{sorted(expected - found)[0]}")

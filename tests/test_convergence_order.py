@@ -55,6 +55,9 @@ CONDITIONS = {  # name: (train, the kinds checked)
         "{ harmonic = 2, amplitude_um = 0.5 }]")], "ste"), KINDS),
     "demo-3p with a load ramp": (lambda: edited("demo-3p", [(r"^output_torque = (.*)", r"output_torque = \1\n"
                                                              "ramp_s = 0.0004")], "ramp"), KINDS),
+    "demo-3p with a torque expression": (lambda: edited("demo-3p", [(r"^output_torque = (.*)", r"output_torque = \1\n"
+                                                                     'torque_expression = "200 * sin(2 * pi * 900 * t)'
+                                                                     ' * exp(-t / 0.01)"')], "expression"), KINDS),
     "demo-3p, carrier held (star)": (lambda: edited("demo-3p", HELD_CARRIER, "held carrier"), KINDS),
     "helical, 15 deg, contact-line stiffness": (lambda: helical_stage(15.0, stiffness="contact-line"), KINDS),
     "helical-planetary, 15 um parabolic tip relief: tooth pairs entering and leaving contact": (lambda: edited(

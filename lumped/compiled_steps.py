@@ -17,13 +17,14 @@ chunk, and runs RK4 through them in compiled code.  Its right-hand side is that 
   :func:`gearcheck.train.cycloid.pin_contacts` states them).
 
 It takes the model and the chunk in named groups (numba passes named tuples of arrays as structs):
-:class:`Matrices` and :class:`Meshes`, and each turning element kind's group, built once per model
+:class:`Matrices` and :class:`Meshes`, and a tuple of every turning element kind's group, built once per model
 (:func:`kernel_groups`); :class:`Chunk` per chunk of steps, :class:`Output` where the samples go.  A turning
-element kind keeps its group and its compiled forces in its own file, beside its rows
-(:class:`~gearcheck.lumped.elements.coupling.Couplings` and
-:func:`~gearcheck.lumped.elements.coupling.coupling_forces`; :class:`~gearcheck.lumped.elements.cycloid.Discs`,
-:func:`~gearcheck.lumped.elements.cycloid.disc_forces` and :func:`~gearcheck.lumped.elements.cycloid.pin_switching`);
-the kernel calls each kind's functions once per stage.
+element kind keeps its group and its compiled forces in its own file, beside its rows, and registers them
+(:func:`gearcheck.lumped.elements.base.compiled_group`: the radial couplings'
+:class:`~gearcheck.lumped.elements.coupling.Couplings`, the cycloid discs'
+:class:`~gearcheck.lumped.elements.cycloid.Discs`); the kernel calls every kind's functions once per stage through
+the hooks :data:`~gearcheck.lumped.elements.base.FORCES` and :data:`~gearcheck.lumped.elements.base.SWITCHING`,
+naming none.
 
 numba (``@njit(cache=True)``, compiled on the first call and cached on disk) is the one compiled dependency:
 a step is a loop over a few hundred numbers with branches (dead zones, contacts) that numpy cannot vectorise
@@ -37,8 +38,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from gearcheck.lumped.elements.coupling import Couplings, coupling_forces
-from gearcheck.lumped.elements.cycloid import Discs, disc_forces, pin_switching
+from gearcheck.lumped.elements import base
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
@@ -84,23 +84,19 @@ class Meshes(NamedTuple):
     relieved: np.ndarray
 
 
-GROUPS = {"couplings": Couplings, "discs": Discs}  # the compiled groups a turning element names (Turning.compiled)
-
-
-def kernel_groups(system) -> tuple[Matrices, Meshes, Couplings, Discs]:
+def kernel_groups(system) -> tuple[Matrices, Meshes, tuple]:
     """The groups of a model's right-hand side (:class:`gearcheck.lumped.time_solver._System`) that
-    :func:`rk4_steps` takes after q and v, each turning element in the group it names; TypeError for one that
-    names none."""
-    members = {name: [] for name in GROUPS}
+    :func:`rk4_steps` takes after q and v: the matrices, the meshes, and every registered kind of turning element
+    in its group (:data:`gearcheck.lumped.elements.base.GROUPS`, empty where the model has none of it, so that one
+    compiled kernel serves every model); TypeError for a turning element with no compiled form."""
     for e in system.turning:
-        if e.compiled not in members:
+        if e.compiled not in base.GROUPS:
             raise TypeError(f"no compiled form of the turning element {type(e).__name__}")
-        members[e.compiled].append(e)
-    static_load = sum((e.static_load for e in members["discs"]), np.zeros(system.Minv.size))
+    static_load = sum((e.static_load for e in system.turning), np.zeros(system.Minv.size))
     return (Matrices(system.Minv, system.F0 - static_load, system.b_in, system.b_out, Sparse.of(system.Kc),
                      Sparse.of(system.D)),
             Meshes(Sparse.of(system.A), system.c, system.b, system.has_backlash, system.relieved_index),
-            *(GROUPS[name].of(elements) for name, elements in members.items()))
+            tuple(group.of([e for e in system.turning if e.compiled is group]) for group in base.GROUPS))
 
 
 class Chunk(NamedTuple):
@@ -133,10 +129,11 @@ class Output(NamedTuple):
 
 # ---------------------------------------------------------------------------------------------- the kernel
 STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's samples t, t + h/2, t + h
+turning_forces, turning_switching = base.FORCES.each, base.SWITCHING.each  # numba calls functions, not attributes
 
 
 @njit(inline="always")
-def _acceleration(x, u, out, t, ti, to, k, e, de, pairs, matrices, meshes, couplings, discs):
+def _acceleration(x, u, out, t, ti, to, k, e, de, pairs, matrices, meshes, turning):
     """q'' into ``out`` at state (x, u), time t, torques ti and to, the meshes' k, e, de and tooth pairs."""
     minv, F0, b_in, b_out = matrices.minv, matrices.load, matrices.b_in, matrices.b_out
     kp, ki, kx = matrices.K
@@ -172,14 +169,13 @@ def _acceleration(x, u, out, t, ti, to, k, e, de, pairs, matrices, meshes, coupl
         f = elastic + c[m] * (rate - de[m])
         for p in range(ap[m], ap[m + 1]):
             out[ai[p]] -= ax[p] * f
-    coupling_forces(x, u, t, couplings, out)
-    disc_forces(x, u, t, discs, out)
+    turning_forces(turning, (x, u, t, out))
     for i in range(n):
         out[i] *= minv[i]
 
 
 @njit(inline="always")
-def _rk4(q, v, h, times, k, e, de, tin, tout, pairs, Q, V, acc, matrices, meshes, couplings, discs):
+def _rk4(q, v, h, times, k, e, de, tin, tout, pairs, Q, V, acc, matrices, meshes, turning):
     """One classical RK4 step of length h in place, the drive given at the stage samples (axis 0: t, t + h/2,
     t + h; stages 2 and 3 both see the middle one)."""
     n = q.size
@@ -189,7 +185,7 @@ def _rk4(q, v, h, times, k, e, de, tin, tout, pairs, Q, V, acc, matrices, meshes
     for stage in range(4):
         s = STAGE_TIMES[stage]
         _acceleration(Q[stage], V[stage], acc[stage], times[s], tin[s], tout[s], k[s], e[s], de[s], pairs[s],
-                      matrices, meshes, couplings, discs)
+                      matrices, meshes, turning)
         if stage < 3:
             a = advance[stage]
             for i in range(n):
@@ -202,12 +198,12 @@ def _rk4(q, v, h, times, k, e, de, tin, tout, pairs, Q, V, acc, matrices, meshes
 
 
 @njit(inline="always")
-def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
+def _switching(x, u, t, e, de, pairs, s, span, meshes, turning, g, rate) -> None:
     """The contact switching functions at state (x, u), time t into g and their rates of change into ``rate``,
     each changing sign where a contact law has a kink: a backlash's two edges (y - b, y + b), a relieved mesh's
-    tooth pairs (y - e_j; -1 for a padded pair), the pins' compressions.  ``pairs``: the tooth pairs at the three
-    samples of a (sub-)step of length ``span``, t at sample ``s`` (their gaps' rates from the three); a pin's rate
-    leaves out its normal's turning."""
+    tooth pairs (y - e_j; -1 for a padded pair), then the turning elements' (the pins' compressions; a pin's rate
+    leaves out its normal's turning).  ``pairs``: the tooth pairs at the three samples of a (sub-)step of length
+    ``span``, t at sample ``s`` (their gaps' rates from the three)."""
     (ap, ai, ax), c, half, backlash, relieved = meshes
     n = 0
     for m in range(c.size):
@@ -228,14 +224,14 @@ def _switching(x, u, t, e, de, pairs, s, span, meshes, discs, g, rate) -> None:
             g[n], g[n + 1] = y - half[m], y + half[m]
             rate[n], rate[n + 1] = dy, dy
             n += 2
-    pin_switching(x, u, t, discs, g, rate, n)
+    turning_switching(turning, (x, u, t, g, rate), n)
 
 
-def switching_count(meshes: Meshes, discs: Discs, pairs_per_mesh: int) -> int:
+def switching_count(meshes: Meshes, turning: tuple, pairs_per_mesh: int) -> int:
     """How many switching functions :func:`_switching` writes."""
     relieved = meshes.relieved >= 0
     edges = 2 * int(np.sum(~relieved & (meshes.half_backlash > 0))) if meshes.backlash else 0
-    return edges + int(np.sum(relieved)) * pairs_per_mesh + int(np.sum(discs.pins))
+    return edges + int(np.sum(relieved)) * pairs_per_mesh + base.switch_count(turning)
 
 
 @njit(inline="always")
@@ -253,13 +249,13 @@ def _part_of(chunk, r, a, b, part) -> None:
 
 
 @njit(cache=True)
-def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out, switches, located):
+def rk4_steps(q, v, matrices, meshes, turning, chunk, out, switches, located):
     """Classical RK4 through the sub-steps of ``chunk`` (:class:`Chunk`, its ``pairs`` an array, empty along its
     last axes without tip relief), q and v updated in place.  The drive of sub-step r at its stage times
     ``times[r]`` (t, t + h/2, t + h) is ``[r, 0|1|2]`` of the drive arrays (stages 2 and 3 both see index 1); the
-    turning elements (:class:`Couplings`, :class:`Discs`) are placed at the stage times.  ``switches``, the number
-    of switching functions (:func:`switching_count`; 0: none), enables contact-event location (counted into
-    ``located[0]``): where a switching function (:func:`_switching`) crosses zero within a step
+    turning elements (``turning``: their groups, :func:`kernel_groups`) are placed at the stage times.
+    ``switches``, the number of switching functions (:func:`switching_count`; 0: none), enables contact-event
+    location (counted into ``located[0]``): where a switching function (:func:`_switching`) crosses zero within a step
     (:func:`first_crossing`), the step is taken again, ended at the crossing, with the drive interpolated
     quadratically from its three samples, and the rest of the step follows, itself checked; at most ``MAX_EVENTS``
     a step.  A kink left inside a step costs an error of order h^2 there; ended at it, RK4 keeps its order.
@@ -275,13 +271,12 @@ def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out, switches, lo
     written = 0
     for r in range(lengths.size):
         h = lengths[r]
-        _rk4(q, v, h, times[r], k[r], e[r], de[r], tin[r], tout[r], pairs[r], Q, V, acc, matrices, meshes,
-             couplings, discs)
+        _rk4(q, v, h, times[r], k[r], e[r], de[r], tin[r], tout[r], pairs[r], Q, V, acc, matrices, meshes, turning)
         if switches > 0:
             done, span = 0.0, h
-            _switching(Q[0], V[0], times[r, 0], e[r, 0], de[r, 0], pairs[r], 0, h, meshes, discs, g0, r0)
+            _switching(Q[0], V[0], times[r, 0], e[r, 0], de[r, 0], pairs[r], 0, h, meshes, turning, g0, r0)
             for _ in range(MAX_EVENTS):
-                _switching(q, v, times[r, 2], e[r, 2], de[r, 2], pairs[r], 2, h, meshes, discs, g1, r1)
+                _switching(q, v, times[r, 2], e[r, 2], de[r, 2], pairs[r], 2, h, meshes, turning, g1, r1)
                 theta, crossed = first_crossing(g0, r0, g1, r1, span)
                 if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
                     break
@@ -290,15 +285,15 @@ def rk4_steps(q, v, matrices, meshes, couplings, discs, chunk, out, switches, lo
                 v[:] = V[0]
                 _part_of(chunk, r, done, at, part)
                 _rk4(q, v, (at - done) * h, part[0], part[1], part[2], part[3], part[4], part[5], part[6], Q, V, acc,
-                     matrices, meshes, couplings, discs)
+                     matrices, meshes, turning)
                 located[0] += 1
-                _switching(q, v, part[0][2], part[2][2], part[3][2], part[6], 2, (at - done) * h, meshes, discs,
-                           g0, r0)
+                _switching(q, v, part[0][2], part[2][2], part[3][2], part[6], 2, (at - done) * h, meshes,
+                           turning, g0, r0)
                 crossed_together(g0, r0, (at - done) * h, crossed)
                 done, span = at, (1.0 - at) * h
                 _part_of(chunk, r, done, 1.0, part)
                 _rk4(q, v, span, part[0], part[1], part[2], part[3], part[4], part[5], part[6], Q, V, acc, matrices,
-                     meshes, couplings, discs)
+                     meshes, turning)
         if ends[r]:
             step += 1
             if step % every == 0:

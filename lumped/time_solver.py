@@ -89,7 +89,7 @@ class _System:
         self.b_in, self.b_out = model.b_input, model.b_output
         self.kernel = kernel_groups(self)
         pairs = self.exc.tooth_pairs(0.0)[0]
-        self.switches = switching_count(self.kernel[1], self.kernel[3], 0 if pairs is None else pairs.shape[-1])
+        self.switches = switching_count(self.kernel[1], self.kernel[2], 0 if pairs is None else pairs.shape[-1])
 
     def drive(self, t):
         """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``

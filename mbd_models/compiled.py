@@ -15,10 +15,12 @@ writes the model fields and the data that the Python loop writes, and calls MuJo
 model through its C library (``ctypes``), with the GIL released, so several twins run at once in threads
 (:func:`gearcheck.mbd_models.runner.simulate_mujoco_many`).
 
-The pin contacts of an RV reducer's discs come in their element's compiled form, beside the element's bodies
-and tendons (:mod:`gearcheck.mbd_models.elements.cycloid`: ``CompiledPins``, ``refresh_pins``,
-``pin_switching``, ``pin_forces_into``).  The kernel is compiled on first use and cached by numba next to its
-file.
+The moving contacts (an RV reducer's pins) come in their element's compiled form, beside the element's bodies
+and tendons: a group per kind (:mod:`gearcheck.mbd_models.elements.cycloid`: ``CompiledPins``), every registered
+kind's group in one tuple, and its functions on the hooks :data:`~gearcheck.mbd_models.elements.base.REFRESH`,
+:data:`~gearcheck.mbd_models.elements.base.SWITCHING` and :data:`~gearcheck.mbd_models.elements.base.RECORD`,
+which the kernel calls without naming a kind.  The kernel is compiled on first use and cached by numba next to
+its file.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ import mujoco
 import numba
 import numpy as np
 
-from gearcheck.mbd_models.elements.cycloid import pin_forces_into, pin_switching, refresh_pins
+from gearcheck.mbd_models.elements import base
 from gearcheck.mbd_models.twin import TurningCoefficients
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
@@ -41,6 +43,7 @@ from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together,
 _LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
 STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's stage times t, t + h/2, t + h
 STAGE_ADVANCE = (0.5, 0.5, 1.0)  # stage i + 1 starts from the step's start advanced by this times h along stage i
+refresh_moving, moving_switching, record_moving = base.REFRESH.each, base.SWITCHING.each, base.RECORD.each
 
 
 class _MuJoCoC:
@@ -236,17 +239,18 @@ class Flags(NamedTuple):
     tooth_pairs: bool
     record_stiffness: bool
     record_energy: bool
-    pin_contacts: bool
+    moving_contacts: bool
 
 
 class Outputs(NamedTuple):
-    """The sampled rows: sensordata, the force reader's forces, and (possibly empty) stiffness, energy, pin forces."""
+    """The sampled rows: sensordata, the force reader's forces, and (possibly empty) stiffness, energy, the moving
+    contacts' forces (``MbdModel.moving_slices``)."""
 
     sensors: np.ndarray
     forces: np.ndarray
     stiffness: np.ndarray
     energy: np.ndarray
-    pin_forces: np.ndarray
+    contact_forces: np.ndarray
 
 
 # ---------------------------------------------------------------------------------------------- the kernel
@@ -327,15 +331,15 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
 
 
 @numba.njit(cache=True)
-def _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid):
+def _sample(j, passive, pointers, model, data, reader, outputs, flags, moving):
     """``_Stepper.sample``: sensordata, the force reader's generalized forces (``ForceReader.sample``), and
-    optionally the stiffness used and MuJoCo's energy, into row ``j``."""
+    optionally the stiffness used, MuJoCo's energy and the moving contacts' forces, into row ``j``."""
     stiffness, lengthspring = model.tendon_stiffness, model.tendon_lengthspring
     probe_stiffness, probe_lengthspring = model.probe_stiffness, model.probe_lengthspring
     sensordata, spring, damper, energy, applied = (data.sensordata, data.qfrc_spring, data.qfrc_damper, data.energy,
                                                    data.qfrc_applied)
     dofs, slides = reader
-    sensors, forces, used, energies, pin_forces = outputs
+    sensors, forces, used, energies, contact_forces = outputs
     sensors[j, :] = sensordata
     n = probe_stiffness.size
     for i in range(n):
@@ -356,24 +360,24 @@ def _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid):
     if flags.record_energy:
         energies[j, 0] = energy[0]
         energies[j, 1] = energy[1]
-    if flags.pin_contacts:
-        pin_forces_into(pin_forces[j], model, data, cycloid)
+    if flags.moving_contacts:
+        record_moving(moving, (contact_forces[j], model, data), 0)
 
 
 @numba.njit(cache=True)
-def _drive_stage(s, r, drive, kinematics, com_pos, jac, pointers, model, data, turning, contacts, work, cycloid,
+def _drive_stage(s, r, drive, kinematics, com_pos, jac, pointers, model, data, turning, contacts, work, moving,
                  flags):
-    """Everything a stage sets from its own state: the pin tendons, the turned coefficients, the drive of row ``r``
-    at stage time ``s``."""
-    if flags.pin_contacts:
-        refresh_pins(kinematics, com_pos, jac, pointers.model, pointers.data, model, data, cycloid)
+    """Everything a stage sets from its own state: the moving contacts' tendons, the turned coefficients, the drive
+    of row ``r`` at stage time ``s``."""
+    if flags.moving_contacts:
+        refresh_moving(moving, (kinematics, com_pos, jac, pointers.model, pointers.data, model, data))
     _refresh(data.qpos, model.wrap_prm, turning.coefficients, work.coef)
     _set_stage(drive.k[r, s], drive.u[r, s], drive.e[r, s], drive.de[r, s], drive.pairs[r, s],
                flags.transmission_error, flags.tooth_pairs, model, data, turning, contacts, work)
 
 
 @numba.njit(cache=True)
-def _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, r, h, flags, outputs,
+def _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, r, h, flags, outputs,
          sample, j):
     """One RK4 (sub-)step of length h with the drive of row ``r`` at its stage times, MuJoCo's ``mj_RungeKutta``
     written out (the same sums in the same order) with each stage driven from its own state; the first stage
@@ -397,11 +401,11 @@ def _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, sta
             for i in range(act.size):
                 act[i] = act0[i] + AD[stage - 1, i] * a * h
         _drive_stage(STAGE_TIMES[stage], r, drive, kinematics, com_pos, jac, pointers, model, data, turning,
-                     contacts, work, cycloid, flags)
+                     contacts, work, moving, flags)
         if stage == 0:
             forward(m, d)
             if sample:
-                _sample(j, passive, pointers, model, data, reader, outputs, flags, cycloid)
+                _sample(j, passive, pointers, model, data, reader, outputs, flags, moving)
                 j += 1
         else:
             forward_skip(m, d, 0, 1)  # mjSTAGE_NONE, no sensors
@@ -428,7 +432,7 @@ def _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, sta
 
 
 @numba.njit(cache=True)
-def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive, r, s, span, flags, g, rate):
+def _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, s, span, flags, g, rate):
     """The contact switching functions of the twin's state into g and their rates into ``rate``: each mesh
     tendon's backlash edges (L - e - b, L - e + b) or tooth pairs (L - e - e_j; -1 for a padded pair), L the
     tendon's length with its coefficients turned to the state's carrier angles, and each pin's compression (its
@@ -459,9 +463,9 @@ def _switching(c, pointers, model, data, turning, work, cycloid, switches, drive
             g[n], g[n + 1] = length - half[i], length + half[i]
             rate[n], rate[n + 1] = speed, speed
             n += 2
-    if flags.pin_contacts:
-        refresh_pins(c[4], c[5], c[6], pointers.model, pointers.data, model, data, cycloid)
-        pin_switching(cycloid, g, rate, n)
+    if flags.moving_contacts:
+        refresh_moving(moving, (c[4], c[5], c[6], pointers.model, pointers.data, model, data))
+        moving_switching(moving, (g, rate), n)
 
 
 @numba.njit(cache=True)
@@ -484,36 +488,36 @@ def _part_of(drive, r, a, b, part) -> None:
 
 
 @numba.njit(cache=True)
-def _step(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, r, h, flags, outputs,
+def _step(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, r, h, flags, outputs,
           sample, j, switches, events):
     """One (sub-)step of length h with the drive of row ``r`` (:func:`_rk4`), its contact events located where
     ``switches`` has any (:mod:`gearcheck.shared.events`: the step taken again to the first crossing of a switching
     function, :func:`_switching`, and on from there; counted into ``events.located[0]``).  Returns the next row."""
     g0, r0, g1, r1, part, located = events
     if g0.size:
-        _switching(c, pointers, model, data, turning, work, cycloid, switches, drive, r, 0, h, flags, g0, r0)
-    j = _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, r, h, flags, outputs,
+        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 0, h, flags, g0, r0)
+    j = _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, r, h, flags, outputs,
              sample, j)
     if not g0.size:
         return j
     done, span = 0.0, h
     for _ in range(MAX_EVENTS):
-        _switching(c, pointers, model, data, turning, work, cycloid, switches, drive, r, 2, h, flags, g1, r1)
+        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 2, h, flags, g1, r1)
         theta, crossed = first_crossing(g0, r0, g1, r1, span)
         if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
             break
         at = done + theta * (1.0 - done)  # the crossing, a fraction of the whole step
         _restart(stages, data)
         _part_of(drive, r, done, at, part)
-        _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, part, 0, (at - done) * h,
+        _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, part, 0, (at - done) * h,
              flags, outputs, False, j)
         located[0] += 1
-        _switching(c, pointers, model, data, turning, work, cycloid, switches, part, 0, 2, (at - done) * h, flags,
+        _switching(c, pointers, model, data, turning, work, moving, switches, part, 0, 2, (at - done) * h, flags,
                    g0, r0)
         crossed_together(g0, r0, (at - done) * h, crossed)
         done, span = at, (1.0 - at) * h
         _part_of(drive, r, done, 1.0, part)
-        _rk4(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, part, 0, span, flags,
+        _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, part, 0, span, flags,
              outputs, False, j)
     return j
 
@@ -531,21 +535,22 @@ class Events(NamedTuple):
 
 
 @numba.njit(nogil=True, cache=True)
-def run_steps(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, split, flags,
+def run_steps(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, split, flags,
               outputs, h, start, stop, every, j, switches, events):
     """Steps start..stop-1 of one twin, sampling those that begin on a multiple of ``every`` into rows j.. of
     ``outputs``; returns the next row.  ``c``: MuJoCo's C functions (forward, forward_skip, integrate_pos, passive,
-    kinematics, com_pos, jac); then the twin in the groups above: ``drive`` one row per step, ``split`` the split
-    steps' sub-steps, ``switches`` and ``events`` the contact events' location (:func:`_step`)."""
+    kinematics, com_pos, jac); then the twin in the groups above, ``moving`` every registered kind of moving
+    contact's group (:data:`gearcheck.mbd_models.elements.base.GROUPS`), ``drive`` one row per step, ``split`` the
+    split steps' sub-steps, ``switches`` and ``events`` the contact events' location (:func:`_step`)."""
     first, count, lengths = split.first, split.count, split.lengths
     for step in range(start, stop):
         i = step - start
         sample = step % every == 0
         if count[i] > 0:
             for s in range(first[i], first[i] + count[i]):
-                j = _step(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, split.drive, s,
+                j = _step(c, pointers, model, data, turning, contacts, work, reader, moving, stages, split.drive, s,
                           lengths[s], flags, outputs, sample and s == first[i], j, switches, events)
             continue
-        j = _step(c, pointers, model, data, turning, contacts, work, reader, cycloid, stages, drive, i, h, flags,
+        j = _step(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, i, h, flags,
                   outputs, sample, j, switches, events)
     return j

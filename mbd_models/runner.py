@@ -66,7 +66,7 @@ import mujoco
 import numpy as np
 
 from gearcheck.mbd_models import compiled
-from gearcheck.mbd_models.elements.cycloid import cycloid_arrays
+from gearcheck.mbd_models.elements import base as elements
 from gearcheck.mbd_models.forces import ForceReader
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
 from gearcheck.mbd_models.twin import MbdModel
@@ -311,6 +311,13 @@ class _Stepper:
 RK4_WEIGHTS = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
 
 
+def moving_groups(mb: MbdModel) -> tuple:
+    """Every registered kind of moving contact's compiled group (:data:`gearcheck.mbd_models.elements.base.GROUPS`)
+    with the twin's contacts of that kind, empty where it has none (one compiled kernel serves every twin)."""
+    return tuple(group.of([c for c in mb.moving_contacts if c.compiled is group], mb.model.nv)
+                 for group in elements.GROUPS)
+
+
 def mesh_switches(mb: MbdModel) -> compiled.MeshSwitches:
     """The mesh tendons whose contact law has kinks (a backlash's dead zone, a relieved mesh's tooth pairs) with
     their coefficients' addresses, and (``count``) how many switching functions the twin has with its pins."""
@@ -378,7 +385,7 @@ class _CompiledStepper(_Stepper):
             compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n), np.zeros(n)),
             compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
                             np.ascontiguousarray(reader.slides, dtype=np.int64)),
-            cycloid_arrays(mb.moving_contacts, m.nv),
+            moving_groups(mb),
             compiled.Stages.of(m))
         self.outputs = compiled.Outputs(self.sensors, self.forces,
                                         np.zeros((0, n)) if self.stiffness is None else self.stiffness,

@@ -60,6 +60,7 @@ from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.elements import ELEMENTS
+from gearcheck.mbd_models.elements.base import group_order
 from gearcheck.mbd_models.elements.mesh import mesh_joints
 from gearcheck.mbd_models.mjcf_builder import document, header
 from gearcheck.mbd_models.mjcf_text import LateValues, member_axes
@@ -261,7 +262,8 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
 
     mb = _indices(spec, kin, exc, model)
     kinds = dict.fromkeys(part.element for part in spec.parts)
-    mb.moving_contacts = tuple(c for c in (ELEMENTS[kind].contacts(spec, model) for kind in kinds) if c is not None)
+    contacts = (ELEMENTS[kind].contacts(spec, model) for kind in kinds)
+    mb.moving_contacts = tuple(sorted((c for c in contacts if c is not None), key=group_order))
     for c in mb.moving_contacts:  # the contacts of t = 0, as MuJoCo's own Jacobians give them
         c.refresh(data)
         values.coefficients.update(c.written()[0])

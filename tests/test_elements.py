@@ -5,16 +5,20 @@ per side and this test file (DESIGN.md 8)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import mujoco
 import numpy as np
 import pytest
+from numba import njit
+from numba.core.caching import NullCache
 
 import gearcheck
 from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.compiled_steps import rk4_steps
 from gearcheck.lumped.elements import ELEMENTS as LUMPED
-from gearcheck.lumped.elements.base import Contribution, Row
+from gearcheck.lumped.elements import base as lumped_base
+from gearcheck.lumped.elements.base import Contribution, Row, Turning, compiled_group
 from gearcheck.lumped.modal import modes as lumped_modes
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.elements import ELEMENTS as MUJOCO
@@ -23,6 +27,7 @@ from gearcheck.mbd_models.mjcf_text import fixed, member_joints
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.elements import Registry
 from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.kernel_hooks import Hook
 from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.spec import TrainSpec
 
@@ -105,3 +110,128 @@ def test_a_new_kind_of_part_reaches_both_models(monkeypatch):
     mujoco_frequencies = linearise.modes(twin).frequencies
     assert np.max(np.abs(lumped - before) / before) > 1e-3
     np.testing.assert_allclose(mujoco_frequencies, lumped, rtol=1e-8)
+
+
+# --------------------------------------------------------------------------- a kind whose forces move with time
+class Beats(NamedTuple):
+    """The compiled group: per beating spring, its two coordinates and (k, depth, omega)."""
+
+    index: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, elements) -> "Beats":
+        return cls(np.array([[e.i, e.j] for e in elements], dtype=np.int64).reshape(-1, 2),
+                   np.array([[e.k, e.depth, e.omega] for e in elements], dtype=float).reshape(-1, 3))
+
+
+@njit(inline="always")
+def beat_forces(beats, at):
+    x, _, t, out = at
+    for b in range(beats.index.shape[0]):
+        i, j = beats.index[b, 0], beats.index[b, 1]
+        f = beats.values[b, 0] * (1.0 + beats.values[b, 1] * np.cos(beats.values[b, 2] * t)) * (x[i] - x[j])
+        out[i] -= f
+        out[j] += f
+
+
+@dataclass(frozen=True)
+class BeatingTorsion(Turning):
+    """A torsional spring k (1 + depth cos(omega t)) between coordinates i and j: its row of t = 0 in the model,
+    :meth:`forces` in time."""
+
+    compiled = Beats
+    i: int
+    j: int
+    k: float
+    depth: float
+    omega: float
+    rows: tuple[str, ...]
+
+    def forces(self, t, q, v) -> np.ndarray:
+        f = self.k * (1.0 + self.depth * np.cos(self.omega * np.asarray(t, dtype=float))) * (
+            q[..., self.i] - q[..., self.j])
+        out = np.zeros(np.shape(q))
+        out[..., self.i] -= f
+        out[..., self.j] += f
+        return out
+
+
+@dataclass(frozen=True)
+class BeatingPart(Part):
+    element: ClassVar[str] = "test-beating-torsion"
+    a: str
+    b: str
+    stiffness: float
+    depth: float
+    omega: float
+
+
+def beating_rows(part, build) -> Contribution:
+    name = f"{part.a}-{part.b}.beating"
+    element = BeatingTorsion(build.dofs(part.a, "theta"), build.dofs(part.b, "theta"), part.stiffness, part.depth,
+                             part.omega, (name,))
+    a = build.dofs.unit((part.a, "theta", 1.0), (part.b, "theta", -1.0))
+    return Contribution([Row(name, "coupling", a, part.stiffness * (1.0 + part.depth), 0.0)], turning=[element])
+
+
+def test_a_kernel_hook_calls_each_groups_function_in_order_and_skips_the_unregistered():
+    """The hooks that the compiled kernels call: one call per group in the tuple's order, a threaded index passed
+    from one to the next, a group with no function skipped; from plain Python the hook refuses to run."""
+    forces, counts = Hook("forces-test"), Hook("count-test", threads=True)
+
+    class One(NamedTuple):
+        value: float
+
+    class Two(NamedTuple):
+        values: np.ndarray
+
+    @njit
+    def add_one(group, at):
+        at[0][0] = at[0][0] * 10.0 + group.value
+
+    @njit
+    def count_two(group, at, n):
+        for v in group.values:
+            at[0][n] = v
+            n += 1
+        return n
+
+    forces.register(One, add_one)
+    forces.register(Two, add_one)  # never reached: Two has no ``value``, so a call would not compile
+    forces.functions.pop(Two)
+    counts.register(Two, count_two)
+    each_force, each_count = forces.each, counts.each
+
+    @njit
+    def kernel(groups, out, slots):
+        each_force(groups, (out,))
+        return each_count(groups, (slots,), 1)
+
+    out, slots = np.zeros(1), np.zeros(5)
+    n = kernel((One(1.0), Two(np.array([7.0, 8.0])), One(2.0), Two(np.array([9.0]))), out, slots)
+    assert out[0] == 12.0 and n == 4 and list(slots) == [0.0, 7.0, 8.0, 9.0, 0.0]
+    with pytest.raises(TypeError, match="compiled hook"):
+        each_force((One(1.0),), (out,))
+
+
+def test_a_part_whose_forces_move_with_time_runs_in_the_compiled_steps(monkeypatch):
+    """A kind of part whose stiffness beats in time, registered from this file alone (a description, its lumped
+    element, its compiled group): the compiled RK4 steps run it through the kernel's hooks without a line of the
+    kernel changed, and agree with the same RK4 taken stage by stage in Python (the reference, which calls
+    ``forces``) to rounding, while the beat moves the response by far more."""
+    monkeypatch.setitem(LUMPED._kinds, "test-beating-torsion", beating_rows)
+    monkeypatch.setattr(rk4_steps, "_cache", NullCache())  # numba's disk cache cannot hold a test module's types
+    monkeypatch.setattr(lumped_base, "GROUPS", list(lumped_base.GROUPS))
+    monkeypatch.setattr(lumped_base.FORCES, "functions", dict(lumped_base.FORCES.functions))
+    compiled_group(Beats, beat_forces)
+    spec = gearcheck.load("demo-3p")
+    plain = gearcheck.simulate(spec, "lumped", duration=0.01, dt=2e-6)
+    beating = BeatingPart("stage1.sun", "stage1.carrier", 2e5, 0.5, 2 * np.pi * 300.0)
+    monkeypatch.setattr(TrainSpec, "parts", property(lambda s: train_parts(s) + (beating,)))
+    compiled = gearcheck.simulate(spec, "lumped", duration=0.01, dt=2e-6)
+    python = gearcheck.simulate(spec, "lumped", duration=0.01, dt=2e-6, method="rk4-stages")
+    name = "stage1.sun.alpha"
+    scale = np.max(np.abs(python[name]))
+    assert np.max(np.abs(compiled[name] - python[name])) < 1e-9 * scale
+    assert np.max(np.abs(compiled[name] - plain[name])) > 1e-3 * scale

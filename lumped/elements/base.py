@@ -5,6 +5,11 @@ c.  An element builds its rows on the coordinates of :class:`DofMap` (each membe
 <gearcheck.train.spec.Member.dofs>`) and returns them in a :class:`Contribution`: constant rows, a driven mesh
 row, turning elements whose rows move with time (:class:`Turning`), and a last step that places it in the
 finished model.
+
+A turning element's compiled form is its kind's *group*: a named tuple of arrays that the compiled RK4 steps
+(:mod:`gearcheck.lumped.compiled_steps`) take, with its functions on the hooks :data:`FORCES` and
+:data:`SWITCHING` (:mod:`gearcheck.shared.kernel_hooks`), registered by :func:`compiled_group` in the kind's
+element file.  The steps call every kind's functions without naming one.
 """
 
 from __future__ import annotations
@@ -13,6 +18,8 @@ from dataclasses import dataclass, field
 from typing import Callable, ClassVar
 
 import numpy as np
+
+from gearcheck.shared.kernel_hooks import Hook
 
 
 @dataclass(frozen=True)
@@ -97,7 +104,8 @@ class Turning:
     rows: tuple[str, ...]
     has_contacts: ClassVar[bool] = False  # rows that touch or not (their set is solved with the static state)
     smooth: ClassVar[bool] = True  # its forces are linear in the state (no contact switching)
-    compiled: ClassVar[str | None] = None  # the group of the compiled steps that evaluates it (None: none)
+    compiled: ClassVar[type | None] = None  # its compiled group (:func:`compiled_group`; None: it has none)
+    static_load: ClassVar[np.ndarray | float] = 0.0  # what of its forces the model's static load holds
     words: ClassVar[str] = "rows that turn with time"  # what it is, in a sentence that refuses it
 
     @property
@@ -135,3 +143,28 @@ class Turning:
     def contact_set(self, model):
         """Which of its contacts touch in the configuration ``model`` is placed at (None: it has none)."""
         return None
+
+
+# ------------------------------------------------------------------------- the compiled steps' groups
+FORCES = Hook("forces")  # function(group, (x, u, t, out)): its forces at state (x, u), time t added into out
+SWITCHING = Hook("switching", threads=True)  # function(group, (x, u, t, g, rate), n) -> the next n: see below
+GROUPS: list[type] = []  # the compiled groups, in the order the steps add their forces
+_COUNTS: dict[type, Callable] = {}
+
+
+def compiled_group(group: type, forces, switching=None, count: Callable | None = None) -> None:
+    """Register the compiled form of a kind of turning element: ``group`` a named tuple class whose
+    ``group.of(elements)`` packs that kind's elements of a model (none: empty arrays of the same types), ``forces``
+    its :data:`FORCES` function; where its forces have kinks, ``switching`` writes its switching functions
+    (:meth:`Turning.switching`, in their order) into g and their rates into ``rate`` from index n on and returns
+    the index after them, and ``count(group)`` says how many it writes."""
+    GROUPS.append(group)
+    FORCES.register(group, forces)
+    if switching is not None:
+        SWITCHING.register(group, switching)
+        _COUNTS[group] = count
+
+
+def switch_count(groups) -> int:
+    """How many switching functions the groups write (:data:`SWITCHING`)."""
+    return sum(_COUNTS[type(g)](g) for g in groups if type(g) in _COUNTS)

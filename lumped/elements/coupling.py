@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from gearcheck.lumped.elements import ELEMENTS
-from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning
+from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning, compiled_group
 from gearcheck.train.spec import ROTATION
 
 
@@ -35,6 +35,20 @@ def coupling_rows(part, build: Build) -> Contribution:
     return Contribution(rows, turning=turning)
 
 
+class Couplings(NamedTuple):
+    """Radial couplings between turning frames: ``index`` (T, 4) the (a_x, a_y, b_x, b_y) coordinates, ``values``
+    (T, 4) their (Omega_a, Omega_b, stiffness, damping)."""
+
+    index: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, couplings) -> "Couplings":
+        return cls(np.array([[*e.a, *e.b] for e in couplings], dtype=np.int64).reshape(-1, 4),
+                   np.array([[e.omega_a, e.omega_b, e.stiffness, e.damping] for e in couplings],
+                            dtype=float).reshape(-1, 4))
+
+
 @dataclass(frozen=True)
 class TurningCoupling(Turning):
     """A radial coupling between members whose frames turn at different speeds (a ring shared by two
@@ -51,7 +65,7 @@ class TurningCoupling(Turning):
     stiffness: float
     damping: float
     rows: tuple[str, str]  # names of its t = 0 rows
-    compiled = "couplings"
+    compiled = Couplings
     words = "a radial coupling between frames that turn apart"
 
     def forces(self, t, q, v) -> np.ndarray:
@@ -78,24 +92,11 @@ class TurningCoupling(Turning):
         return out
 
 
-class Couplings(NamedTuple):
-    """Radial couplings between turning frames: ``index`` (T, 4) the (a_x, a_y, b_x, b_y) coordinates, ``values``
-    (T, 4) their (Omega_a, Omega_b, stiffness, damping)."""
-
-    index: np.ndarray
-    values: np.ndarray
-
-    @classmethod
-    def of(cls, couplings) -> "Couplings":
-        return cls(np.array([[*e.a, *e.b] for e in couplings], dtype=np.int64).reshape(-1, 4),
-                   np.array([[e.omega_a, e.omega_b, e.stiffness, e.damping] for e in couplings],
-                            dtype=float).reshape(-1, 4))
-
-
 @njit(inline="always")
-def coupling_forces(x, u, t, couplings, out) -> None:
+def coupling_forces(couplings, at) -> None:
     """The compiled steps' form of :meth:`TurningCoupling.forces`: every radial coupling between turning frames at
-    state (x, u), time t, added into ``out`` (:mod:`gearcheck.lumped.compiled_steps`)."""
+    ``at`` = (x, u, t, out), state (x, u) and time t, added into ``out`` (:mod:`gearcheck.lumped.compiled_steps`)."""
+    x, u, t, out = at
     coupling_index, coupling = couplings
     for w in range(coupling.shape[0]):
         wa, wb, kc, cc = coupling[w, 0], coupling[w, 1], coupling[w, 2], coupling[w, 3]
@@ -110,3 +111,6 @@ def coupling_forces(x, u, t, couplings, out) -> None:
         out[i1] -= p1
         out[i2] += cs * p0 + sn * p1
         out[i3] += -sn * p0 + cs * p1
+
+
+compiled_group(Couplings, coupling_forces)

@@ -32,7 +32,7 @@ import numpy as np
 from numba import njit
 
 from gearcheck.lumped.elements import ELEMENTS
-from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning
+from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning, compiled_group
 from gearcheck.lumped.static import mean_load
 from gearcheck.shared.errors import SolverError
 from gearcheck.train.cycloid import pin_contacts
@@ -60,13 +60,59 @@ def cycloid_element(cyc, build: Build) -> Contribution:
     return Contribution(place=place)
 
 
+class Discs(NamedTuple):
+    """Cycloid discs, one row per disc of every cycloid stage: ``index`` (D, 3) its (x, y, theta), ``wheel`` (D, 3)
+    its pin wheel's (-1: fixed), ``crank_index`` (D, M, 3) its stage's cranks, ``crank_place`` (D, M, 2) cos and sin
+    of their places psi_k (padded), ``cranks`` (D,) their number, ``pin_place`` (D, Z, 2) cos and sin of
+    2 pi i / Z_p (padded), ``pins`` (D,) Z_p, and ``values`` (D, 14): phase, w_H - Omega, w_w - Omega, K1, r_c,
+    Z_p e, e, m e w_H^2, needle k and c, pin k and c, clearance, and the carrier radius."""
+
+    index: np.ndarray
+    wheel: np.ndarray
+    crank_index: np.ndarray
+    crank_place: np.ndarray
+    cranks: np.ndarray
+    pin_place: np.ndarray
+    pins: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, cycloids) -> "Discs":
+        discs = [(e, j) for e in cycloids for j in range(len(e.disc))]
+        most_cranks = max((len(e.crank) for e in cycloids), default=0)
+        most_pins = max((e.geometry.pins for e in cycloids), default=0)
+        index = np.zeros((len(discs), 3), dtype=np.int64)
+        wheel = np.full((len(discs), 3), -1, dtype=np.int64)
+        crank_index = np.zeros((len(discs), most_cranks, 3), dtype=np.int64)
+        crank_place = np.zeros((len(discs), most_cranks, 2))
+        cranks = np.zeros(len(discs), dtype=np.int64)
+        pin_place = np.zeros((len(discs), most_pins, 2))
+        pins = np.zeros(len(discs), dtype=np.int64)
+        values = np.zeros((len(discs), 14))
+        for d, (e, j) in enumerate(discs):
+            g = e.geometry
+            index[d] = e.disc[j]
+            if e.wheel is not None:
+                wheel[d] = e.wheel
+            cranks[d] = len(e.crank)
+            crank_index[d, :cranks[d]] = e.crank
+            crank_place[d, :cranks[d]] = np.stack([np.cos(e.psi), np.sin(e.psi)], axis=-1)
+            angles = 2 * np.pi * np.arange(g.pins) / g.pins
+            pin_place[d, :g.pins] = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+            pins[d] = g.pins
+            values[d] = (e.phases[j], e.omega_eccentric, e.omega_pins, g.K1, g.rolling_radius, g.pitch_radius,
+                         g.eccentricity, e.disc_mass * g.eccentricity * e.omega_orbit**2, e.needle_stiffness,
+                         e.needle_damping, e.pin_stiffness, e.pin_damping, e.clearance, e.carrier_radius)
+        return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
+
+
 @dataclass(frozen=True)
 class CycloidRows(Turning):
     """The time-periodic rows and loads of one cycloid-pin stage (see the module docstring)."""
 
     has_contacts = True
     smooth = False
-    compiled = "discs"
+    compiled = Discs
     words = "a cycloid-pin stage"
 
     stage: str
@@ -257,52 +303,6 @@ class CycloidRows(Turning):
 
 
 # ------------------------------------------------------------------------- the compiled steps' form
-class Discs(NamedTuple):
-    """Cycloid discs, one row per disc of every cycloid stage: ``index`` (D, 3) its (x, y, theta), ``wheel`` (D, 3)
-    its pin wheel's (-1: fixed), ``crank_index`` (D, M, 3) its stage's cranks, ``crank_place`` (D, M, 2) cos and sin
-    of their places psi_k (padded), ``cranks`` (D,) their number, ``pin_place`` (D, Z, 2) cos and sin of
-    2 pi i / Z_p (padded), ``pins`` (D,) Z_p, and ``values`` (D, 14): phase, w_H - Omega, w_w - Omega, K1, r_c,
-    Z_p e, e, m e w_H^2, needle k and c, pin k and c, clearance, and the carrier radius."""
-
-    index: np.ndarray
-    wheel: np.ndarray
-    crank_index: np.ndarray
-    crank_place: np.ndarray
-    cranks: np.ndarray
-    pin_place: np.ndarray
-    pins: np.ndarray
-    values: np.ndarray
-
-    @classmethod
-    def of(cls, cycloids) -> "Discs":
-        discs = [(e, j) for e in cycloids for j in range(len(e.disc))]
-        most_cranks = max((len(e.crank) for e in cycloids), default=0)
-        most_pins = max((e.geometry.pins for e in cycloids), default=0)
-        index = np.zeros((len(discs), 3), dtype=np.int64)
-        wheel = np.full((len(discs), 3), -1, dtype=np.int64)
-        crank_index = np.zeros((len(discs), most_cranks, 3), dtype=np.int64)
-        crank_place = np.zeros((len(discs), most_cranks, 2))
-        cranks = np.zeros(len(discs), dtype=np.int64)
-        pin_place = np.zeros((len(discs), most_pins, 2))
-        pins = np.zeros(len(discs), dtype=np.int64)
-        values = np.zeros((len(discs), 14))
-        for d, (e, j) in enumerate(discs):
-            g = e.geometry
-            index[d] = e.disc[j]
-            if e.wheel is not None:
-                wheel[d] = e.wheel
-            cranks[d] = len(e.crank)
-            crank_index[d, :cranks[d]] = e.crank
-            crank_place[d, :cranks[d]] = np.stack([np.cos(e.psi), np.sin(e.psi)], axis=-1)
-            angles = 2 * np.pi * np.arange(g.pins) / g.pins
-            pin_place[d, :g.pins] = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
-            pins[d] = g.pins
-            values[d] = (e.phases[j], e.omega_eccentric, e.omega_pins, g.K1, g.rolling_radius, g.pitch_radius,
-                         g.eccentricity, e.disc_mass * g.eccentricity * e.omega_orbit**2, e.needle_stiffness,
-                         e.needle_damping, e.pin_stiffness, e.pin_damping, e.clearance, e.carrier_radius)
-        return cls(index, wheel, crank_index, crank_place, cranks, pin_place, pins, values)
-
-
 @njit(inline="always")
 def pin(d, i, x, t, discs):
     """Pin i of disc d at state x, time t: (compression, normal x, normal y, arm on the disc, arm on the wheel)."""
@@ -327,9 +327,11 @@ def pin(d, i, x, t, discs):
 
 
 @njit(inline="always")
-def disc_forces(x, u, t, discs, out) -> None:
+def disc_forces(discs, at) -> None:
     """The compiled steps' form of :meth:`CycloidRows.forces`: every disc's orbit load, needle bearings and pin
-    contacts at state (x, u), time t, added into ``out`` (:mod:`gearcheck.lumped.compiled_steps`)."""
+    contacts at ``at`` = (x, u, t, out), state (x, u) and time t, added into ``out``
+    (:mod:`gearcheck.lumped.compiled_steps`)."""
+    x, u, t, out = at
     disc_index, wheel_index, crank_index, crank_place, cranks, _, pins, disc = discs
     for d in range(disc.shape[0]):
         dx_, dy, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
@@ -375,9 +377,11 @@ def disc_forces(x, u, t, discs, out) -> None:
 
 
 @njit(inline="always")
-def pin_switching(x, u, t, discs, g, rate, n) -> None:
-    """Every pin's compression at state (x, u), time t into g from index n on, and its rate into ``rate`` (its
-    normal's turning left out): the pins' switching functions (:mod:`gearcheck.lumped.compiled_steps`)."""
+def pin_switching(discs, at, n) -> int:
+    """Every pin's compression at ``at`` = (x, u, t, g, rate), state (x, u) and time t, into g from index n on, and
+    its rate into ``rate`` (its normal's turning left out): the pins' switching functions
+    (:mod:`gearcheck.lumped.compiled_steps`); returns the index after them."""
+    x, u, t, g, rate = at
     disc_index, wheel_index, _, _, _, _, pins, _ = discs
     for d in range(pins.size):
         dx_, dy_, dth = disc_index[d, 0], disc_index[d, 1], disc_index[d, 2]
@@ -389,3 +393,7 @@ def pin_switching(x, u, t, discs, g, rate, n) -> None:
             if wx >= 0:
                 rate[n] -= nx * u[wx] + ny * u[wy] + wheel_arm * u[wt]
             n += 1
+    return n
+
+
+compiled_group(Discs, disc_forces, pin_switching, lambda discs: int(np.sum(discs.pins)))

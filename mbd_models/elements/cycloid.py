@@ -40,7 +40,7 @@ import numpy as np
 
 from gearcheck.mbd_models import gear_visuals
 from gearcheck.mbd_models.elements import ELEMENTS
-from gearcheck.mbd_models.elements.base import Element
+from gearcheck.mbd_models.elements.base import Element, compiled_group
 from gearcheck.mbd_models.mjcf_text import (
     LATE,
     RGBA,
@@ -285,8 +285,96 @@ class _Stage:
     jacobian: np.ndarray  # (N, 2, n) work space: J_disc(P) - J_wheel(P) on those dofs
 
 
+# ------------------------------------------------------------------------- the compiled runner's group
+class Pins(NamedTuple):
+    """Per pin tendon (in its rows' order): tendon, stiffness, damping, clearance, pin site, ``wrap_prm`` entries."""
+
+    tendons: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    clearance: np.ndarray
+    site: np.ndarray
+    wraps: np.ndarray
+
+
+class Discs(NamedTuple):
+    """Per cycloid disc: body, pin wheel (-1: none), phase, lobes, eccentricity, pitch radius, first pin row, pins,
+    and its tendons' dofs (their number, and the dofs and qpos addresses, padded)."""
+
+    body: np.ndarray
+    wheel: np.ndarray
+    phase: np.ndarray
+    lobes: np.ndarray
+    eccentricity: np.ndarray
+    pitch_radius: np.ndarray
+    first: np.ndarray
+    count: np.ndarray
+    ndof: np.ndarray
+    dofs: np.ndarray
+    qadr: np.ndarray
+
+
+class PinWork(NamedTuple):
+    """Work space of the pin contacts: a Jacobian, the contact point, G, each row's compression, length and rate
+    of length (its coefficients held)."""
+
+    jacobian: np.ndarray
+    point: np.ndarray
+    G: np.ndarray
+    delta: np.ndarray
+    length: np.ndarray
+    speed: np.ndarray
+
+
+class CompiledPins(NamedTuple):
+    """An RV reducer's pin contacts as the compiled runner takes them (:meth:`of`)."""
+
+    pins: Pins
+    discs: Discs
+    work: PinWork
+
+    @classmethod
+    def of(cls, contacts, nv: int) -> "CompiledPins":
+        """The twin's pin contacts (its ``CycloidTwin``, or none: empty arrays of the same types) as flat arrays for
+        :func:`refresh_pins`, every contact's tendons in their order."""
+        rows, discs, stages, offset = [], [], [], 0
+        for c in contacts:  # each contact's stages, with where its tendons start among all
+            stages += [(g, offset) for g in c.stages]
+            offset += len(c.tendons)
+        width = max([g.dofs.shape[1] for g, _ in stages], default=6)
+        for g, offset in stages:
+            for i, body in enumerate(g.bodies):
+                first = offset + g.rows.start + i * len(g.sites)
+                dofs, qadr = np.full(width, -1), np.full(width, -1)
+                dofs[:g.dofs.shape[1]], qadr[:g.dofs.shape[1]] = g.dofs[i], g.qadr[i]
+                discs.append((body, g.wheel, g.phases[i], g.lobes, g.eccentricity, g.pitch_radius, first,
+                              len(g.sites), g.dofs.shape[1], dofs, qadr))
+                for p, pin_site in enumerate(g.sites):
+                    wraps = np.full(width, -1)
+                    wraps[:g.dofs.shape[1]] = g.wraps[i, p]
+                    rows.append((pin_site, wraps))
+        i64, f64 = np.int64, np.float64
+        n_pins = len(rows)
+
+        def joined(name: str, kind) -> np.ndarray:
+            return np.concatenate([np.asarray(getattr(c, name), dtype=kind) for c in contacts] + [np.zeros(0, kind)])
+
+        pins = Pins(joined("tendons", i64), joined("stiffness", f64), joined("damping", f64), joined("clearance", f64),
+                    np.array([r[0] for r in rows], dtype=i64),
+                    np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
+        columns = list(zip(*discs)) if discs else [[]] * 11
+        types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
+        disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))
+        disc = Discs(*disc[:9], *(x.reshape(len(discs), width) for x in disc[9:]))
+        work = PinWork(np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins),
+                       np.zeros(n_pins))
+        return cls(pins, disc, work)
+
+
 class CycloidTwin:
     """The pin contacts and needle bearings of a compiled twin's cycloid-pin stages."""
+
+    compiled = CompiledPins
 
     def __init__(self, spec, model: mujoco.MjModel):
         m, self.spec, self.model = model, spec, model
@@ -428,97 +516,15 @@ class CycloidTwin:
         return m.tendon_stiffness[t] * np.maximum(compression, 0.0) + m.tendon_damping[t] * d.ten_velocity[t]
 
 
-# ------------------------------------------------------------------------- the compiled runner's form
-class Pins(NamedTuple):
-    """Per pin tendon (in its rows' order): tendon, stiffness, damping, clearance, pin site, ``wrap_prm`` entries."""
-
-    tendons: np.ndarray
-    stiffness: np.ndarray
-    damping: np.ndarray
-    clearance: np.ndarray
-    site: np.ndarray
-    wraps: np.ndarray
-
-
-class Discs(NamedTuple):
-    """Per cycloid disc: body, pin wheel (-1: none), phase, lobes, eccentricity, pitch radius, first pin row, pins,
-    and its tendons' dofs (their number, and the dofs and qpos addresses, padded)."""
-
-    body: np.ndarray
-    wheel: np.ndarray
-    phase: np.ndarray
-    lobes: np.ndarray
-    eccentricity: np.ndarray
-    pitch_radius: np.ndarray
-    first: np.ndarray
-    count: np.ndarray
-    ndof: np.ndarray
-    dofs: np.ndarray
-    qadr: np.ndarray
-
-
-class PinWork(NamedTuple):
-    """Work space of the pin contacts: a Jacobian, the contact point, G, each row's compression, length and rate
-    of length (its coefficients held)."""
-
-    jacobian: np.ndarray
-    point: np.ndarray
-    G: np.ndarray
-    delta: np.ndarray
-    length: np.ndarray
-    speed: np.ndarray
-
-
-class CompiledPins(NamedTuple):
-    """An RV reducer's pin contacts as the compiled runner takes them (:func:`cycloid_arrays`)."""
-
-    pins: Pins
-    discs: Discs
-    work: PinWork
-
-
-def cycloid_arrays(contacts, nv: int) -> CompiledPins:
-    """The twin's pin contacts (:attr:`gearcheck.mbd_models.twin.MbdModel.moving_contacts`: an RV reducer's
-    ``CycloidTwin``) as flat arrays for :func:`refresh_pins`, every contact's tendons in their order; none: empty arrays
-    of the same types."""
-    rows, discs, stages, offset = [], [], [], 0
-    for c in contacts:  # each contact's stages, with where its tendons start among all
-        stages += [(g, offset) for g in c.stages]
-        offset += len(c.tendons)
-    width = max([g.dofs.shape[1] for g, _ in stages], default=6)
-    for g, offset in stages:
-        for i, body in enumerate(g.bodies):
-            first = offset + g.rows.start + i * len(g.sites)
-            dofs, qadr = np.full(width, -1), np.full(width, -1)
-            dofs[:g.dofs.shape[1]], qadr[:g.dofs.shape[1]] = g.dofs[i], g.qadr[i]
-            discs.append((body, g.wheel, g.phases[i], g.lobes, g.eccentricity, g.pitch_radius, first,
-                          len(g.sites), g.dofs.shape[1], dofs, qadr))
-            for p, pin_site in enumerate(g.sites):
-                wraps = np.full(width, -1)
-                wraps[:g.dofs.shape[1]] = g.wraps[i, p]
-                rows.append((pin_site, wraps))
-    i64, f64 = np.int64, np.float64
-    n_pins = len(rows)
-
-    def joined(name: str, kind) -> np.ndarray:
-        return np.concatenate([np.asarray(getattr(c, name), dtype=kind) for c in contacts] + [np.zeros(0, kind)])
-
-    pins = Pins(joined("tendons", i64), joined("stiffness", f64), joined("damping", f64), joined("clearance", f64),
-                np.array([r[0] for r in rows], dtype=i64),
-                np.array([r[1] for r in rows], dtype=i64).reshape(n_pins, width))
-    columns = list(zip(*discs)) if discs else [[]] * 11
-    types = (i64, i64, f64, f64, f64, f64, i64, i64, i64, i64, i64)
-    disc = tuple(np.array(column, dtype=kind) for column, kind in zip(columns, types))
-    disc = Discs(*disc[:9], *(x.reshape(len(discs), width) for x in disc[9:]))
-    work = PinWork(np.zeros((3, nv)), np.zeros(3), np.zeros((2, width)), np.zeros(n_pins), np.zeros(n_pins),
-                   np.zeros(n_pins))
-    return CompiledPins(pins, disc, work)
-
-
+# ------------------------------------------------------------------------- the compiled runner's functions
 @numba.njit(cache=True)
-def refresh_pins(kinematics, com_pos, jac, m, d, model, data, cycloid):
+def refresh_pins(cycloid, at):
     """``CycloidTwin.refresh(d)`` (a run's compression-only contacts): every pin tendon's coefficients, spring
-    lengths, stiffness and damping at the discs' present poses, from MuJoCo's kinematics and Jacobians."""
+    lengths, stiffness and damping at the discs' present poses, from MuJoCo's kinematics and Jacobians; ``at`` =
+    (kinematics, com_pos, jac, m, d, model, data) (:data:`~gearcheck.mbd_models.elements.base.REFRESH`)."""
+    kinematics, com_pos, jac, m, d, model, data = at
+    if cycloid.discs.body.size == 0:
+        return
     stiffness, lengthspring, wrap_prm, damping_model = (model.tendon_stiffness, model.tendon_lengthspring,
                                                         model.wrap_prm, model.tendon_damping)
     qpos, qvel, xpos, xmat, site_xpos = data.qpos, data.qvel, data.xpos, data.xmat, data.site_xpos
@@ -576,23 +582,31 @@ def refresh_pins(kinematics, com_pos, jac, m, d, model, data, cycloid):
 
 
 @numba.njit(cache=True)
-def pin_forces_into(out, model, data, cycloid):
+def pin_forces_into(cycloid, at, n):
     """:meth:`CycloidTwin.pin_forces` in the compiled runner: each pin tendon's force at the data's state into
-    ``out``."""
+    ``out`` from column n on, ``at`` = (out, model, data); returns the column after them."""
+    out, model, data = at
     stiffness, lengthspring, damping = model.tendon_stiffness, model.tendon_lengthspring, model.tendon_damping
     tendons, ten_length, ten_velocity = cycloid.pins.tendons, data.ten_length, data.ten_velocity
     for p in range(tendons.size):
         t = tendons[p]
         compression = ten_length[t] - lengthspring[t, 1]
-        out[p] = stiffness[t] * max(compression, 0.0) + damping[t] * ten_velocity[t]
+        out[n + p] = stiffness[t] * max(compression, 0.0) + damping[t] * ten_velocity[t]
+    return n + tendons.size
 
 
 @numba.njit(cache=True)
-def pin_switching(cycloid, g, rate, n):
-    """Every pin's compression (its clearance off) into g from index n on and its rate into ``rate``, as
-    :func:`refresh_pins` last found them: the pins' switching functions in the compiled runner."""
+def pin_switching(cycloid, at, n):
+    """Every pin's compression (its clearance off) into g from index n on and its rate into ``rate``, ``at`` =
+    (g, rate), as :func:`refresh_pins` last found them: the pins' switching functions in the compiled runner;
+    returns the index after them."""
+    g, rate = at
     delta, speed, clearance = cycloid.work.delta, cycloid.work.speed, cycloid.pins.clearance
     for p in range(delta.size):
         g[n] = delta[p] - clearance[p]
         rate[n] = speed[p]
         n += 1
+    return n
+
+
+compiled_group(CompiledPins, refresh_pins, pin_switching, pin_forces_into)

@@ -86,10 +86,16 @@ def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
     # for 2.5 s): both of its runs start on their periodic steady states, and it is decided like the others
     assert main(["crosscheck", "--all", "--baseline", "--out", str(tmp_path)]) == 0  # the baselines' duration
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert {r["train"] for r in summary["presets"]} == set(preset_names())
-    assert all(r["moved"] == 0 and r["failed"] == 0 for r in summary["presets"])
-    assert {r["train"]: r["status"] for r in summary["presets"]} == {name: "PASS" for name in preset_names()}
-    assert (tmp_path / "summary.html").read_text().count("report.html") == len(summary["presets"])
+    assert {r["train"] for r in summary["trains"]} == set(preset_names())
+    assert all(r["moved"] == 0 and r["failed"] == 0 for r in summary["trains"])
+    assert {r["train"]: r["status"] for r in summary["trains"]} == {name: "PASS" for name in preset_names()}
+    assert summary["verdict"] == "PASS"
+    assert (tmp_path / "summary.html").read_text().count("report.html") == len(summary["trains"])
+    text = (tmp_path / "summary.md").read_text()
+    assert f"**overall: PASS (0 failed, 0 inconclusive, {len(preset_names())} passed of {len(preset_names())} " \
+           "trains)**" in text
+    assert text.count("every quantity and mode within tolerance") == len(preset_names())
+    assert "(0.05)" in text  # the worst NRMSE beside its tolerance
 
 
 def test_a_baseline_rewritten_without_a_duration_keeps_its_own(tmp_path):

@@ -31,12 +31,13 @@ from gearcheck.compare.engine.crosscheck import MODELS
 from gearcheck.compare.presentation.junit import write_junit
 from gearcheck.compare.presentation.progress import ProgressBar
 from gearcheck.compare.presentation.report import write_report
-from gearcheck.compare.presentation.summary import summary_row, write_summary
+from gearcheck.compare.presentation.summary import overall_line, summary_row, write_summary
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError, did_you_mean, one_line
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
 from gearcheck.shared.trust import granted
 from gearcheck.shared.units import checked_rpm
+from gearcheck.train.files import report_folders, train_list
 
 
 FULL = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}  # a disk full, a quota, a read-only file system
@@ -664,13 +665,21 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_crosscheck(args) -> int:
-    if args.all == (args.train is not None):
-        raise GearcheckError("give a TRAIN or --all, not both")
-    if args.all and (args.model not in MODELS or args.results is not None):
-        raise GearcheckError("--model FILE and --results check one train; --all runs the shipped presets")
-    if args.all and args.speed is not None:
-        raise GearcheckError("--speed applies to one train; --all runs each preset at its own speed")
-    names = gearcheck.presets() if args.all else [args.train]
+    if args.all == bool(args.train):
+        raise GearcheckError("give TRAIN (one or more) or --all, not both")
+    names = gearcheck.presets() if args.all else train_list(args.train)
+    fleet = args.all or len(names) > 1
+    if fleet and (args.model not in MODELS or args.results is not None):
+        raise GearcheckError("--model FILE and --results check one train, not several")
+    if fleet and args.speed is not None:
+        raise GearcheckError("--speed applies to one train; several run each at its own speed")
+    specs = [gearcheck.load(name) for name in names]  # every train checked before anything runs or is written
+    if args.history is not None:
+        for spec, name in zip(specs, names):
+            if [s.name for s in specs].count(spec.name) > 1:
+                raise GearcheckError(f"TRAIN {name}: another train of the fleet has its name {spec.name!r}, and "
+                                     "--history keeps one record per commit and train name")
+    folders = report_folders(names) if fleet else [""]
     rows, lines, reports = [], [], []
     if args.junit is not None:
         check_place(args.junit, "--junit", folder=False)
@@ -679,7 +688,7 @@ def cmd_crosscheck(args) -> int:
         history.check_store(args.history)
         commit = history.checked_commit(args.history, args.commit or os.environ.get("GITHUB_SHA") or head_commit())
     with OutputDirectory(args.out) as place:
-        for name in names:
+        for name, folder in zip(names, folders):
             bar = ProgressBar(f"crosscheck {name}")
             result = gearcheck.crosscheck(
                 name, speed=args.speed, duration=args.duration, model=args.model, against=args.against,
@@ -688,20 +697,20 @@ def cmd_crosscheck(args) -> int:
                 sensor_band=args.sensor_band, baseline=args.baseline, update_baseline=args.update_baseline,
                 progress=bar)
             bar.close()
-            data = write_report(result, place.path / name if args.all else place.path)
-            lines.append(_verdict_line(result, args.out / name if args.all else args.out))
-            rows.append(summary_row(data))
+            data = write_report(result, place.path / folder)
+            lines.append(_verdict_line(result, args.out / folder))
+            rows.append(summary_row(data, folder))
             reports.append(data)
             if args.history is not None:
                 history.append(args.history, data, commit, commit_date(commit))
-        if args.all:
-            write_summary(place.path, rows)
+        if fleet:
+            write_summary(place.path, rows, "every preset" if args.all else f"{len(rows)} trains")
     if args.junit is not None:
         write_junit(reports, args.junit)
     for line in lines:
         print(line)
-    if args.all:
-        print(f"summary: {args.out / 'summary.md'}")
+    if fleet:
+        print(f"{overall_line(rows)} (summary: {args.out / 'summary.md'})")
     if args.junit is not None:
         print(f"junit: {args.junit}")
     return exit_status([r["status"] for r in rows])
@@ -794,7 +803,9 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
     "crosscheck": Command(
         cmd_crosscheck, "run both solvers, compare them, write a report; exit 1 when a tolerance is exceeded or a "
                         "baseline metric moved, 3 when the comparison is inconclusive",
-        arg("train", metavar="TRAIN", nargs="?", help="preset name or path to a train TOML file"),
+        arg("train", metavar="TRAIN", nargs="*",
+            help="preset name or train TOML file; several, a folder (its *.toml) or a quoted pattern ('fleet/*.toml') "
+                 "check a fleet: a report each, one summary, one --junit file, one --history append"),
         arg("--all", action="store_true", help="every shipped preset, with a summary table"),
         arg("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)"),
         arg("--duration", type=SECONDS, metavar="S",

@@ -11,6 +11,7 @@ deeper than Python's parser recurses.
 
 from __future__ import annotations
 
+import glob
 import io
 import math
 import os
@@ -144,3 +145,53 @@ def parse_toml(text: str, source: str) -> dict:
 
 def read_toml(path: str | Path, what: str = "file") -> dict:
     return parse_toml(read_text(path, what), str(path))
+
+
+GLOB_CHARACTERS = frozenset("*?[")
+MAX_TRAINS = 10000  # a fleet's train files, after folders and patterns are expanded
+
+
+def train_list(items: list[str], option: str = "TRAIN") -> list[str]:
+    """The trains a fleet names, in order, each once: a preset name or train file as it is, a folder as every
+    ``*.toml`` directly in it (sorted), a pattern with ``*``, ``?`` or ``[`` that names no file as the files it
+    matches (sorted; ``**`` reaches into subfolders).  A folder or pattern that yields no file is refused."""
+    trains: list[str] = []
+    seen: set[str] = set()
+    for item in items:
+        path = Path(item)
+        if path.is_dir():
+            found = sorted(str(p) for p in path.glob("*.toml") if p.is_file())
+            if not found:
+                raise GearcheckError(f"{option} {item}: a folder with no .toml train file in it")
+        elif GLOB_CHARACTERS & set(item) and not path.exists():
+            found = sorted(p for p in glob.glob(item, recursive=True) if Path(p).is_file())
+            if not found:
+                raise GearcheckError(f"{option} {item!r}: the pattern matches no file")
+        else:
+            found = [item]
+        for train in found:  # a file named twice (a.toml, ./a.toml) runs once
+            key = os.path.realpath(train) if Path(train).exists() else train
+            if key not in seen:
+                seen.add(key)
+                trains.append(train)
+        if len(trains) > MAX_TRAINS:
+            raise GearcheckError(f"{option}: more than {MAX_TRAINS} trains")
+    return trains
+
+
+def report_folders(trains: list[str]) -> list[str]:
+    """A folder name per train of a fleet, unique: a preset's name, a file's stem, and where two files share a stem
+    as many of their parent folders' names in front (``a-train``, ``b-train``) as tell them apart."""
+    parts = [tuple(x for x in Path(t).with_suffix("").parts if x not in (os.sep, "..", "."))
+             if t.endswith(".toml") else (t,) for t in trains]
+    depth = [1] * len(parts)
+    while True:
+        names = ["-".join(p[-d:]) for p, d in zip(parts, depth)]
+        clashes = {n for n in names if names.count(n) > 1}
+        grow = [i for i, n in enumerate(names) if n in clashes and depth[i] < len(parts[i])]
+        if not grow:
+            break
+        for i in grow:
+            depth[i] += 1
+    # the same path written two ways (./a.toml, a.toml) or nothing left to tell apart: numbered
+    return [f"{n}-{i + 1}" if n in clashes else n for i, n in enumerate(names)]

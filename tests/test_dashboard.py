@@ -81,13 +81,14 @@ def test_append_is_idempotent_and_reads_back(scratch, tmp_path):
     history.append(store, reports[2], "c0", machine="runner-7")  # c0 again: replaced, keeps its date
     after, runs = history.read(store), history.runs(store)
     assert history.commits(store) == ["c0", "c1", "c2"]
-    per_run = [7 * len(d["quantities"]) + 3 * len(d["modes"]) + len(d["volatile"]["wall_time"]) for d in reports]
+    per_run = [7 * len(d["quantities"]) + 3 * len(d["modes"]) + len(d["volatile"]["wall_time"])
+               + len(d["volatile"]["cpu_time"]) for d in reports]
     assert len(runs) == 3 and len(after) == len(before) == sum(per_run)
     assert runs["machine"].tolist() == ["runner-7"] + [d["provenance"]["machine"] for d in reports[1:]]
     assert runs["date"].tolist() == ["2025-01-01T00:00:00Z", "2025-01-02T00:00:00Z", "2025-01-03T00:00:00Z"]
-    physics = after[after["item"] != "wall_time"]
+    physics = after[~after["item"].isin(history.TIMES)]
     c0, c2 = (physics.loc[physics["commit"] == c, "value"].tolist() for c in ("c0", "c2"))
-    assert c0 == c2 != before.loc[(before["commit"] == "c0") & (before["item"] != "wall_time"), "value"].tolist()
+    assert c0 == c2 != before.loc[(before["commit"] == "c0") & ~before["item"].isin(history.TIMES), "value"].tolist()
     history.append(store, reports[1], "c1")  # the same record again: nothing changes
     pd.testing.assert_frame_equal(history.read(store), after)
 
@@ -102,6 +103,9 @@ def test_append_is_idempotent_and_reads_back(scratch, tmp_path):
     assert row.loc["lumped.frequency", "value"] == mode["lumped"]["value"]
     assert row.loc["rel_error", "status"] == mode["status"]
     assert set(after.loc[after["item"] == "wall_time", "metric"]) == set(reports[0]["volatile"]["wall_time"])
+    assert set(after.loc[after["item"] == "cpu_time", "metric"]) == set(reports[0]["volatile"]["cpu_time"])
+    cpu = after[(after["commit"] == "c1") & (after["item"] == "cpu_time")].set_index("metric")["value"]
+    assert all(cpu[k] == v["value"] >= 0 for k, v in reports[1]["volatile"]["cpu_time"].items())
     assert after["order"].is_monotonic_increasing
 
     other = dict(reports[0], train=dict(reports[0]["train"], name="other"))
@@ -175,7 +179,7 @@ def test_change_points_on_synthetic_series():
     assert history.change_points(gated + [3.0e-3], tolerance=0.01) == [4]
     assert history.change_points([1e-15, 7e-15, 3e-15, 9e-15]) == []  # round-off
     assert history.change_points([1.0, None, float("nan"), 1.5, 1.5]) == [3]  # gaps skipped, indices kept
-    assert history.rule("wall_time", "s", None) is None
+    assert history.rule("wall_time", "s", None) is None and history.rule("cpu_time", "s", None) is None
 
 
 # ---------------------------------------------------------------- the must-hold
@@ -235,6 +239,8 @@ def test_the_pages_render_in_headless_chromium(scratch, page, browser):
     dom = browser.browse(path, "--dump-dom")
     assert not browser.console(dom.stderr), browser.console(dom.stderr)
     assert dom.stdout.count("<svg") >= (1 if page == "index.html" else 60) and 'class="change-point"' in dom.stdout
+    if page != "index.html":  # the timing trend in CPU time, steadier than the wall time on a shared runner
+        assert "CPU time (s)" in dom.stdout and "Wall time (s)" not in dom.stdout
     shot = scratch.root / page.replace(".html", ".png")
     done = browser.browse(path, f"--screenshot={shot}")
     assert not browser.console(done.stderr), browser.console(done.stderr)

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -104,7 +105,8 @@ class CrosscheckResult:
     modal_results: tuple  # (reference ModalResult, test ModalResult)
     grid: np.ndarray
     series: dict  # quantity -> (a, b) on the grid
-    wall_times: dict
+    wall_times: dict  # s, by step (``Clock``)
+    cpu_times: dict  # s, by step: this process's CPU time, its threads included
     measurements: list[dict] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)  # findings stated in plain words in the report
     references: list[str] = field(default_factory=list)  # keys of gearcheck.shared.citations.REFERENCES
@@ -177,13 +179,11 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     sensor_band: (low, high) Hz of an accelerometer chain applied to both runs' accelerations.
     progress: callable(fraction) over the runs.
     """
-    wall = {}
-    started = time.perf_counter()
-    modes_a = reference.modes()
-    wall["lumped_modes_s"] = time.perf_counter() - started
-    started = time.perf_counter()
-    modes_b = test.modes() if test.has_modes else None
-    wall["mujoco_modes_s"] = time.perf_counter() - started
+    clock = Clock()
+    with clock.step("lumped_modes_s"):
+        modes_a = reference.modes()
+    with clock.step("mujoco_modes_s"):
+        modes_b = test.modes() if test.has_modes else None
     modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
 
     asked = settings[0].duration
@@ -199,7 +199,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     while True:
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
         try:
-            attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, wall, progress, periodic)
+            attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, clock, progress, periodic)
         except (UnsupportedError, SolverError) as exc:
             if not periodic:
                 raise
@@ -264,7 +264,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     return CrosscheckResult(spec, run_settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
                             comparisons, t0, how in ("detected", "decayed", "transient", "periodic"), (a, b),
                             (modes_a, modes_b),
-                            grid, series, wall, notes=notes, references=list(dict.fromkeys(references)),
+                            grid, series, clock.wall, clock.cpu, notes=notes,
+                            references=list(dict.fromkeys(references)),
                             steady_how=how, settle_s=plan.settle if plan.detect_steady else None,
                             solvers=(reference.solver, test.solver))
 
@@ -290,11 +291,11 @@ class _Attempt:
         return max((q.error_ratio for q in self.comparisons if q.status != "negligible"), default=0.0)
 
     @classmethod
-    def of(cls, sides, settings, plan, tolerances, sensor_band, wall, progress, periodic=False) -> "_Attempt":
+    def of(cls, sides, settings, plan, tolerances, sensor_band, clock, progress, periodic=False) -> "_Attempt":
         """Both sides run (from their periodic steady states where ``periodic``: steady from the start) and
         compared."""
         starts = []
-        (a, a_check), (b, b_check) = _run_pairs(sides, settings, wall, progress, periodic, starts)
+        (a, a_check), (b, b_check) = _run_pairs(sides, settings, clock, progress, periodic, starts)
         names = [n for n in a.names(compared=True) if n in b]
         grid, fs, series = _common_grid(a, b, names, plan, sensor_band)
         t0, how = 0.0, "periodic" if periodic else "transient"
@@ -334,7 +335,23 @@ def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:
                          modes_b.types, [modes_a.multiplicity[i] for i in partner])
 
 
-def _run_pairs(sides, settings, wall, progress, periodic=False, starts=None):
+class Clock:
+    """Wall and CPU time of a cross-check's steps, by name.  The CPU time is this process's, its threads included
+    (MuJoCo's runs): what a step costs, steady where the wall time of a shared CI runner is not."""
+
+    def __init__(self):
+        self.wall: dict[str, float] = {}
+        self.cpu: dict[str, float] = {}
+
+    @contextmanager
+    def step(self, name: str):
+        wall, cpu = time.perf_counter(), time.process_time()
+        yield
+        self.wall[name] = time.perf_counter() - wall
+        self.cpu[name] = time.process_time() - cpu
+
+
+def _run_pairs(sides, settings, clock, progress, periodic=False, starts=None):
     """Each side's run and its integration check (2 h, or h / 2 where 2 h is beyond its stable step), both from
     the side's periodic steady state where ``periodic`` (how each was found appended to ``starts``); a recorded
     side (``rerunnable`` False) has no check."""
@@ -343,27 +360,25 @@ def _run_pairs(sides, settings, wall, progress, periodic=False, starts=None):
         label = ("lumped", "mujoco")[i]
         # progress over both sides: a run counts 1, its check (at most twice the step) 0.5
         report = (lambda f, i=i: progress((1.5 * i + f) / 3.0)) if progress else None
-        started = time.perf_counter()
         if periodic:
             if i == 1 and run_settings.dt is not None and run_settings.dt == settings[0].dt:
                 # the step the reference made a whole fraction of its period: a twin whose period is a multiple
                 # of it keeps it, and the two runs sample the same instants (as two free runs on one step do)
                 run_settings = replace(run_settings, dt=pairs[0][0].info["dt_s"])
-            run, check, how = side.run_periodic(run_settings, lambda h, side=side: check_step(side, h), report)
+            with clock.step(f"{label}_run_s"):
+                run, check, how = side.run_periodic(run_settings, lambda h, side=side: check_step(side, h), report)
             starts.append(how)
-            wall[f"{label}_run_s"] = time.perf_counter() - started
             pairs.append((run, check))
             continue
-        run = side.run(run_settings, report)
-        wall[f"{label}_run_s"] = time.perf_counter() - started
+        with clock.step(f"{label}_run_s"):
+            run = side.run(run_settings, report)
         if not side.rerunnable:
             pairs.append((run, None))
             continue
         check_dt = check_step(side, run.info["dt_s"])
         report = (lambda f, i=i: progress((1.5 * i + 1.0 + 0.5 * f) / 3.0)) if progress else None
-        started = time.perf_counter()
-        check = side.run(replace(run_settings, dt=check_dt, output_dt=None), report)
-        wall[f"{label}_check_s"] = time.perf_counter() - started
+        with clock.step(f"{label}_check_s"):
+            check = side.run(replace(run_settings, dt=check_dt, output_dt=None), report)
         pairs.append((run, check))
     return pairs
 

@@ -20,7 +20,8 @@ A run's metrics (``item`` / ``metric``): per quantity (``item`` its name) ``nrms
 ``mujoco.peak_to_peak`` (in the quantity's unit), ``integration_error.lumped`` and
 ``integration_error.mujoco`` (with the quantity's tolerance, which their sum must stay below); per
 mode (``item`` "mode N") ``rel_error`` (gated), ``lumped.frequency`` and ``mujoco.frequency`` (Hz);
-``item`` "wall_time": one metric per timed step (s).
+``item`` "wall_time" and "cpu_time" (this process's, its threads included; reports up to gearcheck 0.2.0 have wall
+time only): one metric per timed step (s).
 
 Change points (:func:`change_points`): point ``i`` of a metric's series over commits is where the
 metric moved when both the point and the median of the next ``CONFIRM`` points (itself included)
@@ -63,6 +64,7 @@ K = 4.0  # noise multiples a move must exceed
 TOLERANCE_SHARE = 0.1  # a gated metric moves when it moves by this share of its tolerance
 RELATIVE_FLOOR = 0.01  # a physical value (amplitude, frequency) moves when it moves by this part of itself
 ROUND_OFF = 1e-12  # moves below this (in the metric's unit) are round-off
+TIMES = ("wall_time", "cpu_time")  # the report's timings of its steps (its ``volatile`` part)
 _NOISE = 0.6745 * math.sqrt(2.0)  # median |x_j - x_j-1| of Gaussian noise, in standard deviations
 
 _TABLES = """
@@ -239,8 +241,8 @@ def change_points(values, tolerance: float | None = None, relative: float = 0.0,
 
 def rule(item: str, unit: str | None, tolerance: float | None) -> dict | None:
     """The keywords of :func:`change_points` for a recorded metric: its tolerance, and ``relative`` for a
-    physical value (not a ratio); None for wall times, which are machine noise, not the code's."""
-    if item == "wall_time":
+    physical value (not a ratio); None for times, which are the machine's, not the code's."""
+    if item in TIMES:
         return None
     return {"tolerance": tolerance, "relative": 0.0 if unit in ("1", None) else RELATIVE_FLOOR}
 
@@ -279,8 +281,9 @@ def _record(data: dict, machine: str | None) -> tuple[str, dict, list[tuple]]:
                      mode_tol is not None))
         for solver in ("lumped", "mujoco"):
             rows.append((item, f"{solver}.frequency", m.get("type"), "Hz", _value(m.get(solver)), None, None, False))
-    for name, value in sorted(((data.get("volatile") or {}).get("wall_time") or {}).items()):
-        rows.append(("wall_time", name, "wall_time", "s", _value(value), None, None, False))
+    for clock in TIMES:
+        for name, value in sorted(((data.get("volatile") or {}).get(clock) or {}).items()):
+            rows.append((clock, name, clock, "s", _value(value), None, None, False))
     return data["train"]["name"], run, rows
 
 

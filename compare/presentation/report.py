@@ -174,7 +174,8 @@ def to_dict(result) -> dict:
         "notes": result.notes,
         "references": cite(result.references),
         "volatile": {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-                     "wall_time": {k: _u(v, "s") for k, v in result.wall_times.items()}},
+                     "wall_time": {k: _u(v, "s") for k, v in result.wall_times.items()},
+                     "cpu_time": {k: _u(v, "s") for k, v in result.cpu_times.items()}},
     }
 
 
@@ -547,7 +548,9 @@ def _report_properties() -> dict:
         "notes": _array(STRING),
         "references": _array(_object({"key": STRING, "citation": STRING})),
         "volatile": _object({"timestamp": {"type": "string", "format": "date-time"},
-                             "wall_time": {"type": "object", "additionalProperties": seconds}}),
+                             "wall_time": {"type": "object", "additionalProperties": seconds},
+                             "cpu_time": {"type": "object", "additionalProperties": seconds}},
+                            required=["timestamp", "wall_time"]),  # cpu_time: in reports after gearcheck 0.2.0
     }
 
 

@@ -255,7 +255,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         "duration_s": asked, "simulated_s": duration, **plan.operating,
         "lumped": {k: a.info[k] for k in SIDE_SETTINGS if k in a.info},
         "mujoco": {k: v for k, v in b.info.items() if k != "wall_time_s" and _plain(v)},
-        "common_sample_rate_hz": fs, "steady_cycle_s": plan.cycle,
+        "common_sample_rate_hz": fs, "steady_cycle_s": plan.cycle, "steady_cycle_of": plan.cycle_of,
         "integration_check_steps_s": [c.info["dt_s"] if c is not None else None for c in (a_check, b_check)],
         "sensor_band_hz": list(sensor_band) if sensor_band else None,
         "tolerances": dict(sorted(tolerances.values.items())),

@@ -86,6 +86,11 @@ class TrainPlan:
         """The period of the slowest mesh: the cycle of the steady-state test and of the plots."""
         return 1.0 / min(f for f, _ in self.stage_frequencies.values())
 
+    @property
+    def cycle_of(self) -> str:
+        """What :attr:`cycle` is the cycle of, in words: "the stage2 mesh" (each stage's meshes have their own)."""
+        return f"the {min(self.stage_frequencies, key=lambda stage: self.stage_frequencies[stage][0])} mesh"
+
     def _frequencies(self, name: str) -> tuple[float, float]:
         f_mesh, f_carrier = self.stage_frequencies.get(name.split(".")[0], next(iter(self.stage_frequencies.values())))
         mesh = name.rsplit(".", 1)[0]
@@ -129,6 +134,10 @@ class TransientPlan:
     def cycle(self) -> float:
         elastic = self.frequencies[self.frequencies > 0]
         return 1.0 / float(elastic.min())
+
+    @property
+    def cycle_of(self) -> str:
+        return f"mode {int(np.argmax(self.frequencies > 0)) + 1}"
 
     def max_lag(self, name: str) -> float:
         return self.dt

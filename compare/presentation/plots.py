@@ -47,19 +47,19 @@ def _png(fig) -> bytes:
 
 def headline_quantities(result) -> list[str]:
     """Carrier and ring accelerations (world y, as the accelerometers see them) and the first
-    sun-planet and ring-planet mesh forces of every stage; the first four quantities when none
-    of those is compared."""
+    sun-planet and ring-planet mesh forces of every stage, those not negligible (a held ring's acceleration is
+    both solvers' round-off); the first four quantities not negligible when none of those is."""
     names = []
-    available = {q.name for q in result.quantities}
     for stage in result.spec.stages:
         for member in (stage.carrier, *[c for c in stage.centrals if result.spec.members[c].kind == "ring"]):
             names.append(f"{member}.ay.world")
         for mesh in result.spec.meshes:
             if mesh.stage == stage.name and mesh.planet_index == 0:
                 names.append(f"{mesh.id}.force")
-    names = [n for n in names if n in available]
-    if not names:  # trains compared on other quantities (e.g. a published 4-DOF model): the first four
-        names = [q.name for q in result.quantities][:4]
+    shown = {q.name for q in result.quantities if q.status != "negligible"}  # round-off draws as a disagreement
+    names = [n for n in names if n in shown]
+    if not names:  # trains compared on other quantities (a published 4-DOF model), or with those negligible
+        names = ([q.name for q in result.quantities if q.name in shown] or [q.name for q in result.quantities])[:4]
     return names
 
 
@@ -92,7 +92,9 @@ def time_histories_figure(result, names=None, cycles: int = 4) -> Figure:
         ax.grid(alpha=0.3)
     axes[0, 0].legend(loc="upper right", fontsize=8)
     axes[-1, 0].set_xlabel("time [ms]")
-    fig.suptitle(_title(result, f"steady-state time histories, last {cycles} mesh cycles"), fontsize=9)
+    of = result.settings.get("steady_cycle_of", "the slowest mesh")
+    fig.suptitle(_title(result, f"steady-state time histories, last {cycles} cycles of {of} ({f_cycle:.4g} Hz)"),
+                 fontsize=9)
     return fig
 
 

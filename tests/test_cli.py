@@ -1,6 +1,7 @@
 """The command line: listing, showing, modes as JSON, a lumped run writing its files."""
 
 import json
+import logging
 import re
 
 import numpy as np
@@ -8,6 +9,7 @@ import pandas as pd
 import pytest
 
 from gearcheck.cli import main
+from gearcheck.shared import settings
 from gearcheck.train.loader import preset_text
 from gearcheck.shared.results import units_of
 
@@ -62,3 +64,25 @@ def test_show_leaves_out_a_source_the_file_does_not_give(tmp_path, capsys):
     assert main(["show", str(path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[1] == f"  file: {path}" and not any("source:" in line for line in lines)
+
+
+def test_verbose_tells_what_each_step_costs_and_quiet_leaves_errors_only(tmp_path, capsys, monkeypatch):
+    """``-v`` logs every run's wall and CPU time and its work, ``-q`` silences notes (warnings) and progress;
+    both at once are refused; the logger is left as it was."""
+    assert main(["crosscheck", "demo-3p", "--duration", "0.05", "-v", "--out", str(tmp_path / "v")]) == 0
+    err = capsys.readouterr().err
+    assert re.search(r"^gearcheck: lumped run: \S+ s wall, \S+ s CPU$", err, re.M)
+    assert re.search(r"^gearcheck: mujoco: mujoco-compiled, dt \S+ s, \d+ steps, \d+ right-hand-side calls$", err,
+                     re.M)
+    assert re.search(r"^gearcheck: demo-3p: 0.05 s simulated, steps \S+ s, \S+ s, from the static states$", err,
+                     re.M)
+    monkeypatch.setattr(settings, "LONG_STEPS", 100)  # every run is "long": a note on stderr
+    run = ["run", "demo-3p", "--duration", "0.002", "--out", str(tmp_path / "r")]
+    assert main(run) == 0
+    assert "gearcheck: note: duration 0.002 s at the step" in capsys.readouterr().err
+    assert main(run + ["-q"]) == 0
+    assert capsys.readouterr().err == ""
+    assert main(run + ["-q", "-v"]) == 2
+    assert capsys.readouterr().err == "gearcheck: error: -v and -q: give one\n"
+    logger = logging.getLogger("gearcheck")
+    assert not logger.handlers and logger.level == logging.NOTSET and logger.propagate

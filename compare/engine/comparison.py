@@ -35,6 +35,7 @@ Any pair of :class:`~gearcheck.shared.side.Side` objects, read by a comparison p
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from contextlib import contextmanager
@@ -59,6 +60,7 @@ from gearcheck.shared.errors import SolverError, UnsupportedError
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
+from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.side import display_name
 from gearcheck.shared.stepping import ORDER, richardson_factor
 
@@ -70,6 +72,8 @@ ASYMPTOTIC = 0.25  # Richardson's estimate where doubling the step moves the mes
 EXTENSION_FACTOR = 8  # a run is extended to its steady state up to this multiple of the duration asked for
 SENSED = ("acceleration", "angular_acceleration")  # the kinds an accelerometer chain (sensor_band) filters
 SIDE_SETTINGS = ("method", "dt_s", "steps", "rotating_frame_terms")  # what the report states of the reference run
+
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -196,8 +200,13 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     periodic = rerunnable and needed is not None and needed > EXTENSION_FACTOR * asked
     if periodic:
         periodic = _periodic_note(plan, reference, needed, asked, notes)
+    told = 0  # notes already logged
     while True:
+        told = _tell(notes, told)
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
+        log.info("%s: %.4g s simulated, steps %s, %s", spec.name, duration,
+                 ", ".join("derived" if dt is None else f"{dt:.4g} s" for dt in steps),
+                 "from the periodic steady states" if periodic else "from the static states")
         try:
             attempt = _Attempt.of((reference, test), runs, plan, tolerances, sensor_band, clock, progress, periodic)
         except (UnsupportedError, SolverError) as exc:
@@ -231,6 +240,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
                          f"as h^{order}).")
             continue
         break
+    _tell(notes, told)
     (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
     if best.starts:
         notes.append("Periodic steady states found by " + "; ".join(best.starts) + ".")
@@ -349,6 +359,23 @@ class Clock:
         yield
         self.wall[name] = time.perf_counter() - wall
         self.cpu[name] = time.process_time() - cpu
+        log.info("%s: %.3g s wall, %.3g s CPU", name.removesuffix("_s").replace("_", " "), self.wall[name],
+                 self.cpu[name])
+
+
+def _tell(notes: list[str], told: int) -> int:
+    """Log the notes from ``told`` on as they are made (the command line's ``-v``); returns how many are told."""
+    for note in notes[told:]:
+        log.info("%s", " ".join(note.split()))
+    return len(notes)
+
+
+def _log_work(label: str, run) -> None:
+    """What a run did, at the command line's ``-v``: its engine, step, steps and right-hand-side calls."""
+    info = run.info
+    if isinstance(info, RunInfo):  # a recording's is the file's description
+        log.info("%s: %s, dt %.4g s, %d steps, %d right-hand-side calls", label, info.engine, info["dt_s"],
+                 info.steps, info.rhs_calls)
 
 
 def _run_pairs(sides, settings, clock, progress, periodic=False, starts=None):
@@ -372,6 +399,7 @@ def _run_pairs(sides, settings, clock, progress, periodic=False, starts=None):
             continue
         with clock.step(f"{label}_run_s"):
             run = side.run(run_settings, report)
+        _log_work(label, run)
         if not side.rerunnable:
             pairs.append((run, None))
             continue
@@ -379,6 +407,7 @@ def _run_pairs(sides, settings, clock, progress, periodic=False, starts=None):
         report = (lambda f, i=i: progress((1.5 * i + 1.0 + 0.5 * f) / 3.0)) if progress else None
         with clock.step(f"{label}_check_s"):
             check = side.run(replace(run_settings, dt=check_dt, output_dt=None), report)
+        _log_work(f"{label} check", check)
         pairs.append((run, check))
     return pairs
 

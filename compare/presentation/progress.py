@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import sys
 import time
 
 
 class ProgressBar:
-    """Callable with a fraction in [0, 1]; draws to stderr only when it is a terminal."""
+    """Callable with a fraction in [0, 1]; draws to stderr only when it is a terminal, not in CI, and not quiet
+    (the command line's ``-q`` raises gearcheck's logger above warnings)."""
 
     def __init__(self, label: str, stream=None, width: int = 30):
         self.stream = stream or sys.stderr
-        self.enabled = self.stream.isatty() and not os.environ.get("CI")
+        self.enabled = (self.stream.isatty() and not os.environ.get("CI")
+                        and logging.getLogger("gearcheck").isEnabledFor(logging.WARNING))
         self.label = label
         self.width = width
         self.start = time.perf_counter()

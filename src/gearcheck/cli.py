@@ -6,7 +6,8 @@ error estimate as large as a tolerance), 2 bad input (one line on stderr naming 
 value; nothing written; also a full disk and memory run out), 70 an internal error (one line; ``GEARCHECK_DEBUG=1``
 shows its traceback), 130 interrupted (SIGINT), 143 terminated (SIGTERM); a closed pipe ends the
 program quietly, as other command-line tools do.  Outputs are written whole or not at all
-(:class:`~gearcheck.shared.outputs.OutputDirectory`).
+(:class:`~gearcheck.shared.outputs.OutputDirectory`).  ``-v`` logs what a run does and what each step costs,
+``-vv`` every debug line, ``-q`` leaves errors only.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import argparse
 import errno
 import json
+import logging
 import math
 import os
 import re
@@ -21,6 +23,7 @@ import signal
 import sys
 import warnings
 from collections.abc import Callable
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -84,8 +87,9 @@ def as_flags(message: str) -> str:
 
 
 def _note(message, category, filename, lineno, file=None, line=None) -> None:
-    """A warning as the command line says it: one line, ``gearcheck: note: ...``."""
-    print(f"gearcheck: note: {' '.join(str(message).split())}", file=sys.stderr)
+    """A warning as the command line says it: one line, ``gearcheck: note: ...`` (none with ``-q``)."""
+    if logging.getLogger("gearcheck").isEnabledFor(logging.WARNING):
+        print(f"gearcheck: note: {' '.join(str(message).split())}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -94,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
     shown_before, warnings.showwarning = warnings.showwarning, _note
     try:
         args = _parser().parse_args(argv)
-        with granted(args.trust, args.data_root):
+        with granted(args.trust, args.data_root), told(args.verbose, args.quiet):
             return args.func(args)
     except GearcheckError as exc:
         print(f"gearcheck: error: {as_flags(' '.join(str(exc).splitlines()))}", file=sys.stderr)
@@ -196,13 +200,43 @@ GRANTS = (  # every command's: what a train file may do beyond numbers (gearchec
         help="let train files name files inside DIR, besides their own folder (repeatable)"),
 )
 
+VERBOSITY = (  # every command's: how much it tells on stderr (gearcheck's loggers)
+    arg("-v", "--verbose", action="count", default=0,
+        help="say what the run does and what each step costs (wall and CPU time, steps, right-hand-side calls); "
+             "-vv: every logger's debug lines"),
+    arg("-q", "--quiet", action="store_true", help="no progress bars and no notes: errors only"),
+)
+LEVELS = {0: logging.WARNING, 1: logging.INFO}  # -v count -> level of the "gearcheck" logger (more: DEBUG)
+
+
+@contextmanager
+def told(verbose: int, quiet: bool):
+    """Logging for one command: gearcheck's loggers to stderr as ``gearcheck: ...`` lines at the level ``-v`` and
+    ``-q`` ask (notes are warnings, shown unless ``-q``); the logger as it was afterwards."""
+    if verbose and quiet:
+        raise GearcheckError("-v and -q: give one")
+    logger = logging.getLogger("gearcheck")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("gearcheck: %(name)s: %(message)s" if verbose > 1 else
+                                           "gearcheck: %(message)s"))
+    before = logger.level, logger.propagate
+    logger.setLevel(logging.ERROR if quiet else LEVELS.get(verbose, logging.DEBUG))
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(before[0])
+        logger.propagate = before[1]
+
 
 class Command:
     """A command of the command line: the function that runs it (each calls the front door), its help line and its
     arguments, as :func:`arg` writes them (and :data:`GRANTS`)."""
 
     def __init__(self, run: Callable[[argparse.Namespace], int], help: str, *arguments: tuple):
-        self.run, self.help, self.arguments = run, help, (*arguments, *GRANTS)
+        self.run, self.help, self.arguments = run, help, (*arguments, *GRANTS, *VERBOSITY)
 
 
 TRAIN = arg("train", metavar="TRAIN", help="preset name or path to a train TOML file")

@@ -6,6 +6,7 @@ import re
 
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 
 from gearcheck.cli import main
@@ -48,6 +49,9 @@ def test_run_lumped_writes_timeseries_and_summary(tmp_path, capsys):
     assert df["t"].iloc[-1] == pytest.approx(0.01, rel=1e-3)
     units = units_of(tmp_path / "timeseries.parquet")
     assert units["stage1.ring.ay.world"]["unit"] == "m/s^2" and units["stage1.planet1.sun.force"]["unit"] == "N"
+    field = pq.read_schema(tmp_path / "timeseries.parquet").field("stage1.planet1.sun.force")  # per field too
+    assert field.metadata[b"unit"] == b"N" and field.metadata[b"description"].decode() == units[field.name][
+        "description"]
     assert main(["run", "demo-3p", "--duration", "0.01", "--speed", "1000", "--output-dt", "2e-5", "--format", "csv",
                  "--out", str(tmp_path / "csv")]) == 0
     csv = pd.read_csv(tmp_path / "csv" / "timeseries.csv")

@@ -5,6 +5,7 @@ interrupted sweep; bad input refused with one line and nothing written."""
 
 from __future__ import annotations
 
+import json
 import math
 import subprocess
 import sys
@@ -228,6 +229,11 @@ def test_the_sweep_command_writes_table_plots_and_summary(tmp_path, capsys):
     assert {p.name: p.read_bytes() for p in out.iterdir() if p.suffix in (".parquet", ".png")} == before
     schema = pq.read_schema(out / "sweep.parquet")
     assert b"gearcheck.sweep" in schema.metadata and schema.field("amplitude").type == "double"
+    units = json.loads(schema.metadata[b"gearcheck.units"])
+    for name in ("amplitude", "frequency_hz", "speed_rpm"):  # each field carries its unit and description itself
+        field = schema.field(name)
+        assert field.metadata == {b"unit": units[name]["unit"].encode(),
+                                  b"description": units[name]["description"].encode()}
 
 
 @pytest.mark.parametrize("args, message", [

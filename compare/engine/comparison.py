@@ -42,6 +42,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+import pandas as pd
 
 from gearcheck.compare.engine.align import (
     STEADY_THRESHOLD,
@@ -56,7 +57,7 @@ from gearcheck.compare.engine.metrics import modal_metrics, spectral_amplitude, 
 from gearcheck.compare.engine.metrics import waveform_metrics
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.tolerances import Tolerances
-from gearcheck.shared.errors import SolverError, UnsupportedError
+from gearcheck.shared.errors import SolverError, UnsupportedError, did_you_mean
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.settings import RunSettings
@@ -65,6 +66,8 @@ from gearcheck.shared.side import display_name
 from gearcheck.shared.stepping import ORDER, richardson_factor
 
 NEGLIGIBLE = 1e-6
+COMPARED = (("rel_rms", "1"), ("rel_peak_to_peak", "1"), ("rel_peak", "1"), ("nrmse", "1"), ("nrmse_ac", "1"),
+            ("correlation", "1"), ("lag_s", "s"))  # the metrics that compare the two sides of a quantity
 TARGET_FRACTION = 0.5  # the steps keep both solvers' integration error estimates within this part of a tolerance
 FIRST_STEP_FACTOR = 2  # a side's first step in default steps (20 per period of its highest mode: 10)
 MAX_REFINEMENTS = 3  # halvings of the first steps to get there
@@ -154,7 +157,37 @@ class CrosscheckResult:
         for q in self.quantities:
             if q.name == name:
                 return q
-        raise KeyError(f"no compared quantity {name!r}")
+        raise KeyError(f"no compared quantity {name!r}" + did_you_mean(str(name), [q.name for q in self.quantities],
+                                                                       n=3))
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The cross-check as a tidy table, one row per quantity (or mode), side and metric: ``quantity``,
+        ``kind``, ``side`` (each solver's name for its own statistics, "both" for what compares them), ``metric``,
+        ``value``, ``unit``, ``tolerance`` (where the metric is gated), ``status``; the verdict, train and solvers
+        in ``attrs``."""
+        rows = []
+        for q in self.quantities:
+            for side, key in zip(self.solvers, ("reference", "test")):
+                rows += [(q.name, q.kind, side, stat, value, q.unit, None, q.status)
+                         for stat, value in q.metrics[key].items()]
+                rows.append((q.name, q.kind, side, "integration_error", q.metrics["integration_error"][key], "1", None,
+                             q.status))
+            for metric, unit in COMPARED:
+                rows.append((q.name, q.kind, "both", metric.removesuffix("_s"), q.metrics[metric], unit,
+                             q.tolerance if metric == "nrmse" else None, q.status))
+        for m in self.modal:
+            status = "pass" if m["rel_error"] <= self.modal_tolerance else "fail"
+            name = f"mode {m['mode']}"
+            rows += [(name, "natural_frequency", side, "frequency", m[key], "Hz", None, status)
+                     for side, key in zip(self.solvers, ("reference_hz", "test_hz"))]
+            rows.append((name, "natural_frequency", "both", "rel_error", m["rel_error"], "1", self.modal_tolerance,
+                         status))
+        frame = pd.DataFrame(rows, columns=["quantity", "kind", "side", "metric", "value", "unit", "tolerance",
+                                            "status"])
+        frame["value"] = frame["value"].astype(float)
+        frame["tolerance"] = frame["tolerance"].astype(float)
+        frame.attrs |= {"train": self.spec.name, "verdict": self.verdict, "solvers": list(self.solvers)}
+        return frame
 
     def plot(self, quantities=None):
         """Both sides' steady time histories of ``quantities`` (a name or several; default: the report's headline

@@ -671,13 +671,17 @@ def _speed_of(point: Point) -> float:
 
 
 def table_schema(plan: SweepPlan) -> pa.Schema:
-    head = [("point", pa.int64()), ("sample", pa.int64()), ("seed", pa.int64()), ("speed_rpm", pa.float64())]
-    head += [(name, pa.float64()) for name in plan.fields]
+    """The sweep table's schema: its columns' units and descriptions in each field's metadata and, as one JSON
+    object, in the schema's (``gearcheck.units``), with the sweep's settings (``gearcheck.sweep``)."""
+    head = [pa.field("point", pa.int64()), pa.field("sample", pa.int64()), pa.field("seed", pa.int64()),
+            pa.field("speed_rpm", pa.float64())] + [pa.field(name, pa.float64()) for name in plan.fields]
+    units = COLUMNS | {f: ("file", "swept train-file field, in the file's own unit") for f in plan.fields}
     meta = {"gearcheck.sweep": json.dumps(plan.settings, sort_keys=True),
-            "gearcheck.units": json.dumps({k: {"unit": u, "description": d} for k, (u, d) in COLUMNS.items()}
-                                          | {f: {"unit": "file", "description": "swept train-file field, in the "
-                                                 "file's own unit"} for f in plan.fields}, sort_keys=True)}
-    return pa.schema(head + list(POINT_SCHEMA) + [("key", pa.string())], metadata=meta)
+            "gearcheck.units": json.dumps({k: {"unit": u, "description": d} for k, (u, d) in units.items()},
+                                          sort_keys=True)}
+    fields = head + list(POINT_SCHEMA) + [pa.field("key", pa.string())]
+    return pa.schema([f.with_metadata({"unit": units[f.name][0], "description": units[f.name][1]})
+                      if f.name in units else f for f in fields], metadata=meta)
 
 
 def parquet_bytes(table: pa.Table) -> bytes:

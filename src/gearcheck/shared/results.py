@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gearcheck.shared.errors import SolverError
+from gearcheck.shared.errors import GearcheckError, SolverError, did_you_mean
 from gearcheck.shared.outputs import OutputDirectory
 from gearcheck.shared.selection import chosen
 
@@ -61,16 +61,21 @@ class TimeResult:
         self._index = {s.name: j for j, s in enumerate(self.signals)}
 
     def __getitem__(self, name: str) -> np.ndarray:
+        return self.values[:, self._position(name)]
+
+    def _position(self, name: str) -> int:
+        """The column of signal ``name``; KeyError naming the closest signals."""
         try:
-            return self.values[:, self._index[name]]
-        except KeyError:
-            raise KeyError(f"{self.solver} result of {self.train} has no signal {name!r}") from None
+            return self._index[name]
+        except (KeyError, TypeError):
+            raise KeyError(f"{self.solver} result of {self.train} has no signal {name!r}"
+                           + did_you_mean(str(name), self._index, n=3)) from None
 
     def __contains__(self, name: str) -> bool:
         return name in self._index
 
     def signal(self, name: str) -> Signal:
-        return self.signals[self._index[name]]
+        return self.signals[self._position(name)]
 
     def names(self, kind: str | None = None, compared: bool | None = None) -> list[str]:
         """Signal names, optionally of one kind and/or only those the cross-check gates (or not)."""
@@ -91,6 +96,21 @@ class TimeResult:
         frame = pd.DataFrame({"t": self.t, **{n: self[n] for n in names}})
         frame.attrs["units"] = {"t": "s"} | {n: self.signal(n).unit for n in names}
         return frame
+
+    def to_xarray(self, names=None):
+        """The signals ``names`` (default: all) as an :class:`xarray.Dataset` over the coordinate ``t`` (s), each
+        variable with its ``unit``, ``kind`` and ``description`` in its attrs (``pip install xarray``)."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise GearcheckError("to_xarray needs xarray: pip install xarray (or gearcheck[xarray])") from None
+        names = [s.name for s in self.signals] if names is None else list(names)
+        variables = {}
+        for name in names:
+            s = self.signal(name)
+            variables[name] = ("t", self[name], {"unit": s.unit, "kind": s.kind, "description": s.description})
+        return xr.Dataset(variables, coords={"t": ("t", self.t, {"unit": "s", "description": "time"})},
+                          attrs={"train": self.train, "solver": self.solver})
 
     def plot(self, signals=None):
         """A :class:`matplotlib.figure.Figure` (no pyplot) of ``signals`` (a name or several; default: those the
@@ -149,9 +169,20 @@ def _write_table(frame: pd.DataFrame, path: Path, columns: dict) -> Path:
 
     table = pa.Table.from_pandas(frame, preserve_index=False)
     meta = {UNITS_KEY: json.dumps({k: {"unit": u, "description": d} for k, (u, d) in columns.items()}).encode()}
-    pq.write_table(table.replace_schema_metadata({**(table.schema.metadata or {}), **meta}), path,
-                   compression="zstd")
+    pq.write_table(with_field_units(table, columns).replace_schema_metadata({**(table.schema.metadata or {}), **meta}),
+                   path, compression="zstd")
     return path
+
+
+def with_field_units(table, columns: dict):
+    """``table`` with each column of ``columns`` ({name: (unit, description)}) carrying its ``unit`` and
+    ``description`` in its own field's metadata, where pyarrow, polars and DuckDB users see them."""
+    import pyarrow as pa
+
+    fields = [f.with_metadata({**(f.metadata or {}), b"unit": columns[f.name][0].encode(),
+                               b"description": columns[f.name][1].encode()}) if f.name in columns else f
+              for f in table.schema]
+    return pa.Table.from_arrays(table.columns, schema=pa.schema(fields, metadata=table.schema.metadata))
 
 
 def units_of(path) -> dict:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from tqdm import tqdm
 
 import gearcheck
 
@@ -52,3 +53,17 @@ def test_a_mistyped_name_is_answered_with_the_closest(check):
     with pytest.raises(KeyError, match=r"no compared quantity 'stage1\.ring\.ay\.wrld' \(did you mean "
                                        r"'stage1\.ring\.ay\.world'"):
         check["stage1.ring.ay.wrld"]
+
+
+def test_progress_true_draws_a_bar_and_closes_it(capsys):
+    """``progress=True`` in the front door: tqdm's bar (a text bar outside Jupyter) labelled with the function and
+    the train, run to 100 % and closed; a callable still gets the fractions."""
+    gearcheck.simulate("demo-3p", duration=0.005, progress=True)
+    err = capsys.readouterr().err
+    assert "simulate demo-3p: 100%" in err and err.endswith("\n")
+    seen = []
+    gearcheck.simulate("demo-3p", duration=0.005, progress=seen.append)
+    assert seen and seen[-1] == pytest.approx(1.0) and seen == sorted(seen)
+    with pytest.raises(gearcheck.GearcheckError):  # a refused call leaves no bar open
+        gearcheck.Train("demo-3p").simulate(duration=-1.0, progress=True)
+    assert "simulate demo-3p:" in capsys.readouterr().err and not list(tqdm._instances)

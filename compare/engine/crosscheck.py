@@ -19,12 +19,14 @@ from gearcheck.compare.engine.measurements import attach, check_quantities, load
 from gearcheck.compare.engine.model_pair import MODELS, resolve_model
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.progress import shows_progress
 from gearcheck.shared.units import rad_s_to_rpm
 from gearcheck.train.loader import load_train
 
 __all__ = ["MODELS", "crosscheck"]
 
 
+@shows_progress
 def crosscheck(train, *, speed: float | None = None, duration: float | None = None, model="general",
                against: str = "lumped", results=None, columns=None, modes=None, dt_lumped: float | None = None,
                dt_mujoco: float | None = None, tolerances=None, measurements=None,
@@ -68,8 +70,8 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
     update_baseline : bool
         Rewrite ``baseline`` with this run instead of comparing (over the duration it was taken over, unless
         ``duration`` says otherwise).
-    progress : callable, optional
-        Called with the fraction done.
+    progress : callable or True, optional
+        Called with the fraction done; True: a progress bar (``tqdm.auto``: a widget in Jupyter).
     sides : callable, optional
         The lumped model and the twin already built for this train at this speed (``"lumped"``/``"mujoco"`` ->
         side, as :meth:`gearcheck.Train.side`); default: built here.

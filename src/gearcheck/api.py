@@ -141,8 +141,8 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
     method : str
         The lumped solver's integrator: "rk4" (default), "rk4-stages", or scipy's "RK45", "DOP853",
         "Radau", "BDF", "LSODA" (then ``dt`` is their largest step).
-    progress : callable, optional
-        Called with the fraction done.
+    progress : callable or True, optional
+        Called with the fraction done; True: a progress bar (``tqdm.auto``: a widget in Jupyter).
 
     Returns
     -------
@@ -202,8 +202,8 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
         Any executor of your own instead.
     cache : path, optional
         Folder of finished points (``KEY.parquet``); None: no cache.
-    progress : callable, optional
-        Called with the fraction of points done.
+    progress : callable or True, optional
+        Called with the fraction of points done; True: a progress bar (``tqdm.auto``: a widget in Jupyter).
 
     Returns
     -------

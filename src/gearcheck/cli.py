@@ -32,7 +32,7 @@ import gearcheck
 from gearcheck.compare.presentation import history
 from gearcheck.compare.engine.crosscheck import MODELS
 from gearcheck.compare.presentation.junit import write_junit
-from gearcheck.compare.presentation.progress import ProgressBar
+from gearcheck.shared.progress import ProgressBar
 from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.presentation.summary import overall_line, summary_row, write_summary
 from gearcheck.shared.citations import REFERENCES

@@ -28,6 +28,7 @@ from gearcheck.lumped.transmission_error import relief_sweep, static_transmissio
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
+from gearcheck.shared.progress import shows_progress
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
@@ -78,6 +79,7 @@ class Train:
         side = self.side(solver)
         return side.modes() if speed is None else side.modes_at_speed(rpm_to_rad_s(checked_rpm(speed, zero=True)))
 
+    @shows_progress
     def simulate(self, solver: str = "lumped", duration: float = 0.2, *, dt: float | None = None,
                  output_dt: float | None = None, settle: float | None = None, method: str = "rk4", y0=None,
                  progress=None) -> TimeResult:
@@ -131,6 +133,7 @@ class Train:
         relief amount of ``amounts`` (m) (:func:`gearcheck.lumped.transmission_error.relief_sweep`)."""
         return relief_sweep(self.spec, amounts, slices=slices)
 
+    @shows_progress
     def sweep(self, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
               solver: str = "both", duration: float = 0.5, harmonics: int = 3, integration_check: bool = True,
               refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None,

@@ -43,6 +43,11 @@ class LongRunWarning(UserWarning):
     """A run that will take minutes, said before it starts (the command line prints it as a note)."""
 
 
+class TrainNote(UserWarning):
+    """A train file's value that a designer would want a word on, said when it is loaded (the command line prints
+    it as a note)."""
+
+
 def one_line(exc: BaseException, width: int = 200) -> str:
     """An exception's message as one line of at most ``width`` characters (its type's name when it has none)."""
     text = " ".join(str(exc).split()) or type(exc).__name__

@@ -352,11 +352,13 @@ BODY = {
 
 SUPPORT = Table(
     {
-        "radial_stiffness": Positive("stiffness of the bearing/support in x and in y (isotropic)", "N/m", REQUIRED,
-                                     bound("stiffness")),
-        "radial_damping": NonNegative("damping of the bearing/support in x and y", "N·s/m", 0.0, bound("damping")),
-        "torsional_stiffness": NonNegative("torsional stiffness to the housing (0 = free rotation)", "N·m/rad", 0.0,
-                                           bound("stiffness")),
+        "radial_stiffness": Positive("stiffness of the bearing/support in x and in y (isotropic; rolling bearings "
+                                     "1e8-1e9)", "N/m", REQUIRED, bound("stiffness")),
+        "radial_damping": NonNegative("damping of the bearing/support in x and y (0 is noted at load; a damping "
+                                      "ratio of 1-5 %: c = 2 zeta sqrt(k m), some hundreds to thousands)", "N·s/m",
+                                      0.0, bound("damping")),
+        "torsional_stiffness": NonNegative("torsional stiffness to the housing (0 = free rotation; a held member "
+                                           "needs it, e.g. 1e7-1e9)", "N·m/rad", 0.0, bound("stiffness")),
         "torsional_damping": NonNegative("torsional damping to the housing", "N·m·s/rad", 0.0, bound("damping")),
         "axial_stiffness": NonNegative("axial stiffness to the housing (helical stages need it)", "N/m", 0.0,
                                        bound("stiffness")),
@@ -367,9 +369,10 @@ SUPPORT = Table(
 
 PLANET_BEARING = Table(
     {
-        "radial_stiffness": Positive("stiffness of the planet bearing, radial and tangential", "N/m", REQUIRED,
-                                     bound("stiffness")),
-        "radial_damping": NonNegative("damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
+        "radial_stiffness": Positive("stiffness of the planet bearing, radial and tangential (1e8-1e9)", "N/m",
+                                     REQUIRED, bound("stiffness")),
+        "radial_damping": NonNegative("damping of the planet bearing (0 is noted at load)", "N·s/m", 0.0,
+                                      bound("damping")),
         "axial_stiffness": NonNegative("axial stiffness of the planet on its pin (helical stages need it)", "N/m",
                                        0.0, bound("stiffness")),
         "axial_damping": NonNegative("axial damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
@@ -649,7 +652,8 @@ TRAIN_TABLE = Table(
         "input": Text("input member, `STAGE.MEMBER`", REQUIRED),
         "output": Text("output member", REQUIRED),
         "held": ListOf(Text("member", REQUIRED),
-                       "members held by their torsional support stiffness", ()),
+                       "members held by their torsional support stiffness: each needs "
+                       "`support.torsional_stiffness` > 0, so that its vibration is still modelled", ()),
         "measurements_file": Text("a TOML file of [[measurements]] (relative to the train file) shown in every "
                                   "cross-check and used by calibrate", None),
         "user_model": Text("your own model of this train, checked by `crosscheck --model user`: a .mat or .npz "

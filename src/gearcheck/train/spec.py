@@ -10,6 +10,7 @@ of a planetary stage is checked here with an error that names the file and the f
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 from math import gcd
 from pathlib import Path
@@ -24,7 +25,7 @@ from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geom
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.schema import Context, parse_measurements
-from gearcheck.shared.errors import GearcheckError, TrainFileError, did_you_mean, shown
+from gearcheck.shared.errors import GearcheckError, TrainFileError, TrainNote, did_you_mean, shown
 from gearcheck.shared.trust import inside_roots
 
 MIN_TEETH = 6
@@ -421,6 +422,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
                           op["input_torque"], op["torque_expression"])
 
+    _note_undamped(members)
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
@@ -430,6 +432,22 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
         user_model=_user_model(train["user_model"], source, fail),
     )
+
+
+def _note_undamped(members: dict) -> None:
+    """A note (:class:`~gearcheck.shared.errors.TrainNote`) naming the supports and bearings that are stiff in a
+    direction and have no damping in it: their damping defaults to 0, and the modes that live in them then decay
+    only through the meshes' damping (a cross-check may wait long for its steady state)."""
+    undamped = []
+    for mid, m in members.items():
+        for what, support in (("support", m.support), ("bearing", m.bearing)):
+            for direction in ("radial", "torsional", "axial") if support is not None else ():
+                if getattr(support, f"{direction}_stiffness") > 0 and getattr(support, f"{direction}_damping") == 0:
+                    undamped.append(f"{f'{m.stage}.{m.kind}' if m.orbits else mid} {what} {direction}")
+    if undamped:
+        warnings.warn(f"no damping in {', '.join(dict.fromkeys(undamped))} (damping defaults to 0): the modes that "
+                      "live there decay only through the meshes; a bearing is commonly given a damping ratio of "
+                      "1-5 %, c = 2 zeta sqrt(k m)", TrainNote, stacklevel=2)
 
 
 MAX_KEY_DEPTH = 16  # dotted parts of a tolerance key: the longest quantity name and its metric have 6

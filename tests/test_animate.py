@@ -106,3 +106,20 @@ def test_live_view_without_a_display_says_so_in_one_line(monkeypatch):
     with pytest.raises(GearcheckError, match="^no display: .*gearcheck animate") as err:
         live_view(gearcheck.load("demo-3p"))
     assert "\n" not in str(err.value)
+
+
+def test_the_force_trace_has_its_label_scale_and_time_axis():
+    """The inset is a chart, not a squiggle: its label and unit above it, its largest and smallest values at its
+    left corners, the time it covers at its right; drawn on a black frame, text appears in each of those places
+    and nowhere without the trace."""
+    black = np.zeros((360, 480, 3), dtype=np.uint8)
+    x0, y0, bw, bh = (int(f * s) for f, s in zip(anim.TRACE, (480, 360, 480, 360)))
+    trace = anim.Trace(np.array([4019.0, 5444.0, 4500.0]), 3, "mesh force stage1.planet1.sun [N]", 0.0394)
+    drawn = np.asarray(anim._overlay(black, [], trace))
+    bare = np.asarray(anim._overlay(black, []))
+    places = {"label": drawn[y0 - 12:y0 - 2, x0:x0 + bw // 2], "largest": drawn[y0 + 3:y0 + 12, x0 + 3:x0 + 30],
+              "smallest": drawn[y0 + bh - 12:y0 + bh - 3, x0 + 3:x0 + 30],
+              "time": drawn[y0 + bh - 12:y0 + bh - 3, x0 + bw - 40:x0 + bw - 3]}
+    for name, patch in places.items():
+        assert (patch.min(axis=-1) > 200).sum() > 5, name  # white text
+    assert not bare.any()

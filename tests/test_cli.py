@@ -90,3 +90,14 @@ def test_verbose_tells_what_each_step_costs_and_quiet_leaves_errors_only(tmp_pat
     assert capsys.readouterr().err == "gearcheck: error: -v and -q: give one\n"
     logger = logging.getLogger("gearcheck")
     assert not logger.handlers and logger.level == logging.NOTSET and logger.propagate
+
+
+def test_sensitivity_states_its_units_and_harmonic_notation(tmp_path, capsys):
+    assert main(["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "harmonic (k1, k2): the orders of the train's clocks" in out and "amplitudes in rad" in out
+    frame = pd.read_csv(tmp_path / "sensitivity.csv")
+    assert set(frame["amplitude_unit"]) == {"rad"} and list(frame["harmonic"][:2]) == ["(1,)", "(2,)"]
+    assert main(["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--coordinate", "stage1.sun.x",
+                 "--out", str(tmp_path / "x")]) == 0
+    assert set(pd.read_csv(tmp_path / "x" / "sensitivity.csv")["amplitude_unit"]) == {"m"}

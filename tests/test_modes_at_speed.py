@@ -104,3 +104,29 @@ def test_campbell_shades_the_unstable_range(tmp_path, capsys):
     zones = json.loads((tmp_path / "c" / "campbell.json").read_text())["instability_zones"]
     assert zones == [{"solver": "lumped", "from_rpm": 43000.0, "to_rpm": 46000.0}]
     assert "UNSTABLE (lumped) from 43000 to 46000 rpm" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("preset, sun_teeth, planets", [("demo-3p", 22, 3), ("demo-4p", 22, 4)])
+def test_campbell_marks_the_crossings_the_planets_phasing_cannot_excite(preset, sun_teeth, planets):
+    """Parker (2000), tested by forced response in test_phasing.py: harmonic l of N equally spaced planets reaches
+    rotational modes when l z_s / N is an integer, translational when l z_s +- 1 is a multiple of N, planet modes
+    otherwise.  Every crossing carries its mode's type and whether the harmonic reaches it, and the diagram draws
+    the unreachable ones hollow."""
+    result = gearcheck.campbell(preset, np.linspace(0.0, 6000.0, 13), solver="lumped")
+    assert result.crossings
+    for c in result.crossings:
+        l = c["harmonic"]
+        rotational = (l * sun_teeth) % planets == 0
+        translational = (l * sun_teeth + 1) % planets == 0 or (l * sun_teeth - 1) % planets == 0
+        expected = {"rotational": rotational, "translational": translational,
+                    "planet": not (rotational or translational)}[c["type"]]
+        assert c["excited"] is expected, c
+    kept = [c for c in result.crossings if c["excited"] is False]
+    assert kept and len(kept) < len(result.crossings)
+    hollow = [line for line in result.plot().axes[0].lines if line.get_marker() == "o"]
+    assert len(hollow) == 1 and len(hollow[0].get_xdata()) == len(kept)
+
+
+def test_campbell_applies_no_phasing_rule_to_two_stages():
+    result = gearcheck.campbell("hub-drive", [0.0, 1000.0, 2000.0], solver="lumped")
+    assert result.crossings and all(c["excited"] is None for c in result.crossings)

@@ -21,6 +21,7 @@ import subprocess
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -160,28 +161,44 @@ def _font(height: int):
     return ImageFont.load_default(size=max(8, height // 26))
 
 
-def _overlay(pixels: np.ndarray, lines: list[str], trace: np.ndarray | None = None) -> Image.Image:
-    """The frame with text lines at its top left and, optionally, a small trace at its bottom right: ``trace``
-    (values, n) draws the first n values on the scale of all of them."""
+class Trace(NamedTuple):
+    """A small chart at the frame's bottom right: ``values`` drawn up to sample ``n`` on the scale of all of them,
+    ``label`` its quantity and unit ("mesh force [N]"), ``span`` the time the values cover (s)."""
+
+    values: np.ndarray
+    n: int
+    label: str
+    span: float
+
+
+def _overlay(pixels: np.ndarray, lines: list[str], trace: Trace | None = None) -> Image.Image:
+    """The frame with text lines at its top left and, optionally, a :class:`Trace` at its bottom right with its
+    label, its scale (the largest and smallest value) and its time axis."""
     img = Image.fromarray(pixels)
     draw = ImageDraw.Draw(img)
     w, h = img.size
     font = _font(h)
+    text = {"fill": (255, 255, 255), "font": font, "stroke_width": 1, "stroke_fill": (0, 0, 0)}
     y = 2
     for line in lines:
-        draw.text((4, y), line, fill=(255, 255, 255), font=font, stroke_width=1, stroke_fill=(0, 0, 0))
+        draw.text((4, y), line, **text)
         y += font.size + 3
     if trace is not None:
         x0, y0, bw, bh = TRACE[0] * w, TRACE[1] * h, TRACE[2] * w, TRACE[3] * h
         draw.rectangle((x0, y0, x0 + bw, y0 + bh), fill=(20, 20, 30), outline=(200, 200, 200))
-        values, n = trace
+        values, n = trace.values, int(trace.n)
         lo, hi = float(values.min()), float(values.max())
         span = hi - lo if hi > lo else 1.0
-        xs = x0 + 2 + (bw - 4) * np.arange(int(n)) / max(len(values) - 1, 1)
-        ys = y0 + bh - 2 - (bh - 4) * (values[:int(n)] - lo) / span
-        if int(n) > 1:
+        xs = x0 + 2 + (bw - 4) * np.arange(n) / max(len(values) - 1, 1)
+        ys = y0 + bh - 2 - (bh - 4) * (values[:n] - lo) / span
+        if n > 1:
             draw.line(list(zip(xs.tolist(), ys.tolist())), fill=(255, 90, 60), width=1)
         draw.ellipse((xs[-1] - 2, ys[-1] - 2, xs[-1] + 2, ys[-1] + 2), fill=(255, 220, 60))
+        small = {**text, "font": _font(int(h * 0.75))}
+        draw.text((x0, y0 - 2), trace.label, anchor="ld", **small)
+        draw.text((x0 + 3, y0 + 2), f"{hi:.4g}", anchor="la", **small)
+        draw.text((x0 + 3, y0 + bh - 2), f"{lo:.4g}", anchor="ld", **small)
+        draw.text((x0 + bw - 3, y0 + bh - 2), f"{1e3 * trace.span:.3g} ms", anchor="rd", **small)
     return img
 
 
@@ -271,8 +288,10 @@ def animate(train, path, duration: float = 4.0, fps: float = 15.0, magnify: floa
         rend.update_scene(shown, cam)
         _add_spokes(mb.model, shown, rend.scene)
         lines = [f"{mb.spec.name}  t = {1e3 * t:7.2f} ms", f"slow motion x{slow_motion:g}, deflection x{magnify:g}",
+                 *(["(teeth overlap: the deflection magnified)"] if magnify > 1 else []),
                  f"mesh force {label}: {force[i]:.0f} N"]
-        frames.append(_overlay(rend.render(), lines, (force, i + 1)))
+        span = (len(force) - 1) * every * player.dt
+        frames.append(_overlay(rend.render(), lines, Trace(force, i + 1, f"mesh force {label} [N]", span)))
         if progress is not None:
             progress(0.8 + 0.2 * (i + 1) / n)
     rend.close()

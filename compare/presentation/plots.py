@@ -325,7 +325,7 @@ def mesh_stiffness_figure(spec, cycles: int = 2) -> Figure:
         model = stiffness_model(mesh)
         ax.plot(xi, model(xi) / 1e9, color="tab:blue", lw=1.2, label="k(xi)")
         ax.axhline(model.mean / 1e9, color="gray", ls="--", lw=0.8, label=f"mean {model.mean:.4g} N/m")
-        ax.set_ylabel("k [N/um]")
+        ax.set_ylabel("k [N/µm]")
         ax.set_title(f"{mesh.id} ({mesh.stiffness['model']}, contact ratio {mesh.geometry.contact_ratio:.4f})",
                      fontsize=9)
         ax.legend(loc="upper right", fontsize=7)
@@ -340,29 +340,44 @@ def mesh_stiffness(spec, cycles: int = 2) -> bytes:
     return _png(mesh_stiffness_figure(spec, cycles))
 
 
+MODE_COLORS = {"rotational": "tab:blue", "translational": "tab:green", "planet": "tab:purple"}  # others: gray
+
+
 def campbell_figure(result, solvers=None) -> Figure:
-    """A :class:`~gearcheck.compare.studies.campbell.CampbellResult` drawn: lumped curves, MuJoCo markers, mesh
-    lines, their crossings with the curves, instability zones shaded; ``solvers``: those drawn (default: all)."""
+    """A :class:`~gearcheck.compare.studies.campbell.CampbellResult` drawn: lumped curves coloured by mode type
+    (at the lowest speed), MuJoCo markers, mesh lines, their crossings with the curves (those the planets' phasing
+    keeps from the mode hollow: Parker 2000), instability zones shaded; ``solvers``: those drawn (default: all)."""
     fig, ax = _figure(figsize=(9, 6))
     speeds = result.speeds_rpm
     shown = list(result.results) if solvers is None else list(solvers)
-    for solver, style in (("lumped", {"color": "tab:blue", "lw": 1.0}),
-                          ("mujoco", {"color": "tab:orange", "ls": "none", "marker": ".", "ms": 3})):
-        if solver not in shown:
-            continue
-        f = result.frequencies(solver)
+    labelled = set()
+    if "lumped" in shown:
+        f, types = result.frequencies("lumped"), result.results["lumped"][0].types
         for mode in range(f.shape[1]):
-            ax.plot(speeds, f[:, mode], **style, label=("lumped" if solver == "lumped" else "MuJoCo")
-                    if mode == 0 else None)
+            kind = types[mode]
+            ax.plot(speeds, f[:, mode], color=MODE_COLORS.get(kind, "tab:gray"), lw=1.0,
+                    label=None if kind in labelled else f"lumped, {kind}")
+            labelled.add(kind)
+    if "mujoco" in shown:
+        f = result.frequencies("mujoco")
+        for mode in range(f.shape[1]):
+            ax.plot(speeds, f[:, mode], color="black", ls="none", marker=".", ms=2.5,
+                    label="MuJoCo" if mode == 0 else None)
     top = max(float(np.max(result.frequencies(s))) for s in shown) * 1.05
     for line in result.mesh_lines:
         ax.plot(speeds, line["hz_per_rpm"] * speeds, color="gray", lw=0.7, ls=":" if line["harmonic"] > 1 else "-")
         end = min(speeds[-1], top / line["hz_per_rpm"]) if line["hz_per_rpm"] > 0 else speeds[-1]
         ax.annotate(f"{line['harmonic']}x {line['meshes'][0].rsplit('.', 2)[0]}", (end, line["hz_per_rpm"] * end),
                     fontsize=6, color="gray", ha="right", va="bottom")
-    if result.crossings:
-        ax.plot([c["speed_rpm"] for c in result.crossings], [c["frequency_hz"] for c in result.crossings], "kx",
-                ms=4, label="mesh harmonic = natural frequency")
+    reached = [c for c in result.crossings if c["excited"] is not False]
+    kept = [c for c in result.crossings if c["excited"] is False]
+    if reached:
+        ax.plot([c["speed_rpm"] for c in reached], [c["frequency_hz"] for c in reached], "kx", ms=5,
+                label="mesh harmonic = natural frequency" + ("" if kept else " (no phasing rule applies)"
+                                                             if all(c["excited"] is None for c in reached) else ""))
+    if kept:
+        ax.plot([c["speed_rpm"] for c in kept], [c["frequency_hz"] for c in kept], "o", ms=5, mfc="none",
+                color="gray", label="crossing the planets' phasing keeps from the mode")
     for zone in result.zones:
         ax.axvspan(zone["from_rpm"], zone["to_rpm"], color="red", alpha=0.15,
                    label=f"unstable ({zone['solver']})" if zone is result.zones[0] else None)
@@ -392,9 +407,9 @@ def static_transmission_error(curves, train: str) -> bytes:
         ax.plot(c.xi, c.loaded * 1e6, color="tab:blue", lw=1.2, label=f"loaded ({c.load:.4g} N)")
         ax.plot(c.xi, c.unloaded * 1e6, color="tab:orange", lw=1.0, label="unloaded")
         ax.axhline(c.mean_deflection * 1e6, color="gray", ls="--", lw=0.8,
-                   label=f"F / k_mean = {c.mean_deflection * 1e6:.3g} um")
-        ax.set_ylabel("STE [um]")
-        ax.set_title(f"{c.mesh}: loaded peak-to-peak {np.ptp(c.loaded) * 1e6:.4g} um", fontsize=9)
+                   label=f"F / k_mean = {c.mean_deflection * 1e6:.3g} µm")
+        ax.set_ylabel("STE [µm]")
+        ax.set_title(f"{c.mesh}: loaded peak-to-peak {np.ptp(c.loaded) * 1e6:.4g} µm", fontsize=9)
         ax.legend(loc="upper right", fontsize=7)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("mesh cycles (0 = a tooth pair enters contact)")
@@ -411,9 +426,9 @@ def relief_sweep(sweep: dict, train: str) -> bytes:
         color = f"C{j}"
         ax.plot(amounts, np.array(data["loaded_peak_to_peak_m"]) * 1e6, color=color, marker=".", label=mesh)
         ax.axvline(data["mean_deflection_m"] * 1e6, color=color, ls="--", lw=0.8,
-                   label=f"{mesh}: F / k_mean = {data['mean_deflection_m'] * 1e6:.3g} um")
-    ax.set_xlabel("tip relief amount C_a [um]")
-    ax.set_ylabel("loaded STE peak-to-peak [um]")
+                   label=f"{mesh}: F / k_mean = {data['mean_deflection_m'] * 1e6:.3g} µm")
+    ax.set_xlabel("tip relief amount $C_a$ [µm]")
+    ax.set_ylabel("loaded STE peak-to-peak [µm]")
     ax.set_title(f"{train}: loaded static transmission error against the tip relief", fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
@@ -547,7 +562,7 @@ def _pin_force_against_angle(bx, loads) -> None:
     bx.axhline(peak, color="0.4", lw=0.8, ls=":", label=f"4 T/(Z_p r_c) = {peak:.0f} N")
     bx.set_xlim(-180, 180)
     bx.set_xticks(range(-180, 181, 45))
-    bx.set_xlabel("pin angle from its disc's eccentric, varphi (deg)")
+    bx.set_xlabel("pin angle from its disc's eccentric, φ [deg]")
     bx.set_ylabel("pin force (N)")
     s = loads.summary()
     rigid = (loads.classical > 0).sum(axis=-1)

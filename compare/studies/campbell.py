@@ -3,9 +3,15 @@
 At each input speed the gyroscopic eigenproblem of each solver (:func:`gearcheck.api.modes` with a
 speed; Cooley & Parker 2012): frequencies, growth rates and stability.  Mesh-frequency lines
 (harmonics of every distinct mesh frequency, proportional to the speed) are drawn with their
-crossings of the natural-frequency curves (the speeds where a mesh harmonic excites a mode), and
+crossings of the natural-frequency curves (the speeds where a mesh harmonic may excite a mode), and
 speeds at which a mode grows (divergence or flutter) are shaded as instability zones.  The curves
 are the modes ordered by frequency at each speed, so two modes that cross swap curves there.
+
+A crossing is a resonance only if the harmonic reaches the mode.  With N equally spaced planets in one simple
+planetary stage, the mesh phases select the modes (Parker 2000): harmonic l excites rotational modes only when
+l z_s / N is an integer, translational modes only when l z_s +- 1 is a multiple of N, planet modes otherwise
+(the forced-response test of the rule is ``tests/test_phasing.py``).  Each crossing says ``excited`` True or
+False by that rule, None where it does not apply (several stages, unequal spacing, double planets).
 """
 
 from __future__ import annotations
@@ -71,6 +77,7 @@ def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics
     out = CampbellResult(spec.name, speeds, results, lines)
     reference = solvers[0]
     f = out.frequencies(reference)
+    phasing = phasing_rule(spec)
     for line in lines:
         excitation = line["hz_per_rpm"] * speeds
         for mode in range(f.shape[1]):
@@ -78,13 +85,39 @@ def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics
             for i in np.where((np.sign(gap[:-1]) * np.sign(gap[1:]) <= 0) & (gap[:-1] != gap[1:]))[0]:
                 s = speeds[i] + (speeds[i + 1] - speeds[i]) * gap[i] / (gap[i] - gap[i + 1])
                 if f[i, mode] > 0:
+                    kind = results[reference][i].types[mode]
                     out.crossings.append({"speed_rpm": float(s), "frequency_hz": float(line["hz_per_rpm"] * s),
-                                          "mode": mode + 1, "meshes": line["meshes"], "harmonic": line["harmonic"]})
+                                          "mode": mode + 1, "type": kind, "meshes": line["meshes"],
+                                          "harmonic": line["harmonic"],
+                                          "excited": None if phasing is None else excites(line["harmonic"], kind,
+                                                                                          *phasing)})
     for solver, rs in results.items():
         unstable = np.array([not r.stable for r in rs])
         for start, stop in _runs(unstable):
             out.zones.append({"solver": solver, "from_rpm": float(speeds[start]), "to_rpm": float(speeds[stop])})
     return out
+
+
+def phasing_rule(spec) -> tuple[int, int] | None:
+    """(N, z_s) of a train that is one simple planetary stage with N equally spaced planets (one sun, planets of
+    one kind), for :func:`excites`; None where the rule does not apply."""
+    if len(spec.stages) != 1 or spec.cycloids:
+        return None
+    stage = spec.stages[0]
+    suns = [spec.members[c] for c in stage.centrals if spec.members[c].kind == "sun"]
+    simple = all(spec.members[p].kind == "planet" and len(spec.members[p].gears) == 1 for p in stage.planets)
+    if not stage.equally_spaced or len(suns) != 1 or len(suns[0].gears) != 1 or not simple:
+        return None
+    return len(stage.planets), next(iter(suns[0].gears.values())).teeth
+
+
+def excites(harmonic: int, kind: str, planets: int, sun_teeth: int) -> bool | None:
+    """Whether mesh harmonic ``harmonic`` reaches a mode of type ``kind`` through the phases of ``planets``
+    equally spaced planets on a sun of ``sun_teeth`` (Parker 2000): by l z_s mod N, 0 rotational, +-1
+    translational, else planet modes; None for another type."""
+    r = harmonic * sun_teeth % planets
+    reach = {"rotational": r == 0, "translational": r in (1, planets - 1), "planet": r not in (0, 1, planets - 1)}
+    return reach.get(kind)
 
 
 def _mesh_lines(spec, harmonics: int) -> list[dict]:

@@ -32,6 +32,7 @@ from gearcheck.lumped.fourier_response import (
     harmonic_balance_response,
 )
 from gearcheck.train.loader import load_text, load_train
+from gearcheck.train.spec import ROTATION
 from gearcheck.lumped.response_sensitivity import (
     fourier_series_sensitivity,
     harmonic_balance_sensitivity,
@@ -170,13 +171,24 @@ def _model(text, source, field: FitParameter | None, value, speed):
     return build_model(load_train(load_text(tomli_w.dumps(document), source), speed))
 
 
+HARMONIC_NOTATION = ("harmonic (k1, k2): the orders of the train's clocks, at k1 times the mesh frequency plus k2 "
+                     "times the second clock's (an RV reducer's eccentrics turning in the carrier); (k1,) with one "
+                     "clock")
+
+
+def coordinate_unit(coordinate: str) -> str:
+    """The unit of a model coordinate's amplitude: rad for a rotation (``....theta``), m for a translation."""
+    return "rad" if coordinate.endswith(f".{ROTATION}") else "m"
+
+
 def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, coordinate: str, orders=None,
                     method: str = METHODS[1], progress=None, **grids):
     """d|Q_h|/d ln p of ``coordinate`` (a model coordinate, ``rv.carrier.theta``) for each parameter at each input
     speed (the paper's Figs. 5-10 over the mesh frequency), with the paper's Eq. (15) beside it for the
     Fourier-series method.  The pins' contact pattern is that of the first speed at every speed (it moves only
     with the rotating-frame terms); ``grids`` default to :data:`MAP_GRIDS`.  A pandas DataFrame, one row per
-    speed, parameter and harmonic."""
+    speed, parameter and harmonic (:data:`HARMONIC_NOTATION`), amplitudes and their derivatives in
+    ``amplitude_unit`` (:func:`coordinate_unit`)."""
     import pandas as pd
 
     grids = grids or MAP_GRIDS
@@ -205,6 +217,7 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
                              "harmonic": str(tuple(int(x) for x in hk)),
                              "frequency_hz": float(full.response.frequencies[j]) / (2 * np.pi),
                              "amplitude": float(np.abs(full.response.amplitudes[j, index])),
+                             "amplitude_unit": coordinate_unit(coordinate),
                              "d_amplitude_d_ln_p": float(full.d_modulus[j, index]) * value,
                              "eq15_d_amplitude_d_ln_p": None if truncated is None
                              else float(truncated[j, index]) * value})

@@ -286,7 +286,7 @@ def cmd_show(args) -> int:
             print(f"    pins: f_pin={c['pin_frequency_hz']:.6g} Hz  k={c['pin_stiffness_n_per_m']:.4g} N/m per "
                   "contact  "
                   f"{c['pins_touching_at_rest']} contacts loaded at t = 0  clearance "
-                  f"{c['clearance_m'] * 1e6:.4g} um")
+                  f"{c['clearance_m'] * 1e6:.4g} µm")
     print("  meshes:")
     for m in info["meshes"]:
         face = f"+{m['face_contact_ratio']:.4f}" if m["face_contact_ratio"] else ""
@@ -356,8 +356,10 @@ def cmd_campbell(args) -> int:
         result = gearcheck.campbell(args.train, args.speeds, solver=args.solver, harmonics=args.harmonics)
         write_file(place.path / "campbell.png", campbell_diagram(result))
         write_file(place.path / "campbell.json", json.dumps(result.to_dict(), indent=2) + "\n")
+    kept = sum(c["excited"] is False for c in result.crossings)
     print(f"{result.train}: {len(result.speeds_rpm)} speeds from {result.speeds_rpm[0]:g} to "
-          f"{result.speeds_rpm[-1]:g} rpm, {len(result.crossings)} crossings of mesh harmonics with modes")
+          f"{result.speeds_rpm[-1]:g} rpm, {len(result.crossings)} crossings of mesh harmonics with modes"
+          + (f", {kept} of them kept from their modes by the planets' phasing (Parker 2000)" if kept else ""))
     if result.agreement is not None:
         print(f"  lumped and MuJoCo frequencies agree to {result.agreement:.2e} (relative, worst over all speeds)")
     for zone in result.zones:
@@ -398,12 +400,12 @@ def cmd_ste(args) -> int:
         write_file(place.path / "ste.json", json.dumps(report, indent=2) + "\n")
     for c in curves:
         if ".planet1." in c.mesh or len(curves) == 1:
-            print(f"{c.mesh}: load {c.load:.6g} N, loaded STE peak-to-peak {np.ptp(c.loaded) * 1e6:.4g} um "
-                  f"(mean {np.mean(c.loaded) * 1e6:.4g} um, F/k_mean {c.mean_deflection * 1e6:.4g} um), unloaded "
-                  f"peak-to-peak {np.ptp(c.unloaded) * 1e6:.4g} um")
+            print(f"{c.mesh}: load {c.load:.6g} N, loaded STE peak-to-peak {np.ptp(c.loaded) * 1e6:.4g} µm "
+                  f"(mean {np.mean(c.loaded) * 1e6:.4g} µm, F/k_mean {c.mean_deflection * 1e6:.4g} µm), unloaded "
+                  f"peak-to-peak {np.ptp(c.unloaded) * 1e6:.4g} µm")
     for mesh, data in report.get("relief_sweep", {}).get("meshes", {}).items():
         if ".planet1." in mesh:
-            print(f"  {mesh}: smallest loaded peak-to-peak at {data['best_amount_m'] * 1e6:.4g} um of relief")
+            print(f"  {mesh}: smallest loaded peak-to-peak at {data['best_amount_m'] * 1e6:.4g} µm of relief")
     print(f"  wrote {args.out}")
     return 0
 
@@ -456,6 +458,7 @@ def cmd_sensitivity(args) -> int:
                                  "harmonic": str(tuple(int(x) for x in h)),
                                  "frequency_hz": result.response.frequencies[j] / (2 * np.pi),
                                  "amplitude": abs(result.response.amplitudes[j, index]),
+                                 "amplitude_unit": sensitivity.coordinate_unit(coordinate),
                                  "closed_form": result.closed_form[j, index],
                                  "finite_difference": result.finite_difference[j, index],
                                  "eq15": None if result.truncated is None else result.truncated[j, index]})
@@ -471,6 +474,9 @@ def cmd_sensitivity(args) -> int:
                 print(f"  {r['parameter']}: largest harmonic {r['harmonic']} of {coordinate} at "
                       f"{r['frequency_hz']:.6g} Hz, |Q| {r['amplitude']:.4g}, d|Q|/dp {r['closed_form']:.4g}{eq15}")
             written = ["sensitivity.csv"]
+    print(f"  {sensitivity.HARMONIC_NOTATION}; amplitudes in {sensitivity.coordinate_unit(coordinate)}, their "
+          "derivatives per unit of the field as the train file gives it (a map's d_amplitude_d_ln_p: per relative "
+          "change of the field)")
     for name in written:
         print(f"  wrote {args.out / name}")
     return 0
@@ -814,7 +820,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         cmd_ste, "static transmission error of every mesh, unloaded and loaded, with its tip reliefs (PNG and JSON)",
         TRAIN,
         arg("--relief-sweep", type=MICROMETRE_RANGE, metavar="A:B:N",
-            help="also the loaded STE peak-to-peak for N tip relief amounts from A to B um (every tip relief of the "
+            help="also the loaded STE peak-to-peak for N tip relief amounts from A to B µm (every tip relief of the "
                  "train, lengths as given)"),
         arg("--slices", type=int, metavar="N", help="slices across a helical face (default 400)"),
         arg("--out", type=PATH, default=Path("out/ste"), metavar="DIR",

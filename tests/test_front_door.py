@@ -14,6 +14,7 @@ import pytest
 
 import gearcheck
 from gearcheck.cli import main
+from gearcheck.compare.presentation.plots import MODE_COLORS
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 
@@ -165,9 +166,12 @@ def test_modes_plot_by_type(demo):
 def test_compare_results_plot(demo):
     campbell = demo.campbell([0, 500, 1000])
     n_modes = campbell.frequencies("lumped").shape[1]
-    curves = [line for line in campbell.plot("lumped").axes[0].lines if line.get_color() == "tab:blue"]
+    colours = set(MODE_COLORS.values()) | {"tab:gray"}  # the lumped curves, each coloured by its mode's type
+    curves = [line for line in campbell.plot("lumped").axes[0].lines if line.get_color() in colours]
     assert len(curves) == n_modes
     np.testing.assert_array_equal(curves[0].get_ydata(), campbell.frequencies("lumped")[:, 0])
+    types = campbell.results["lumped"][0].types
+    assert [c.get_color() for c in curves] == [MODE_COLORS.get(t, "tab:gray") for t in types]
     assert campbell.plot().axes[0].get_ylabel() == "natural frequency [Hz]"
     pairing = demo.mac()
     np.testing.assert_array_equal(pairing.plot().axes[0].images[0].get_array(), pairing.mac)

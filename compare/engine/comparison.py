@@ -64,6 +64,7 @@ from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.side import display_name
 from gearcheck.shared.stepping import ORDER, richardson_factor
+from gearcheck.train.spec import TrainSpec
 
 NEGLIGIBLE = 1e-6
 COMPARED = (("rel_rms", "1"), ("rel_peak_to_peak", "1"), ("rel_peak", "1"), ("nrmse", "1"), ("nrmse_ac", "1"),
@@ -101,7 +102,7 @@ class QuantityComparison:
 class CrosscheckResult:
     """Everything a cross-check found; :func:`gearcheck.compare.presentation.report.write_report` writes it."""
 
-    spec: object
+    spec: TrainSpec
     settings: dict
     modal: list[dict]
     modal_tolerance: float
@@ -145,7 +146,7 @@ class CrosscheckResult:
         return "INCONCLUSIVE" if self.unresolved else "PASS"
 
     @property
-    def solver_names(self) -> tuple[str, str]:
+    def solver_names(self) -> tuple[str, ...]:
         """The reference's and the test's names as reports write them."""
         return tuple(display_name(name) for name in self.solvers)
 
@@ -165,7 +166,7 @@ class CrosscheckResult:
         ``kind``, ``side`` (each solver's name for its own statistics, "both" for what compares them), ``metric``,
         ``value``, ``unit``, ``tolerance`` (where the metric is gated), ``status``; the verdict, train and solvers
         in ``attrs``."""
-        rows = []
+        rows: list[tuple] = []
         for q in self.quantities:
             for side, key in zip(self.solvers, ("reference", "test")):
                 rows += [(q.name, q.kind, side, stat, value, q.unit, None, q.status)
@@ -225,13 +226,13 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
 
     asked = settings[0].duration
     adjustable = [s.dt is None for s in settings]
-    duration, notes = asked, []
+    duration, notes = asked, list[str]()
     steps = first_steps((reference, test), settings)
     refinements, extended, best = 0, False, None
     needed = plan.needed_duration() if plan.detect_steady else None
     rerunnable = reference.rerunnable and test.rerunnable
-    periodic = rerunnable and needed is not None and needed > EXTENSION_FACTOR * asked
-    if periodic:
+    periodic = False
+    if rerunnable and needed is not None and needed > EXTENSION_FACTOR * asked:
         periodic = _periodic_note(plan, reference, needed, asked, notes)
     told = 0  # notes already logged
     while True:
@@ -248,8 +249,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
             notes.append(f"They could not: {exc}.  Both runs start from their static states instead.")
             periodic = False
             continue
-        reachable = needed is not None and duration < needed <= EXTENSION_FACTOR * asked and rerunnable
-        if attempt.how is None and not extended and reachable:
+        if (attempt.how is None and not extended and needed is not None
+                and duration < needed <= EXTENSION_FACTOR * asked and rerunnable):
             notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
                          f"the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s, plus "
                          f"{STEADY_WINDOW_CYCLES} mesh cycles to compare.")
@@ -304,7 +305,9 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         "tolerances": dict(sorted(tolerances.values.items())),
     }
     references = list(spec.references) + list(reference.references) + list(test.references)
-    return CrosscheckResult(spec, run_settings, modal_rows, tolerances.lookup("modes", "frequency", "rel_error"),
+    modal_tolerance = tolerances.lookup("modes", "frequency", "rel_error")
+    assert modal_tolerance is not None  # the defaults hold it, and a tolerances file only overrides them
+    return CrosscheckResult(spec, run_settings, modal_rows, modal_tolerance,
                             comparisons, t0, how in ("detected", "decayed", "transient", "periodic"), (a, b),
                             (modes_a, modes_b),
                             grid, series, clock.wall, clock.cpu, notes=notes,
@@ -337,16 +340,17 @@ class _Attempt:
     def of(cls, sides, settings, plan, tolerances, sensor_band, clock, progress, periodic=False) -> "_Attempt":
         """Both sides run (from their periodic steady states where ``periodic``: steady from the start) and
         compared."""
-        starts = []
+        starts: list[str] = []
         (a, a_check), (b, b_check) = _run_pairs(sides, settings, clock, progress, periodic, starts)
         names = [n for n in a.names(compared=True) if n in b]
         grid, fs, series = _common_grid(a, b, names, plan, sensor_band)
-        t0, how = 0.0, "periodic" if periodic else "transient"
+        t0: float = 0.0
+        how: str | None = "periodic" if periodic else "transient"
         if plan.detect_steady and not periodic:
             groups = [(np.stack([series[n][i] for n in forces], axis=1), cycle)
                       for forces, cycle in plan.steady_groups(names) for i in (0, 1)]
-            t0, how = steady_state(grid, groups, plan.settle)
-            t0 = 0.5 * grid[-1] if how is None else t0
+            start, how = steady_state(grid, groups, plan.settle)
+            t0 = 0.5 * grid[-1] if start is None else start
         forces = [n for n in names if a.signal(n).kind == "mesh_force"]
         orders, drifting = [], []
         for side, run, check in zip(sides, (a, b), (a_check, b_check)):
@@ -470,8 +474,9 @@ def first_steps(sides, settings) -> list[float | None]:
     two rates the discontinuous accelerations of contact alias differently in each, and the NRMSE counts it).
     Else a side that picks takes its default step (None: it picks by its own rule)."""
     defaults = [side.default_step() if s.dt is None else None for side, s in zip(sides, settings)]
-    if len(sides) == 2 and None not in defaults:
-        h = min(defaults)
+    known = [d for d in defaults if d is not None]
+    if len(sides) == 2 and len(known) == 2:
+        h = min(known)
         if all(2 * FIRST_STEP_FACTOR * h <= side.stable_step() for side in sides):
             h *= FIRST_STEP_FACTOR
         return [h, h]

@@ -58,14 +58,19 @@ class CampbellResult:
     def to_dict(self) -> dict:
         return {
             "train": self.train, "unit": "Hz", "speeds_rpm": self.speeds_rpm.tolist(),
-            "solvers": {s: [{"speed_rpm": float(v), "stable": r.stable,
-                             "modes": [{"frequency_hz": float(f), "growth_rate_1_s": float(g), "stability": st,
-                                        "type": t} for f, g, st, t in zip(r.frequencies, r.growth, r.stability,
-                                                                          r.types)]}
+            "solvers": {s: [{"speed_rpm": float(v), "stable": r.stable, "modes": _modes(r)}
                             for v, r in zip(self.speeds_rpm, rs)] for s, rs in self.results.items()},
             "max_relative_difference": self.agreement,
             "mesh_lines": self.mesh_lines, "crossings": self.crossings, "instability_zones": self.zones,
         }
+
+
+def _modes(r: ModalResult) -> list[dict]:
+    """One speed's modes as the diagram's file holds them: frequency, growth rate, stability, type."""
+    if r.growth is None or r.stability is None:
+        raise ValueError("a Campbell diagram holds modes at speed, each with its growth rate")
+    return [{"frequency_hz": float(f), "growth_rate_1_s": float(g), "stability": st, "type": t}
+            for f, g, st, t in zip(r.frequencies, r.growth, r.stability, r.types)]
 
 
 def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics: int = 3) -> CampbellResult:

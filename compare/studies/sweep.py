@@ -270,12 +270,12 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
         (len(speeds) if speeds else 1)
     if count > MAX_POINTS:  # before the grid is built
         raise GearcheckError(f"{count} points: more than the {MAX_POINTS} a sweep holds")
+    drawn = seed if laws else None  # a grid draws nothing: no seed
     if laws:
         sets = draw_samples(laws, 32 if samples is None else samples, seed)
     else:
         sets = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
-        seed = None
-    common = dict(source=source, solvers=solvers, duration=float(duration), harmonics=harmonics, seed=seed,
+    common = dict(source=source, solvers=solvers, duration=float(duration), harmonics=harmonics, seed=drawn,
                   extra=_files_digest(document, source), check=integration_check, refine=refine)
     points = _points(document, base, sets, speeds, "distributions" if laws else "fields", common)
     settings = {"train": base.name, "source": source, "solvers": list(solvers), "duration_s": float(duration),
@@ -283,7 +283,7 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
                 "speeds_rpm": speeds,
                 "grid": {f.path: [float(v) for v in vs] for f, vs in grid.items()},
                 "distributions": {f.path: str(d) for f, d in laws.items()},
-                "samples": len(sets) if laws else None, "seed": seed, "gearcheck": version()}
+                "samples": len(sets) if laws else None, "seed": drawn, "gearcheck": version()}
     return SweepPlan(base.name, points, [f.path for f in list(grid) + list(laws)], settings)
 
 
@@ -341,7 +341,7 @@ def _points(document: dict, base, sets: list[dict], speeds, argument: str, commo
     edited train file loaded (``base`` where nothing is edited) and turned at the slowest and fastest speed;
     ``argument`` (``fields`` or ``distributions``) names the sets in messages, ``common`` is what every point
     shares."""
-    points = []
+    points: list[Point] = []
     for i, values in enumerate(sets):
         where = ", ".join(f"{f.path}={v!r}" for f, v in values.items())
         what = f"{argument}={where}" + (f" (sample {i})" if argument == "distributions" else "")

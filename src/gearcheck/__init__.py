@@ -49,7 +49,11 @@ if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.enviro
     os.environ["MUJOCO_GL"] = "egl"
 
 # before the compiled kernels are defined: a read-only install still imports
-ensure_cache_folder(Path(util.find_spec("gearcheck.lumped").submodule_search_locations[0]))
+_lumped = util.find_spec("gearcheck.lumped")
+if _lumped is None or not _lumped.submodule_search_locations:  # pragma: no cover - a broken install
+    raise ImportError("gearcheck is installed without its lumped solver (gearcheck.lumped)")
+ensure_cache_folder(Path(_lumped.submodule_search_locations[0]))
+del _lumped
 
 from gearcheck.api import (  # noqa: E402
                            SOLVERS,

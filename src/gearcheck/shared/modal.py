@@ -88,13 +88,13 @@ class ModalResult:
     def to_dict(self) -> dict:
         modes = []
         for i, (f, t, m) in enumerate(zip(self.frequencies, self.types, self.multiplicity)):
-            mode = {"mode": i + 1, "frequency_hz": float(f), "type": t, "multiplicity": m}
-            if self.growth is not None:
+            mode: dict[str, object] = {"mode": i + 1, "frequency_hz": float(f), "type": t, "multiplicity": m}
+            if self.growth is not None and self.stability is not None:
                 mode.update(growth_rate_1_s=float(self.growth[i]), stability=self.stability[i])
             if self.fractions is not None:
                 mode["energy"] = {g: float(x) for g, x in zip(GROUPS, self.fractions[i])}
             modes.append(mode)
-        out = {"train": self.train, "solver": self.solver, "unit": "Hz", "modes": modes}
+        out: dict[str, object] = {"train": self.train, "solver": self.solver, "unit": "Hz", "modes": modes}
         if self.speed_rpm is not None:
             out.update(speed_rpm=self.speed_rpm, stable=self.stable)
         return out

@@ -57,6 +57,8 @@ def test_exported_reference_passes_the_crosscheck(tmp_path):
     report = result.write(tmp_path / "report")  # a PASS against its own export shows no red row
     lines = [s for q in report["quantities"] for s in q["spectrum"]]
     assert not [s for s in lines if s["status"] == "fail"]
+    assert set(report["volatile"]["cpu_time"]) == {"lumped_modes_s", "test_modes_s", "lumped_run_s", "lumped_check_s",
+                                                   "test_run_s", "test_check_s"}  # the user's model is no "mujoco"
     assert 'class="fail"' not in (tmp_path / "report" / "report.html").read_text()
     # the lines whose relative error exceeds their tolerance (the held samples move a jump by up to 1/4096 of a
     # mesh period, which the phasing of the sun's lines does not forgive) carry under a tenth of it

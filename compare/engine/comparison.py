@@ -218,9 +218,9 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     progress: callable(fraction) over the runs.
     """
     clock = Clock()
-    with clock.step("lumped_modes_s"):
+    with clock.step(f"{_label(reference, 0)}_modes_s"):
         modes_a = reference.modes()
-    with clock.step("mujoco_modes_s"):
+    with clock.step(f"{_label(test, 1)}_modes_s"):
         modes_b = test.modes() if test.has_modes else None
     modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
 
@@ -400,6 +400,12 @@ class Clock:
                  self.cpu[name])
 
 
+def _label(side, i: int) -> str:
+    """A side's name in the timings: gearcheck's two solvers by name (the keys the history keeps), any other side
+    as the reference (``i`` 0) or the test (1)."""
+    return side.solver if side.solver in ("lumped", "mujoco") else ("reference", "test")[i]
+
+
 def _tell(notes: list[str], told: int) -> int:
     """Log the notes from ``told`` on as they are made (the command line's ``-v``); returns how many are told."""
     for note in notes[told:]:
@@ -421,7 +427,7 @@ def _run_pairs(sides, settings, clock, progress, periodic=False, starts=None):
     side (``rerunnable`` False) has no check."""
     pairs = []
     for i, (side, run_settings) in enumerate(zip(sides, settings)):
-        label = ("lumped", "mujoco")[i]
+        label = _label(side, i)
         # progress over both sides: a run counts 1, its check (at most twice the step) 0.5
         report = (lambda f, i=i: progress((1.5 * i + f) / 3.0)) if progress else None
         if periodic:

@@ -66,15 +66,35 @@ class FieldSensitivity:
     derivative: HarmonicResponse
     difference: HarmonicResponse
 
+    def _parts(self):
+        """(closed form, finite difference, response) of the harmonics' amplitudes and of the mean."""
+        return ((self.derivative.amplitudes, self.difference.amplitudes, self.response.amplitudes),
+                (self.derivative.mean[None], self.difference.mean[None], self.response.mean[None]))
+
+    def _null(self, cf, fd, response) -> bool:
+        """Whether both derivatives of one part are round-off: a relative change of the response below ``NULL``
+        per relative change of the parameter (a sun's mass moves no mean deflection: no centripetal load at the
+        centre)."""
+        level = NULL * float(np.abs(response).max()) / abs(self.value) if self.value else 0.0
+        return float(np.abs(fd).max()) <= level and float(np.abs(cf).max()) <= level
+
+    @property
+    def independent(self) -> bool:
+        """The response does not depend on the parameter: every derivative is round-off (:meth:`_null`)."""
+        return all(self._null(*part) for part in self._parts())
+
     def relative_error(self, floor: float = 1e-3) -> float:
         """The largest |closed form - finite difference| of dQ_h/dp and d mean/dp, relative to the largest
         |dQ_h/dp| or |d mean/dp| of the same coordinate, over the coordinates where that is above ``floor`` times
-        the largest of all (the others are round-off: a sun's translation the in-phase planets never load).  Where
-        the differences are all zero (the Fourier-series mean does not see an inertia) the closed form must be too:
-        the error is then 0 or infinite."""
+        the largest of all (the others are round-off: a sun's translation the in-phase planets never load).  A part
+        whose derivatives are both round-off (:meth:`_null`) agrees (0); where the differences are all zero (the
+        Fourier-series mean does not see an inertia) the closed form must be too: the error is then 0 or
+        infinite."""
         errors = []
-        for cf, fd in ((self.derivative.amplitudes, self.difference.amplitudes),
-                       (self.derivative.mean[None], self.difference.mean[None])):
+        for cf, fd, response in self._parts():
+            if self._null(cf, fd, response):
+                errors.append(0.0)
+                continue
             scale = np.abs(fd).max(axis=0)
             if not scale.any():
                 errors.append(np.inf if np.abs(cf).any() else 0.0)
@@ -171,6 +191,7 @@ def _model(text, source, field: FitParameter | None, value, speed):
     return build_model(load_train(load_text(tomli_w.dumps(document), source), speed))
 
 
+NULL = 1e-9  # d ln|Q| / d ln p below this is round-off: the response does not depend on the parameter there
 HARMONIC_NOTATION = ("harmonic (k1, k2): the orders of the train's clocks, at k1 times the mesh frequency plus k2 "
                      "times the second clock's (an RV reducer's eccentrics turning in the carrier); (k1,) with one "
                      "clock")

@@ -462,8 +462,12 @@ def cmd_sensitivity(args) -> int:
                                  "closed_form": result.closed_form[j, index],
                                  "finite_difference": result.finite_difference[j, index],
                                  "eq15": None if result.truncated is None else result.truncated[j, index]})
-                print(f"{parameter} = {result.value:.6g}: closed form against finite differences, largest "
-                      f"relative difference {result.relative_error():.1e} ({method})")
+                if result.independent:
+                    print(f"{parameter} = {result.value:.6g}: the response does not depend on it (every derivative "
+                          f"is round-off: negligible)")
+                else:
+                    print(f"{parameter} = {result.value:.6g}: closed form against finite differences, largest "
+                          f"relative difference {result.relative_error():.1e} ({method})")
             import pandas as pd
 
             frame = pd.DataFrame(rows)

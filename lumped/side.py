@@ -99,6 +99,7 @@ class LinearSide(Side):
         self.linear = model.check(spec, self.train.dofs.labels())
         self.solver = model.name
         self.references = references
+        self.driven = bool(self.linear.meshes) or self.linear.stiffness is not None or self.linear.forcing is not None
 
     def modes(self) -> ModalResult:
         modal = linear_modes(self.linear, self.train)

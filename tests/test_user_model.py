@@ -6,6 +6,7 @@ end in one line and exit status 2 with nothing written."""
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from gearcheck.cli import main
 from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
+from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.matrix_file import read_matrix_file
 from gearcheck.lumped.side import LinearSide, LumpedSide
 from gearcheck.mbd_models.side import MujocoSide
@@ -286,3 +288,21 @@ def test_train_file_registers_its_user_model(tmp_path, capsys):
     status = main(["crosscheck", "demo-3p", "--model", "user", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert status == 2 and "demo-3p registers no user_model" in err and not (tmp_path / "o").exists()
+
+
+def test_a_model_of_mass_and_stiffness_only_gets_a_modal_verdict(tmp_path, capsys):
+    """The file engineers most often have: M and K, no mesh rows, nothing that varies in time (it crashed in the
+    steady-state test, max() of nothing, exit 1).  Its runs would sit still, so its modes alone are compared, and
+    the report says why and what to add; the same matrices 10 % too stiff FAIL on the modes."""
+    ref = reference_linear_model(gearcheck.load("demo-3p"))
+    K = ref.K + sum(float(np.mean(m.stiffness.samples)) * np.outer(m.row, m.row) for m in ref.meshes)
+    for name, stiffness, status in (("right", K, 0), ("stiff", 1.1 * K, 1)):
+        path = tmp_path / f"{name}.npz"
+        write_matrix_file(LinearModel("mk-only", ref.coordinates, ref.M, stiffness), path)
+        out = tmp_path / name
+        assert main(["crosscheck", "demo-3p", "--model", str(path), "--out", str(out)]) == status
+        data = json.loads((out / "report.json").read_text())
+        assert data["steady_state"]["how"] == "modes only" and data["quantities"] == [] and len(data["modes"]) == 18
+        assert any("nothing that drives it" in note for note in data["notes"])
+        assert {m["status"] for m in data["modes"]} == ({"pass"} if status == 0 else {"fail"})
+        assert (out / "natural_frequencies.png").exists() and not (out / "time_histories.png").exists()

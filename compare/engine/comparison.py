@@ -223,6 +223,12 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     with clock.step(f"{_label(test, 1)}_modes_s"):
         modes_b = test.modes() if test.has_modes else None
     modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
+    modal_tolerance = tolerances.lookup("modes", "frequency", "rel_error")
+    assert modal_tolerance is not None  # the defaults hold it, and a tolerances file only overrides them
+    references = list(dict.fromkeys(list(spec.references) + list(reference.references) + list(test.references)))
+    if not test.driven:
+        return _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_tolerance, (modes_a, modes_b),
+                           clock, references)
 
     asked = settings[0].duration
     adjustable = [s.dt is None for s in settings]
@@ -304,16 +310,30 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
         "sensor_band_hz": list(sensor_band) if sensor_band else None,
         "tolerances": dict(sorted(tolerances.values.items())),
     }
-    references = list(spec.references) + list(reference.references) + list(test.references)
-    modal_tolerance = tolerances.lookup("modes", "frequency", "rel_error")
-    assert modal_tolerance is not None  # the defaults hold it, and a tolerances file only overrides them
     return CrosscheckResult(spec, run_settings, modal_rows, modal_tolerance,
                             comparisons, t0, how in ("detected", "decayed", "transient", "periodic"), (a, b),
                             (modes_a, modes_b),
-                            grid, series, clock.wall, clock.cpu, notes=notes,
-                            references=list(dict.fromkeys(references)),
+                            grid, series, clock.wall, clock.cpu, notes=notes, references=references,
                             steady_how=how, settle_s=plan.settle if plan.detect_steady else None,
                             solvers=(reference.solver, test.solver))
+
+
+def _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_tolerance, modal_results, clock,
+                references) -> CrosscheckResult:
+    """The cross-check of a side that nothing drives (``Side.driven`` False): its modes against the reference's,
+    the time-domain part skipped with the reason and what to add."""
+    note = (f"{display_name(test.solver)} has nothing that drives it: no mesh rows, no time-varying stiffness, no "
+            "time-varying force. Its runs would sit at their static state, so only its modes are compared; give its "
+            "meshes as mesh rows (or its stiffness and forcing as functions of time) for the time-domain "
+            "comparison.")
+    log.info("%s", note)
+    settings = {"duration_s": 0.0, "simulated_s": 0.0, **plan.operating, "lumped": {}, "mujoco": {},
+                "common_sample_rate_hz": 0.0, "steady_cycle_s": plan.cycle, "steady_cycle_of": plan.cycle_of,
+                "integration_check_steps_s": [None, None], "sensor_band_hz": None,
+                "tolerances": dict(sorted(tolerances.values.items()))}
+    return CrosscheckResult(spec, settings, modal_rows, modal_tolerance, [], 0.0, True, (None, None), modal_results,
+                            np.zeros(0), {}, clock.wall, clock.cpu, notes=[note], references=references,
+                            steady_how="modes only", solvers=(reference.solver, test.solver))
 
 
 @dataclass

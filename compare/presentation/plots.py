@@ -99,6 +99,8 @@ def time_histories_figure(result, names=None, cycles: int = 4) -> Figure:
 
 
 def time_histories(result, path, cycles: int = 4):
+    if not result.quantities:  # a cross-check of modes only: no run to draw
+        return False
     _save(time_histories_figure(result, cycles=cycles), path)
 
 
@@ -204,6 +206,8 @@ def spectra_figure(result) -> Figure:
 
 
 def spectra(result, path):
+    if not result.quantities:
+        return False
     _save(spectra_figure(result), path)
 
 
@@ -291,6 +295,8 @@ def natural_frequencies(result, path):
 
 def error_bars(result, path):
     gated = [q for q in result.quantities if q.status != "negligible" and q.metrics["nrmse"] is not None]
+    if not gated:
+        return False
     fig, ax = _figure(figsize=(9, max(3.0, 0.22 * len(gated) + 1.5)))
     y = np.arange(len(gated))
     values = [max(q.metrics["nrmse"], 1e-12) for q in gated]

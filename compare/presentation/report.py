@@ -388,26 +388,31 @@ def _summary_lines(data) -> list[str]:
            "decayed": f"the free vibration of the start decayed to {STEADY_THRESHOLD:g}",
            "transient": "the whole transient",
            "periodic": "both runs start on their periodic steady states: the whole run",
+           "modes only": "no run: nothing drives the test model, its modes alone are compared",
            None: "NO steady state: second half shown, verdict inconclusive"}[steady["how"]]
     steps = [f"{x:.4g} s" if x is not None else "none: a recording" for x in s["integration_check_steps"]["value"]]
     p = data["provenance"]
     A, B = solver_names(data)
+    runs = [] if steady["how"] == "modes only" else [
+        f"Reference ({A}): {_settings_line(s['lumped'])}",
+        f"Test ({B}): {_settings_line(s['mujoco'])}"]
+    integration = [] if steady["how"] == "modes only" else [
+        "Integration error per solver, from the same run at twice the step or half it "
+        f"(check steps {', '.join(steps)}): Richardson's estimate for gearcheck's fourth-order solvers, "
+        "rms(x_h − x_2h)/rms(a)/15 or 16/15 rms(x_h − x_h/2)/rms(a); the change itself, a bound, for a model of "
+        "unknown order or runs outside the asymptotic range (the findings say which); 'unresolved' = the two "
+        "estimates together reach the tolerance."]
     return [
         f"Train: {data['train']['name']} — {data['train']['description']} ({data['train']['source']})",
         f"Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
         f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})",
-        f"Reference ({A}): {_settings_line(s['lumped'])}",
-        f"Test ({B}): {_settings_line(s['mujoco'])}",
+        *runs,
         f"gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "
         f"NumPy {p['numpy_version']}, Python {p['python']}, {p['machine']}; train {p['train_file']} "
         f"sha256 {p['train_sha256'][:16]}…",
         f"Metrics: NRMSE = rms(b − a)/rms(a) after removing the lag; {A} = a (reference), {B} = b; "
         "'negligible' = below 1e-6 of the largest quantity of its kind in both solvers (not gated).",
-        "Integration error per solver, from the same run at twice the step or half it "
-        f"(check steps {', '.join(steps)}): Richardson's estimate for gearcheck's fourth-order solvers, "
-        "rms(x_h − x_2h)/rms(a)/15 or 16/15 rms(x_h − x_h/2)/rms(a); the change itself, a bound, for a model of "
-        "unknown order or runs outside the asymptotic range (the findings say which); 'unresolved' = the two "
-        "estimates together reach the tolerance.",
+        *integration,
     ]
 
 
@@ -547,7 +552,8 @@ def _report_properties() -> dict:
         "settings": _settings_schema(),
         "verdict": _verdict_schema(),
         "steady_state": _object({"start": seconds, "detected": BOOLEAN,
-                                 "how": {"enum": ["detected", "decayed", "transient", "periodic", None]},
+                                 "how": {"enum": ["detected", "decayed", "transient", "periodic", "modes only",
+                                                  None]},
                                  "settling_time": _value("s", nullable=True)}),
         "modes": _array(_object({
             "mode": {"type": "integer"}, "type": STRING, "multiplicity": {"type": "integer"},

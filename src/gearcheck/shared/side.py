@@ -32,6 +32,8 @@ class Side(ABC):
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES its equations come from
     rerunnable: bool = True  # run() integrates anew at the settings asked (False: a recording, as it is)
     has_modes: bool = True  # modes() gives natural frequencies (False: a recording without a modes file)
+    driven: bool = True  # its runs have something that moves them (False: matrices with no mesh rows, no varying
+    #                      stiffness and no varying force: its runs would sit still, and only its modes compare)
     linear = None  # its matrices (a LinearModel) when it is a model given as matrices
     order = 1  # the order its runs converge at; 1 (not known) makes the change on doubling the step a bound
 

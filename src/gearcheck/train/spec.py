@@ -739,6 +739,9 @@ def _planet_paths(planet_gears: dict, path: str) -> dict[str, str]:
     return {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}" for name in planet_gears}
 
 
+BASE_PITCH_TOLERANCE = 1e-3  # relative: base radii a paper rounds to 0.01 mm stay within it
+
+
 def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dict:
     """Every gear an involute gear, every central gear's pair with its planet gear an involute mesh: the operating
     geometry of each pair by central key."""
@@ -754,6 +757,12 @@ def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dic
         if gear.internal and gear.teeth <= planet.teeth:
             raise fail(f"{path}.{key}.teeth", f"a ring needs more teeth than its planet gear ({planet.teeth}), "
                                               f"got {gear.teeth}")
+        pitches = [2 * math.pi * g.base_radius / g.teeth for g in (gear, planet)]  # the base pitch, 2 pi r_b / z
+        if abs(pitches[0] - pitches[1]) > BASE_PITCH_TOLERANCE * pitches[1]:
+            raise fail(f"{path}.{key}.base_radius_mm", f"base pitch {pitches[0] * 1e3:.6g} mm, its planet gear's "
+                                                    f"{pitches[1] * 1e3:.6g} mm: gears in mesh share one base pitch "
+                                                    "(their base radii over their teeth), else their meshes turn at "
+                                                    "different frequencies")
         try:
             geoms[key] = mesh_geometry(gear, planet)
         except ValueError as exc:

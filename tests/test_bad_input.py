@@ -122,8 +122,8 @@ GEOMETRY = [
     ("base-radius-too-big", demo((r"^teeth = 22", "teeth = 22\nbase_radius_mm = 40.0")),
      "stages[0].sun.base_radius_mm: base radius 40 mm does not fit the pitch radius 33 mm"),
     ("base-pitches-disagree", demo((r"^teeth = 62", "teeth = 62\nbase_radius_mm = 88.0")),
-     "stages[0].ring.base_radius_mm: normal base pitch 8.91807 mm, its planet gear's 8.85639 mm: gears in mesh "
-     "share one base pitch"),
+     "stages[0].ring.base_radius_mm: meshing ring with the planet: base pitch 8.91807 mm, planet gear planet's "
+     "8.85639 mm: gears in mesh share one base pitch"),
     ("ring-internal-interference", gears(22, 20, 62, (r"^teeth = 62$", "teeth = 62\naddendum_coefficient = 1.3")),
      "involute interference"),
 ]

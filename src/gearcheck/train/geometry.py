@@ -188,6 +188,10 @@ INTERFERENCE_TOLERANCE = 0.05
 """How far (in modules, along the line of action) a tip may reach past the mate's base-circle tangent
 point: the edge break every tooth tip carries (drawings specify about 0.05 m) takes that much off."""
 
+BASE_PITCH_TOLERANCE = 1e-3
+"""How far (relative) the base pitches of two gears in mesh may differ: base radii a paper rounds to 0.01 mm stay
+within it."""
+
 
 def tip_thickness(gear: Gear) -> float:
     """Arc tooth thickness on the tip circle of an external gear (ISO 21771):
@@ -233,17 +237,23 @@ def gear_problem(gear: Gear) -> tuple[str, str] | None:
     return None
 
 
-def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[str, str] | None:
-    """(which gear: "central" or "planet", message) of the first thing that stops the pair meshing as
-    involutes, or None: tips meeting the mate below its base circle (involute interference), tips
-    hitting the mate's root circle, a contact ratio below ``MIN_CONTACT_RATIO`` (transverse and face together
-    for a helical pair)."""
+def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[str, str, str] | None:
+    """(which gear: "central" or "planet", the field to blame, message) of the first thing that stops the pair
+    meshing as involutes, or None: helices that do not match, base pitches that differ (an explicit base radius
+    can make them: the meshes would turn at different frequencies), tips meeting the mate below its base circle
+    (involute interference), tips hitting the mate's root circle, a contact ratio below ``MIN_CONTACT_RATIO``
+    (transverse and face together for a helical pair)."""
     same_hand = central.internal  # an internal pair's helices run the same way, an external pair's opposite
     if central.helix_angle != (planet.helix_angle if same_hand else -planet.helix_angle):
-        return "central", (f"helix angle {math.degrees(central.helix_angle):.6g} deg cannot mesh with "
-                           f"{planet.name}'s {math.degrees(planet.helix_angle):.6g} deg: an "
-                           f"{'internal' if same_hand else 'external'} pair needs equal helix angles of "
-                           f"{'the same' if same_hand else 'opposite'} hand (positive = right hand)")
+        return "central", "teeth", (f"helix angle {math.degrees(central.helix_angle):.6g} deg cannot mesh with "
+                                    f"{planet.name}'s {math.degrees(planet.helix_angle):.6g} deg: an "
+                                    f"{'internal' if same_hand else 'external'} pair needs equal helix angles of "
+                                    f"{'the same' if same_hand else 'opposite'} hand (positive = right hand)")
+    if abs(central.base_pitch - planet.base_pitch) > BASE_PITCH_TOLERANCE * planet.base_pitch:
+        return "central", "base_radius_mm", (
+            f"base pitch {central.base_pitch * 1e3:.6g} mm, planet gear {planet.name}'s "
+            f"{planet.base_pitch * 1e3:.6g} mm: gears in mesh share one base pitch (their base radii over their "
+            "teeth), else their meshes turn at different frequencies")
     line = geometry.centre_distance * math.sin(geometry.pressure_angle)  # between the tangent points
     a, m = geometry.centre_distance, central.normal_module
     if central.internal:  # the ring's tip contact must lie beyond the planet's tangent point
@@ -258,15 +268,16 @@ def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[s
     for who, overlap in reach.items():
         if overlap > INTERFERENCE_TOLERANCE * m:
             mate = names["planet" if who == "central" else "central"]
-            return who, (f"involute interference: the {names[who]} tip meets the {mate} {overlap * 1e3:.4g} mm "
-                         f"({overlap / m:.3f} m) below its base circle along the line of action (tolerated: "
-                         f"{INTERFERENCE_TOLERANCE:g} m)")
+            return who, "teeth", (f"involute interference: the {names[who]} tip meets the {mate} "
+                                  f"{overlap * 1e3:.4g} mm ({overlap / m:.3f} m) below its base circle along the line "
+                                  f"of action (tolerated: {INTERFERENCE_TOLERANCE:g} m)")
     for who, gap in clearance.items():
         if gap < -1e-12:
-            return who, f"the {names[who]} tip hits the mate's root circle ({gap * 1e3:.4g} mm of clearance)"
+            return who, "teeth", (f"the {names[who]} tip hits the mate's root circle ({gap * 1e3:.4g} mm of "
+                                  "clearance)")
     if geometry.total_contact_ratio < MIN_CONTACT_RATIO:  # a helical pair's overlap keeps contact too
         ratio = (f"transverse contact ratio {geometry.contact_ratio:.3f}" if not geometry.face_contact_ratio else
                  f"total contact ratio {geometry.contact_ratio:.3f} + {geometry.face_contact_ratio:.3f}")
-        return "central", (f"{ratio} < {MIN_CONTACT_RATIO:g} with {names['planet']}: the mesh cannot keep a tooth "
-                           "pair in contact")
+        return "central", "teeth", (f"{ratio} < {MIN_CONTACT_RATIO:g} with {names['planet']}: the mesh cannot "
+                                    "keep a tooth pair in contact")
     return None

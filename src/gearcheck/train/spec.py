@@ -739,9 +739,6 @@ def _planet_paths(planet_gears: dict, path: str) -> dict[str, str]:
     return {name: f"{path}.planet" if name == "planet" else f"{path}.planet.gears.{name}" for name in planet_gears}
 
 
-BASE_PITCH_TOLERANCE = 1e-3  # relative: base radii a paper rounds to 0.01 mm stay within it
-
-
 def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dict:
     """Every gear an involute gear, every central gear's pair with its planet gear an involute mesh: the operating
     geometry of each pair by central key."""
@@ -757,7 +754,6 @@ def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dic
         if gear.internal and gear.teeth <= planet.teeth:
             raise fail(f"{path}.{key}.teeth", f"a ring needs more teeth than its planet gear ({planet.teeth}), "
                                               f"got {gear.teeth}")
-        _check_base_pitch(gear, planet, f"{path}.{key}", fail)
         try:
             geoms[key] = mesh_geometry(gear, planet)
         except ValueError as exc:
@@ -765,20 +761,8 @@ def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dic
         problem = mesh_problem(gear, planet, geoms[key])
         if problem:
             where = f"{path}.{key}" if problem[0] == "central" else planet_paths[pg]
-            raise fail(f"{where}.teeth", f"meshing {key} with the planet: {problem[1]}")
+            raise fail(f"{where}.{problem[1]}", f"meshing {key} with the planet: {problem[2]}")
     return geoms
-
-
-def _check_base_pitch(gear: Gear, planet: Gear, path: str, fail) -> None:
-    """Gears in mesh share one normal base pitch, 2 pi r_b cos(beta_b) / z (an explicit base radius may break it:
-    their meshes would then turn at different frequencies); the normal one, so that a helical gear beside a spur
-    one is refused for its helix, by the mesh's own check."""
-    pitches = [2 * math.pi * g.base_radius * math.cos(g.base_helix_angle) / g.teeth for g in (gear, planet)]
-    if abs(pitches[0] - pitches[1]) > BASE_PITCH_TOLERANCE * pitches[1]:
-        raise fail(f"{path}.base_radius_mm", f"normal base pitch {pitches[0] * 1e3:.6g} mm, its planet gear's "
-                                             f"{pitches[1] * 1e3:.6g} mm: gears in mesh share one base pitch (their "
-                                             "base radii over their teeth), else their meshes turn at different "
-                                             "frequencies")
 
 
 def _centre_distance(centrals: dict, planet_gears: dict, geoms: dict, path: str, fail) -> float:

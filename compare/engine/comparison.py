@@ -232,7 +232,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
 
     asked = settings[0].duration
     adjustable = [s.dt is None for s in settings]
-    duration, notes = asked, list[str]()
+    duration, notes = asked, _Notes()
     steps = first_steps((reference, test), settings)
     refinements, extended, best = 0, False, None
     needed = plan.needed_duration() if plan.detect_steady else None
@@ -240,9 +240,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     periodic = False
     if rerunnable and needed is not None and needed > EXTENSION_FACTOR * asked:
         periodic = _periodic_note(plan, reference, needed, asked, notes)
-    told = 0  # notes already logged
     while True:
-        told = _tell(notes, told)
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
         log.info("%s: %.4g s simulated, steps %s, %s", spec.name, duration,
                  ", ".join("derived" if dt is None else f"{dt:.4g} s" for dt in steps),
@@ -280,7 +278,6 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
                          f"as h^{order}).")
             continue
         break
-    _tell(notes, told)
     (a, b), (a_check, b_check), grid, fs, series = best.runs, best.checks, best.grid, best.fs, best.series
     if best.starts:
         notes.append("Periodic steady states found by " + "; ".join(best.starts) + ".")
@@ -322,17 +319,17 @@ def _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_toler
                 references) -> CrosscheckResult:
     """The cross-check of a side that nothing drives (``Side.driven`` False): its modes against the reference's,
     the time-domain part skipped with the reason and what to add."""
-    note = (f"{display_name(test.solver)} has nothing that drives it: no mesh rows, no time-varying stiffness, no "
-            "time-varying force. Its runs would sit at their static state, so only its modes are compared; give its "
-            "meshes as mesh rows (or its stiffness and forcing as functions of time) for the time-domain "
-            "comparison.")
-    log.info("%s", note)
+    notes = _Notes()
+    notes.append(f"{display_name(test.solver)} has nothing that drives it: no mesh rows, no time-varying stiffness, "
+                 "no time-varying force. Its runs would sit at their static state, so only its modes are compared; "
+                 "give its meshes as mesh rows (or its stiffness and forcing as functions of time) for the "
+                 "time-domain comparison.")
     settings = {"duration_s": 0.0, "simulated_s": 0.0, **plan.operating, "lumped": {}, "mujoco": {},
                 "common_sample_rate_hz": 0.0, "steady_cycle_s": plan.cycle, "steady_cycle_of": plan.cycle_of,
                 "integration_check_steps_s": [None, None], "sensor_band_hz": None,
                 "tolerances": dict(sorted(tolerances.values.items()))}
     return CrosscheckResult(spec, settings, modal_rows, modal_tolerance, [], 0.0, True, (None, None), modal_results,
-                            np.zeros(0), {}, clock.wall, clock.cpu, notes=[note], references=references,
+                            np.zeros(0), {}, clock.wall, clock.cpu, notes=notes, references=references,
                             steady_how="modes only", solvers=(reference.solver, test.solver))
 
 
@@ -426,11 +423,12 @@ def _label(side, i: int) -> str:
     return side.solver if side.solver in ("lumped", "mujoco") else ("reference", "test")[i]
 
 
-def _tell(notes: list[str], told: int) -> int:
-    """Log the notes from ``told`` on as they are made (the command line's ``-v``); returns how many are told."""
-    for note in notes[told:]:
+class _Notes(list):
+    """A cross-check's findings, each logged as it is made (the command line's ``-v``)."""
+
+    def append(self, note: str) -> None:
         log.info("%s", " ".join(note.split()))
-    return len(notes)
+        super().append(note)
 
 
 def _log_work(label: str, run) -> None:

@@ -76,7 +76,7 @@ from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory, check_place
-from gearcheck.shared.results import train_signals
+from gearcheck.shared.results import train_signals, unit_schema
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import richardson_factor
 from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
@@ -679,9 +679,7 @@ def table_schema(plan: SweepPlan) -> pa.Schema:
     meta = {"gearcheck.sweep": json.dumps(plan.settings, sort_keys=True),
             "gearcheck.units": json.dumps({k: {"unit": u, "description": d} for k, (u, d) in units.items()},
                                           sort_keys=True)}
-    fields = head + list(POINT_SCHEMA) + [pa.field("key", pa.string())]
-    return pa.schema([f.with_metadata({"unit": units[f.name][0], "description": units[f.name][1]})
-                      if f.name in units else f for f in fields], metadata=meta)
+    return unit_schema(pa.schema(head + list(POINT_SCHEMA) + [pa.field("key", pa.string())], metadata=meta), units)
 
 
 def parquet_bytes(table: pa.Table) -> bytes:

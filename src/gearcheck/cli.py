@@ -22,6 +22,7 @@ import re
 import signal
 import sys
 import warnings
+from collections import Counter
 from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
@@ -34,7 +35,7 @@ from gearcheck.compare.engine.crosscheck import MODELS
 from gearcheck.compare.presentation.junit import write_junit
 from gearcheck.shared.progress import ProgressBar
 from gearcheck.compare.presentation.report import write_report
-from gearcheck.compare.presentation.summary import overall_line, summary_row, write_summary
+from gearcheck.compare.presentation.summary import overall, overall_line, summary_row, write_summary
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError, did_you_mean, one_line
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
@@ -718,11 +719,11 @@ def cmd_crosscheck(args) -> int:
     if fleet and args.speed is not None:
         raise GearcheckError("--speed applies to one train; several run each at its own speed")
     specs = [gearcheck.load(name) for name in names]  # every train checked before anything runs or is written
-    if args.history is not None:
-        for spec, name in zip(specs, names):
-            if [s.name for s in specs].count(spec.name) > 1:
-                raise GearcheckError(f"TRAIN {name}: another train of the fleet has its name {spec.name!r}, and "
-                                     "--history keeps one record per commit and train name")
+    named = Counter(spec.name for spec in specs)
+    for spec, name in zip(specs, names):
+        if args.history is not None and named[spec.name] > 1:
+            raise GearcheckError(f"TRAIN {name}: another train of the fleet has its name {spec.name!r}, and "
+                                 "--history keeps one record per commit and train name")
     folders = report_folders(names) if fleet else [""]
     rows, lines, reports = [], [], []
     if args.junit is not None:
@@ -757,17 +758,11 @@ def cmd_crosscheck(args) -> int:
         print(f"{overall_line(rows)} (summary: {args.out / 'summary.md'})")
     if args.junit is not None:
         print(f"junit: {args.junit}")
-    return exit_status([r["status"] for r in rows])
+    return EXIT_STATUS[overall(rows)]
 
 
-EXIT_STATUS = {"PASS": 0, "FAIL": 1, "INCONCLUSIVE": 3}
+EXIT_STATUS = {"PASS": 0, "FAIL": 1, "INCONCLUSIVE": 3}  # of the worst verdict (summary.overall)
 MOVED_SHOWN = 3  # baseline moves named on the verdict line (the report lists them all)
-
-
-def exit_status(verdicts) -> int:
-    """1 when any cross-check failed, else 3 when any was inconclusive, else 0."""
-    codes = {EXIT_STATUS[v] for v in verdicts}
-    return 1 if 1 in codes else max(codes, default=0)
 
 
 def _verdict_line(result, out: Path) -> str:

@@ -175,14 +175,21 @@ def _write_table(frame: pd.DataFrame, path: Path, columns: dict) -> Path:
 
 
 def with_field_units(table, columns: dict):
-    """``table`` with each column of ``columns`` ({name: (unit, description)}) carrying its ``unit`` and
-    ``description`` in its own field's metadata, where pyarrow, polars and DuckDB users see them."""
+    """``table`` with its schema's fields carrying their units (:func:`unit_schema`)."""
+    import pyarrow as pa
+
+    return pa.Table.from_arrays(table.columns, schema=unit_schema(table.schema, columns))
+
+
+def unit_schema(schema, columns: dict):
+    """``schema`` with each field of ``columns`` ({name: (unit, description)}) carrying its ``unit`` and
+    ``description`` in its own metadata, where pyarrow, polars and DuckDB users see them."""
     import pyarrow as pa
 
     fields = [f.with_metadata({**(f.metadata or {}), b"unit": columns[f.name][0].encode(),
                                b"description": columns[f.name][1].encode()}) if f.name in columns else f
-              for f in table.schema]
-    return pa.Table.from_arrays(table.columns, schema=pa.schema(fields, metadata=table.schema.metadata))
+              for f in schema]
+    return pa.schema(fields, metadata=schema.metadata)
 
 
 def units_of(path) -> dict:

@@ -96,6 +96,13 @@ def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
            "trains)**" in text
     assert text.count("every quantity and mode within tolerance") == len(preset_names())
     assert "(0.05)" in text  # the worst NRMSE beside its tolerance
+    # a helical train's axial motion is compared: each central member's acceleration along the stage axis (its
+    # helix pushes it at the mesh frequency), both solvers within a tenth of its tolerance (measured 1e-4 of 0.05)
+    helical = json.loads((tmp_path / "helical-planetary" / "report.json").read_text())
+    axial = [q for q in helical["quantities"] if q["name"].endswith(".az")]
+    assert sorted(q["name"] for q in axial) == ["stage1.carrier.az", "stage1.ring.az", "stage1.sun.az"]
+    assert all(q["status"] == "pass" and q["errors"]["nrmse"]["value"] < 0.1 * q["tolerance_nrmse"]["value"]
+               for q in axial)
 
 
 def test_a_baseline_rewritten_without_a_duration_keeps_its_own(tmp_path):

@@ -136,8 +136,7 @@ def require_mesh_cycle(spec, what: str) -> None:
                                                                      "only modes, campbell and mac apply; give a "
                                                                      "speed)")
     for i, stage in enumerate(spec.stages):
-        planet = spec.members[stage.planets[0]]
-        if any(g.idealised for g in planet.gears.values()):
+        if stage.idealised:
             raise TrainFileError(spec.path, f"stages[{i}].planet.teeth", f"missing: {what} needs the teeth of "
                                                                         f"idealised stage {stage.name} (its mesh "
                                                                         "cycle); its modes need none")

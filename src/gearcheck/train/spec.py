@@ -305,6 +305,7 @@ class Stage:
     planets: tuple[str, ...]
     carrier: str
     helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
+    idealised: bool = False  # no teeth: base radii and a pressure angle (see _idealised_gear)
 
 
 @dataclass(frozen=True)
@@ -423,6 +424,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
                           op["input_torque"], op["torque_expression"])
 
+    _note_idealised(stages)
     _note_undamped(members)
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,
@@ -433,6 +435,16 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
         user_model=_user_model(train["user_model"], source, fail),
     )
+
+
+def _note_idealised(stages: list[Stage]) -> None:
+    """A note naming the idealised stages and what they skip and lack."""
+    for i, stage in enumerate(stages):
+        if stage.idealised:
+            warnings.warn(f"stages[{i}] ({stage.name}) is idealised (base radii, no teeth): the involute and assembly "
+                          "checks are skipped, the speeds follow from the base radii, and its meshes have no mesh "
+                          "cycle (constant stiffness, no mesh frequency or phase: modes only)", TrainNote,
+                          stacklevel=2)
 
 
 def _note_undamped(members: dict) -> None:
@@ -706,13 +718,13 @@ def _build_stage(st: dict, path: str, fail):
     if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
         members = {mid: replace(m, axial=True) for mid, m in members.items()}
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
-                  f"{name}.carrier", helical)
+                  f"{name}.carrier", helical, idealised)
     return members, stage, meshes, cycloids
 
 
 def _check_idealised(st: dict, centrals: dict, planet_gears: dict, path: str, fail) -> bool:
-    """Whether the stage is idealised (no gear has teeth; see :func:`_idealised_gear`), with a note saying which
-    checks it skips; a stage of toothed and idealised gears is refused, naming the first idealised one."""
+    """Whether the stage is idealised (no gear has teeth; see :func:`_idealised_gear`); a stage of toothed and
+    idealised gears is refused, naming the first idealised one."""
     gears = [(planet_gears[n], q) for n, q in _planet_paths(planet_gears, path).items()] + \
         [(g, f"{path}.{key}") for key, (g, _, _) in centrals.items()]
     idealised = [p for g, p in gears if g.idealised]
@@ -725,9 +737,6 @@ def _check_idealised(st: dict, centrals: dict, planet_gears: dict, path: str, fa
         raise fail(f"{path}.module_mm", "an idealised stage (no teeth) has no module: remove it, or give teeth")
     if st["crank"] is not None or st["cycloid"] is not None:
         raise fail(f"{path}.crank", "an RV reducer's stage needs teeth (its pins and lobes are counted)")
-    warnings.warn(f"{path} ({st['name']}) is idealised (base radii, no teeth): the involute and assembly checks are "
-                  "skipped, its meshes have no mesh cycle (constant stiffness, no mesh frequency or phase), and "
-                  "the speeds follow from the base radii", TrainNote, stacklevel=2)
     return True
 
 

@@ -166,10 +166,10 @@ BAD = {
                 "stages[0].carrier_radius_mm: 88.4 mm, but the gears mesh at an operating centre distance of "
                 "97.7194 mm"),
     "stiffness": ([(r'model = "constant"', 'model = "rectangular"')],
-                  "stages[0].sun.mesh.stiffness.model: 'rectangular' needs tooth geometry; an idealised mesh "
+                  "stages[0].mesh.stiffness.model: 'rectangular' needs tooth geometry; an idealised mesh "
                   "(no teeth) needs constant"),
     "ste": ([(r"^stiffness = (.*)$", "stiffness = \\1\nste = [{ harmonic = 1, amplitude_um = 1.0 }]")],
-            "stages[0].sun.mesh.ste: an idealised mesh (no teeth) has no mesh cycle"),
+            "stages[0].mesh.ste: an idealised mesh (no teeth) has no mesh cycle"),
     "relief": ([(r"^base_radius_mm = 50.15$", "base_radius_mm = 50.15\ntip_relief = { amount_um = 5.0, "
                                               "length_mm = 1.0 }")],
                "stages[0].planet.tip_relief: an idealised gear (no teeth) has no tooth geometry"),

@@ -614,7 +614,7 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
     )
 
 
-TOOTH_FIELDS = ("module_mm", "addendum_coefficient", "dedendum_coefficient", "tip_relief")  # no idealised gear's
+TOOTH_FIELDS = ("module_mm", "addendum_coefficient", "dedendum_coefficient", "tip_relief")  # an idealised gear has none
 
 
 def _idealised_gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:
@@ -907,9 +907,12 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
     checked (a central gear's [mesh] over the stage's)."""
     name = st["name"]
     layers = [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]
+    idealised = any(gear.idealised for gear, _, _ in centrals.values())
     for layer, lpath in layers:
         if layer and layer["stiffness"] is not None:
             _check_stiffness(layer["stiffness"], f"{lpath}.stiffness", fail)
+        if layer and idealised:
+            _check_idealised_mesh(layer, lpath, fail)
     meshes = []
     for key, (gear, pg, raw) in centrals.items():
         mesh = _merge_mesh(st["mesh"], raw["mesh"])
@@ -920,10 +923,7 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
         if damping["ratio"] is not None and damping["coefficient"] is not None:
             raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")
         ste = tuple((s["harmonic"], s["amplitude"], s["phase"]) for s in mesh["ste"])
-        if gear.idealised:
-            _check_idealised_mesh(mesh, mpath, fail)
-            ste = ()
-        else:
+        if not gear.idealised:  # an idealised gear has no module to measure backlash by
             _check_small(mesh["backlash"] or 0.0, MAX_BACKLASH, gear.module, f"{mpath}.backlash_um", "backlash",
                          fail)
         if mesh["backlash"] and (gear.relief_amount or planet_gears[pg].relief_amount):
@@ -943,10 +943,10 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
 
 
 def _check_idealised_mesh(mesh: dict, path: str, fail) -> None:
-    """An idealised mesh (no teeth) needs a stiffness that needs no tooth geometry and has no transmission error
-    (harmonics of a mesh cycle it does not have)."""
-    model = MODELS[mesh["stiffness"]["model"]]
-    if model.needs_teeth:
+    """A [mesh] table of an idealised stage (no teeth): a stiffness model that needs no tooth geometry, and no
+    transmission error (harmonics of a mesh cycle it does not have)."""
+    model = MODELS[mesh["stiffness"]["model"]] if mesh["stiffness"] is not None else None
+    if model is not None and model.needs_teeth:
         toothless = ", ".join(name for name, m in MODELS.items() if not m.needs_teeth)
         raise fail(f"{path}.stiffness.model", f"{model.name!r} needs tooth geometry; an idealised mesh (no teeth) "
                                               f"needs {toothless}")

@@ -112,6 +112,31 @@ def test_speeds_follow_from_the_base_radii():
     assert all(w == 0.0 and math.copysign(1.0, w) == 1.0 for w in kinematics(spec).speeds.values())
 
 
+def test_compound_idealised_planets_turn_by_willis():
+    """A compound planet of base radii f (on the sun) and g (on the ring): ratio 1 + (r_ring r_f)/(r_g r_sun) for sun
+    in, ring held, carrier out (Willis), the ring's base radius closing r_sun + r_f = r_ring - r_g."""
+    text = lin_parker(edits=[(r"^base_radius_mm = 50.15$", "gears = { f = { base_radius_mm = 50.15 }, "
+                                                           "g = { base_radius_mm = 40.0 } }"),
+                             (r"^base_radius_mm = 139.0 .*$", "base_radius_mm = 128.85"),
+                             (r"^\[stages.sun\]$", "[stages.sun]\nplanet_gear = \"f\""),
+                             (r"^\[stages.ring\]$", "[stages.ring]\nplanet_gear = \"g\"")])
+    assert kinematics(load(text)).ratio == pytest.approx(1 + 128.85 * 50.15 / (40.0 * 38.7), rel=1e-12)
+
+
+def test_helical_idealised_stage_on_both_solvers():
+    """A helix on an idealised stage: the transverse pressure angle tan a_t = tan a_n / cos b sets the lines of
+    action, each member slides axially, and the two solvers agree mode for mode."""
+    text = lin_parker(edits=[(r"^pressure_angle_deg = 24.6$", "pressure_angle_deg = 24.6\nhelix_angle_deg = 10.0"),
+                             (r"radial_stiffness = 1.0e8", "radial_stiffness = 1.0e8, axial_stiffness = 1.0e8")])
+    spec = load(text)
+    alpha_t = math.atan(math.tan(math.radians(24.6)) / math.cos(math.radians(10.0)))
+    assert spec.stages[0].carrier_radius == pytest.approx((38.7 + 50.15) * 1e-3 / math.cos(alpha_t), rel=1e-12)
+    train = Train(spec)
+    lumped, mujoco = train.modes("lumped"), train.modes("mujoco")
+    assert len(lumped.frequencies) == 4 * (3 + 3)
+    assert np.allclose(mujoco.frequencies, lumped.frequencies, rtol=1e-9, atol=1e-6)
+
+
 def test_both_solvers_give_the_same_modes_and_shapes():
     """The MuJoCo twin of the idealised stage (plain cylinders, no teeth) against the lumped model: frequencies to
     round-off, and every mode shape paired (mass-weighted MAC)."""

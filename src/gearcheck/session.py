@@ -195,4 +195,5 @@ class Train:
         magnified ``magnify`` times, until the window closes (needs a display)."""
         from gearcheck.compare.presentation.live_view import live_view
 
+        require_mesh_cycle(self.spec, "the viewer's running twin")
         live_view(self.mujoco.model, slow_motion=slow_motion, magnify=magnify)

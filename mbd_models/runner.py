@@ -560,7 +560,7 @@ def _body_clock(mb: MbdModel):
         carrier = spec.stage_of(mesh.planet).carrier
         rel = kin.speeds[mesh.central] - kin.speeds[carrier]
         rows.append((mb.qadr[mesh.central][2], mb.qadr[carrier][2],
-                     math.copysign(1.0, rel) * mesh.central_gear.teeth / (2 * math.pi)))
+                     math.copysign(1.0, rel) * (mesh.central_gear.teeth or 0) / (2 * math.pi)))
     return tuple(np.array(x) for x in zip(*rows))
 
 

@@ -45,7 +45,9 @@ class MujocoSide(Side):
         return linearise.modes(self.model)
 
     def modes_at_speed(self, input_speed: float) -> ModalResult:
-        return linearise.modes_at_speed(self.model, input_speed)
+        turning = self.spec.operating.input_speed or not input_speed  # a twin at rest: one turning at that speed
+        model = self.model if turning else compile_train(self.spec.with_operating(input_speed=input_speed))
+        return linearise.modes_at_speed(model, input_speed)
 
     def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray, np.ndarray]:
         """(coordinate labels, mass matrix, the shapes of ``modal``) in the train's physical coordinates, mapped

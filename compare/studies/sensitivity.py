@@ -31,6 +31,7 @@ from gearcheck.lumped.fourier_response import (
     fourier_series_response,
     harmonic_balance_response,
 )
+from gearcheck.train.kinematics import require_mesh_cycle
 from gearcheck.train.loader import load_text, load_train
 from gearcheck.train.spec import ROTATION
 from gearcheck.lumped.response_sensitivity import (
@@ -113,6 +114,8 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=None, metho
     ``step``, the whole response with ``check_step``; ``grids`` go to
     :func:`~gearcheck.lumped.forced_response.parametric_problem`."""
     _check(method)
+    spec = load_text(text, source)
+    require_mesh_cycle(spec if speed is None else spec.with_operating(input_speed=1.0), "a response sensitivity")
     field = FitParameter.parse(parameter, "parameter")
     value = field.get(tomllib.loads(text))
     contacts: dict = {}

@@ -275,7 +275,8 @@ def cmd_show(args) -> int:
               f"{st['carrier_radius_m'] * 1e3:.6g} mm")
         for name, g in st["gears"].items():
             helix = f"  beta={g['helix_angle_deg']:+.6g} deg" if g["helix_angle_deg"] else ""
-            print(f"    {name:<16} z={g['teeth']:<4d} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
+            teeth = "—" if g["teeth"] is None else g["teeth"]  # an idealised gear's
+            print(f"    {name:<16} z={teeth:<4} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
                   f"r_base={g['base_radius_m'] * 1e3:.6g} mm  r_tip={g['tip_radius_m'] * 1e3:.6g} mm{helix}")
         if "cycloid" in st:
             c = st["cycloid"]
@@ -291,7 +292,8 @@ def cmd_show(args) -> int:
     print("  meshes:")
     for m in info["meshes"]:
         face = f"+{m['face_contact_ratio']:.4f}" if m["face_contact_ratio"] else ""
-        print(f"    {m['mesh']:<24} eps={m['contact_ratio']:.4f}{face}  "
+        eps = "—" if m["contact_ratio"] is None else f"{m['contact_ratio']:.4f}"  # an idealised mesh has none
+        print(f"    {m['mesh']:<24} eps={eps}{face}  "
               f"alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
               f"f_mesh={m['mesh_frequency_hz']:.6g} Hz  phase={m['phase_cycles']:.4f}  "
               f"k={m['mean_stiffness_n_per_m']:.4g} N/m ({m['stiffness_model']})  c={m['damping_n_s_per_m']:.4g} N·s/m")

@@ -35,6 +35,7 @@ class LumpedSide(Side):
     :func:`gearcheck.lumped.time_solver.simulate`)."""
 
     solver = "lumped"
+    kind = "reference lumped model"
     order = stepping.ORDER  # RK4, the drive set at every stage, contact events located
 
     def __init__(self, spec, method: str = "rk4"):
@@ -93,6 +94,8 @@ class LinearSide(Side):
     """A model given as matrices (:class:`~gearcheck.lumped.linear_model.LinearModel`: a user's, or a
     published one) for the train ``spec``; validated against the train's coordinates when built."""
 
+    kind = "user model"
+
     def __init__(self, model: LinearModel, spec, references: tuple[str, ...] = ()):
         self.spec = spec
         self.train = build_model(spec)  # the train's coordinates and kinematics, which the model maps into
@@ -138,6 +141,8 @@ class PublishedSide(LinearSide):
     """A 4-DOF model of Matejic et al. (2021) (``name`` one of
     :data:`gearcheck.train.published_parameters.MODELS`), from rest under the paper's excitation
     (``load``: with the output load on ring b), through the same door as any user's model."""
+
+    kind = "published model"
 
     def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1):
         self.model = four_dof_model(spec, name, planet_sets)

@@ -30,6 +30,7 @@ class MujocoSide(Side):
     :func:`gearcheck.mbd_models.runner.simulate_mujoco`)."""
 
     solver = "mujoco"
+    kind = "MuJoCo twin"
     order = stepping.ORDER  # RK4, the drive set at every stage, contact events located
     references = ("todorov-2012",)
 
@@ -85,6 +86,7 @@ class PublishedTwinSide(Side):
     A run needs its step: the 4-DOF models and their twin are compared on one time grid."""
 
     solver = "mujoco"
+    kind = "MuJoCo twin of a published model"
     references = ("todorov-2012", "matejic2021")
 
     def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1, y1: str | None = None,

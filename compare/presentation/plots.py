@@ -67,9 +67,9 @@ def _title(result, what: str) -> str:
     s = result.settings
     a, b = result.solver_names
     return (f"{result.spec.name} at {s['input_speed_rpm']:.6g} rpm: {what}\n"
-            f"{a} {s['lumped'].get('method', '')} dt={s['lumped'].get('dt_s', float('nan')):.3g} s, "
-            f"{b} {s['mujoco'].get('integrator', s['mujoco'].get('method', ''))} "
-            f"dt={s['mujoco'].get('dt_s', float('nan')):.3g} s")
+            f"{a} {s['reference'].get('method', '')} dt={s['reference'].get('dt_s', float('nan')):.3g} s, "
+            f"{b} {s['test'].get('integrator', s['test'].get('method', ''))} "
+            f"dt={s['test'].get('dt_s', float('nan')):.3g} s")
 
 
 def time_histories_figure(result, names=None, cycles: int = 4) -> Figure:

@@ -57,7 +57,7 @@ MAX_STEP = 2.0  # largest Gauss-Newton step in log factor
 BATCH = 256  # candidates scored together (memory)
 POWERS = (-2, -1, 1, 2)  # a coefficient or stiffness entry times r^p: u = r theta converted too often or not at all
 CONVENTION = 1e-4  # a fitted inertia factor this close (relative) to a convention's factor is named as that one
-PAIR_POOL = 12  # pairs are searched among this many best classes of exact single changes
+PAIR_POOL = 4  # pairs start from this many best exact single changes
 PAIR_MARGIN = 1e-2  # a pair is reported when it scores below this times the best single change
 
 
@@ -252,7 +252,7 @@ class _Base:
         members = model.spec.members
         self.member = [members[label.rsplit(".", 1)[0]] for label in self.labels]
         self.rotation = np.array([label.endswith(f".{ROTATION}") for label in self.labels])
-        self.radii = self._radii()
+        self.radii = self._radii(model, index)
         self.conventions = {}  # member -> {factor: what a fitted inertia factor equal to it means}
         for j in np.where(self.rotation)[0]:
             m = self.member[j]
@@ -271,18 +271,20 @@ class _Base:
         lam = np.linalg.eigvalsh(self.Kt)
         self.rigid = int(np.sum(lam <= RIGID_TOLERANCE * np.max(np.abs(lam))))
 
-    def _radii(self) -> dict[int, list[float]]:
+    def _radii(self, model: LumpedModel, index: dict[str, int]) -> dict[int, list[float]]:
         """The radii r of u = r theta per rotation coordinate: its coefficients' sizes (other than 1) in the rows
-        that join it to other coordinates (a gear's base radius in its meshes, the carrier's pin circle in the
-        planet bearings)."""
+        that join it to other coordinates, held ones included (a gear's base radius in its meshes, the carrier's
+        pin circle in the planet bearings)."""
         radii: dict[int, list[float]] = {}
-        for *_, a in self.rows:
+        for a in [r.a for r in model.rows if r.stiffness] + list(model.mesh_rows):
             nonzero = np.abs(a) > COEFFICIENT_FLOOR * np.max(np.abs(a))
             if np.sum(nonzero) < 2:
                 continue
-            for j in np.where(nonzero & self.rotation)[0]:
-                r = abs(float(a[j]))
-                known = radii.setdefault(int(j), [])
+            for j, label in enumerate(self.labels):
+                if not (self.rotation[j] and nonzero[index[label]]):
+                    continue
+                r = abs(float(a[index[label]]))
+                known = radii.setdefault(j, [])
                 if not math.isclose(r, 1.0, rel_tol=1e-9) and not any(math.isclose(r, x, rel_tol=1e-9)
                                                                      for x in known):
                     known.append(r)
@@ -643,18 +645,24 @@ def _at_speed(base: _Base, trial: _Trial, evidence: np.ndarray) -> None:
     trial.candidate.score += trial.candidate.parts["speed"]
 
 
-def _best_pair(base: _Base, scorer: _Scorer, ranked: list[list[_Trial]],
+def _best_pair(base: _Base, scorer: _Scorer, trials: list[_Trial], partial: np.ndarray,
                speed: np.ndarray | None) -> tuple[_Trial | None, int]:
-    """The best pair of exact changes among the heads of the :data:`PAIR_POOL` best classes, scored exactly (a
-    fitted factor, fitted alone, would be wrong in a pair), and how many pairs were scored."""
-    pool = [t for c in ranked for t in c[:1] if not t.fitted and t.candidate.kind not in ("no mistake",
-                                                                                        "held coordinates")]
+    """The best pair of exact changes (a fitted factor, fitted alone, would be wrong in a pair): each of the
+    :data:`PAIR_POOL` best exact changes at rest (one per set of equal frequencies) with every other exact change,
+    scored exactly, at speed for the :data:`PAIR_POOL` best at rest; and how many pairs were scored."""
+    exact = [i for i in np.argsort(partial, kind="stable")
+             if not trials[i].fitted and trials[i].candidate.kind not in ("no mistake", "held coordinates")]
+    first: list[_Trial] = []
+    for i in exact:
+        if len(first) == PAIR_POOL:
+            break
+        if not any(np.allclose(trials[i].rest, t.rest, rtol=EQUIVALENCE, atol=0.0) for t in first):
+            first.append(trials[i])
     pairs = [_Trial(Candidate(f"two changes: {a.candidate.term}; and {b.candidate.term}", "pair",
                               pair=[replace(a.candidate, equivalents=[]), replace(b.candidate, equivalents=[])]),
                     a.outer + b.outer, gyroscopic=a.gyroscopic and b.gyroscopic,
                     frame=a.frame if a.frame is not None else b.frame)
-             for n, a in enumerate(pool[:PAIR_POOL]) for b in pool[n + 1:PAIR_POOL]
-             if a.frame is None or b.frame is None]
+             for a in first for b in (trials[i] for i in exact) if b is not a and (a.frame is None or b.frame is None)]
     if not pairs:
         return None, 0
     changed = [base.changed(t) for t in pairs]
@@ -663,9 +671,11 @@ def _best_pair(base: _Base, scorer: _Scorer, ranked: list[list[_Trial]],
         t.rest = fi
         t.candidate.parts = {"rest": float(r)} | ({"shapes": float(sh)} if scorer.E is not None else {})
         t.candidate.score = float(r + sh)
-        if speed is not None:
+    pairs = sorted(pairs, key=lambda t: t.candidate.score)[:PAIR_POOL]
+    if speed is not None:
+        for t in pairs:
             _at_speed(base, t, speed)
-    return min(pairs, key=lambda t: t.candidate.score), len(pairs)
+    return min(pairs, key=lambda t: t.candidate.score), len(changed)
 
 
 def constrained(model: LumpedModel, coordinates: list[str], T: np.ndarray) -> LumpedModel:
@@ -722,7 +732,7 @@ def diagnose(model: LumpedModel, evidence: Evidence, top: int = 3) -> Diagnosis:
                   for c in ranked[:top]]  # what looks like the reference is a change this evidence cannot see
     tried = len(trials)
     if candidates[0].score > AGREEMENT:
-        pair, scored = _best_pair(base, scorer, ranked, speed_evidence)
+        pair, scored = _best_pair(base, scorer, trials, partial, speed_evidence)
         tried += scored
         if pair is not None and pair.candidate.score < PAIR_MARGIN * candidates[0].score:
             candidates = [pair.candidate] + candidates[:top - 1]

@@ -73,13 +73,15 @@ class Stage:
 @dataclass
 class Formulation:
     """Matrices over ``labels`` (gearcheck's names): M, K at rest, G and the centripetal stiffness Kc at the
-    carrier's speed; ``rows``: named deflections (name, k, a) where the formulation has them."""
+    carrier's speed; ``planets``: the planets' share of K (the papers' sums over the planets); ``rows``: named
+    deflections (name, k, a) where the formulation has them."""
 
     labels: list[str]
     M: np.ndarray
     K: np.ndarray
     G: np.ndarray
     Kc: np.ndarray
+    planets: np.ndarray
     rows: list[tuple[str, float, np.ndarray]] = field(default_factory=list)
 
     def index(self, label: str) -> int:
@@ -147,9 +149,10 @@ def translational_torsional(stage: Stage, rigid_turn: bool = True) -> Formulatio
         for name, _, s_t in rows:
             if name.endswith("bearing_tangential"):
                 Kc += stage.mass["planet"] * W**2 * (np.outer(uc, uc) + np.outer(uc, s_t) + np.outer(s_t, uc))
+    rows = [(name, kr, v * D) for name, kr, v in rows]
     K = sum(kr * np.outer(v, v) for _, kr, v in rows)
-    return Formulation(labels, D * M * D[:, None], D * K * D[:, None], D * G * D[:, None], D * Kc * D[:, None],
-                       [(name, kr, v * D) for name, kr, v in rows])
+    P = sum(kr * np.outer(v, v) for name, kr, v in rows if name.startswith("planet"))
+    return Formulation(labels, D * M * D[:, None], K, D * G * D[:, None], D * Kc * D[:, None], P, rows)
 
 
 def torsional(stage: Stage) -> Formulation:
@@ -167,5 +170,6 @@ def torsional(stage: Stage) -> Formulation:
         K[p, p] = 2.0 * k * rp**2
         K[0, p] = K[p, 0] = k * rs * rp
         K[1, p] = K[p, 1] = -k * rr * rp
+    P = K - np.diag([stage.k_shaft, stage.k_ring_torsion] + [0.0] * (n - 2))  # all but the shaft and support
     zero = np.zeros((n, n))
-    return Formulation(_labels(N, False), M, K, zero, zero)
+    return Formulation(_labels(N, False), M, K, zero, zero, P)

@@ -22,7 +22,7 @@ from typing import Callable
 import numpy as np
 
 import gearcheck
-from gearcheck.compare.engine.diagnosis import Diagnosis, Evidence, diagnose
+from gearcheck.compare.engine.diagnosis import Candidate, Diagnosis, Evidence, diagnose
 from gearcheck.compare.studies.textbook_planetary import Formulation, Stage, torsional, translational_torsional
 from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.shared.modal import RIGID_TOLERANCE, generalized_modes, speed_modal_result
@@ -301,6 +301,18 @@ def run(case: Case) -> Outcome:
                 and (said is None or any(line.startswith(f"Rigid-body modes {said}") for line in diagnosis.lines())))
     margin = diagnosis.candidates[1].score - best.score if len(diagnosis.candidates) > 1 else math.inf
     return Outcome(case, diagnosis, _effect(case, speed) and not diagnosis.agrees, hit, margin, rigid, reported)
+
+
+def agreement(train: str, shaft: bool = True) -> dict[str, Candidate]:
+    """The unbroken formulations diagnosed against the reference: the reference's own candidate (held where the
+    formulation lacks coordinates), whose score parts are the frequency errors at rest and at speed and the mean
+    1 - MAC of the shapes."""
+    stage = Stage.preset(train, shaft)
+    out = {}
+    for name, f, speed in (("translational-torsional", translational_torsional(stage), True),
+                           ("torsional", torsional(stage), False)):
+        out[name] = diagnose(reference(train, shaft), evidence(f, speed)).best
+    return out
 
 
 def table(outcomes: list[Outcome]) -> list[str]:

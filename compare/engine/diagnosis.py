@@ -8,12 +8,30 @@ scored against what is known of the suspect model (:class:`Evidence`):
 * a deflection row (a bearing, support, coupling or shaft row; a mesh's line-of-action row, named by its
   mesh id) with one coefficient dropped ("dropped coupling") or its sign flipped ("sign error");
 * a row's stiffness times a fitted factor ("stiffness");
+* a spring the train lacks, fitted: from a coordinate to ground, or between two members' coordinates of the same
+  kind (x and x, theta and theta, radial and radial: n(n-1)/2 pairs at most, fewer where the kinds differ), not
+  where a row already is that spring ("extra spring"; a spring to ground removes a rigid-body mode);
+* a row's rotation coefficient, or a stiffness entry with a rotation coordinate, times r^p (p = +-1, +-2, r the
+  member's radius as its rows give it: a gear's base radius, the carrier's pin circle): u = r theta turns
+  K_theta = D K_u D, D = diag(r) on the rotations, so a slip of convention scales exactly those entries, e.g.
+  N r_c k written where N r_c^2 k belongs ("radius power");
+* a stage's central stiffness entry with the planets' share (Lin & Parker 1999's sums over the planets) written
+  for n' = 1, ..., N + 1 planets, n' != N ("planet count", e.g. K_cc = 3 k_p for N = 4);
 * a member's mass on its two transverse translations, its rotational inertia or its axial mass times a
-  fitted factor ("inertia": the member's entries of M);
-* the Coriolis matrix dropped ("gyroscopic") or the centripetal stiffness dropped ("centripetal"), seen only
-  in the frequencies at speed, where the degenerate pairs split (Cooley & Parker 2012);
+  fitted factor ("inertia": the member's entries of M), named as a convention when the factor is one: cos^2
+  alpha or its inverse (I = m r^2 with the pitch radius for the base radius), r^+-2 (u = r theta);
+* the Coriolis matrix dropped ("gyroscopic"), the centripetal stiffness dropped ("centripetal") or written as
+  Lin & Parker's (1999) softening -m Omega^2 alone, without the rigid-turn correction of
+  :mod:`gearcheck.lumped.assembly` ("rigid-turn correction"), seen only in the frequencies at speed, where the
+  degenerate pairs split (Cooley & Parker 2012);
 * when the evidence lacks coordinates: the reference with them held ("held coordinates"); then every other
-  candidate is a one-term change of that held reference.
+  candidate is a one-term change of that held reference;
+* when no single change explains the evidence: pairs of exact changes ("pair"), each of the few best singles with
+  every other exact change, reported first only when a pair scores below :data:`PAIR_MARGIN` times the best
+  single.
+
+The evidence's zero-frequency modes are counted against the reference's: rigid-body modes lost or gained are
+said first.
 
 The score of a candidate is the rms relative frequency error at rest (modes compared in sorted order, each
 error |f - f_e| / max(f, f_e), so a rigid mode that should not be one counts 1), plus the mean of 1 - the
@@ -27,7 +45,8 @@ Fitted factors are fitted to the at-rest frequencies, on log factor within :data
 grid, then Gauss-Newton steps with the eigenvalue derivatives (Fox & Kapoor 1968).  Every candidate's modes at
 rest are solved in batches (the reference's K and M are whitened once by the Cholesky factor of M); the
 gyroscopic eigenproblem at speed is solved only for the candidates whose at-rest score could still place
-them among the best (branch and bound: the at-speed part of a score is never negative).
+them among the best (branch and bound: the at-speed part of a score is never negative).  An exact change heads
+a class of look-alikes before a fitted one (a fitted spring to ground matches an entry's exact change).
 """
 
 from __future__ import annotations

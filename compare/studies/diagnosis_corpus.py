@@ -21,15 +21,18 @@ from typing import Callable
 
 import numpy as np
 
-import gearcheck
 from gearcheck.compare.engine.diagnosis import Candidate, Diagnosis, Evidence, diagnose
 from gearcheck.compare.studies.textbook_planetary import Formulation, Stage, torsional, translational_torsional
 from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.shared.modal import RIGID_TOLERANCE, generalized_modes, speed_modal_result
+from gearcheck.train.loader import load_text, preset_text
+from gearcheck.train.variants import edited_text
 
+SIX_PLANETS = [(r"^planets = 3", "planets = 6"), (r"^teeth = 22", "teeth = 30"), (r"^teeth = 20", "teeth = 24"),
+               (r"^teeth = 62 .*$", "teeth = 78"), (r'^name = "demo-3p"', 'name = "six-planet"')]  # 108 / 6 = 18
 CLASSES = ("dropped coupling", "sign error", "stiffness", "inertia", "inertia convention", "extra spring",
            "radius power", "planet count", "rigid-turn correction", "gyroscopic", "pair")
-TRAINS = ("demo-3p", "demo-4p")
+TRAINS = ("demo-3p", "demo-4p", "six-planet")  # six-planet: demo-3p with 6 planets, z = 30/24/78
 MATCH = 1e-3  # a fitted factor or stiffness within this (relative) of the one broken in is the right one
 SAME_MODES = 1e-8  # relative residual of the broken modes in the unbroken eigenproblem: no effect below it
 
@@ -61,9 +64,19 @@ class Outcome:
 
 
 @cache
+def text(train: str) -> str:
+    """A train's file: a preset's, or six-planet's (demo-3p edited)."""
+    return edited_text("demo-3p", SIX_PLANETS) if train == "six-planet" else preset_text(train)
+
+
+def stage(train: str, shaft: bool = True) -> Stage:
+    return Stage.parse(text(train), shaft)
+
+
+@cache
 def reference(train: str, shaft: bool = True) -> LumpedModel:
-    """gearcheck's reference of a preset; without ``shaft`` its input shaft row removed (torque-driven)."""
-    model = build_model(gearcheck.load(train))
+    """gearcheck's reference of a train; without ``shaft`` its input shaft row removed (torque-driven)."""
+    model = build_model(load_text(text(train), train))
     return model if shaft else replace(model, rows=[r for r in model.rows if r.name != "input_shaft"])
 
 
@@ -120,12 +133,12 @@ def cases(trains: tuple[str, ...] = TRAINS) -> list[Case]:
     out = []
     for train in trains:
         for shaft in (True, False):
-            stage = Stage.preset(train, shaft)
-            N, rs, rp, rc = stage.planets, stage.base["sun"], stage.base["planet"], stage.pin_circle
+            given = stage(train, shaft)
+            N, rs, rp, rc = given.planets, given.base["sun"], given.base["planet"], given.pin_circle
             other = N - 1 if N > 3 else N + 1  # a planet count the train does not have
-            cos2 = math.cos(stage.alpha) ** 2
-            lp, tor = translational_torsional(stage), torsional(stage)
-            textbook = translational_torsional(stage, rigid_turn=False)
+            cos2 = math.cos(given.alpha) ** 2
+            lp, tor = translational_torsional(given), torsional(given)
+            textbook = translational_torsional(given, rigid_turn=False)
 
             def drop(row, label):
                 return (lambda f: _rows(f, row, lambda a, j: np.where(np.arange(len(a)) == j, 0.0, a), label),
@@ -307,10 +320,9 @@ def agreement(train: str, shaft: bool = True) -> dict[str, Candidate]:
     """The unbroken formulations diagnosed against the reference: the reference's own candidate (held where the
     formulation lacks coordinates), whose score parts are the frequency errors at rest and at speed and the mean
     1 - MAC of the shapes."""
-    stage = Stage.preset(train, shaft)
-    out = {}
-    for name, f, speed in (("translational-torsional", translational_torsional(stage), True),
-                           ("torsional", torsional(stage), False)):
+    given, out = stage(train, shaft), {}
+    for name, f, speed in (("translational-torsional", translational_torsional(given), True),
+                           ("torsional", torsional(given), False)):
         out[name] = diagnose(reference(train, shaft), evidence(f, speed)).best
     return out
 

@@ -51,7 +51,13 @@ class Stage:
     @classmethod
     def preset(cls, name: str, shaft: bool = True) -> Stage:
         """The stage of a preset; without ``shaft`` the input is free (a torque-driven train: one rigid mode)."""
-        raw = tomllib.loads((importlib.resources.files("gearcheck.train.presets") / f"{name}.toml").read_text())
+        return cls.parse((importlib.resources.files("gearcheck.train.presets") / f"{name}.toml").read_text(), shaft)
+
+    @classmethod
+    def parse(cls, text: str, shaft: bool = True) -> Stage:
+        """The stage of a train file's text (one stage, sun in, ring held, carrier out)."""
+        raw = tomllib.loads(text)
+        name = raw["train"]["name"]
         stage, op = raw["stages"][0], raw["operating"]
         module, alpha = stage["module_mm"] * 1e-3, math.radians(stage["pressure_angle_deg"])
         teeth = {g: stage[g]["teeth"] for g in ("sun", "ring", "planet")}

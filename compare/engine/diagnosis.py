@@ -317,9 +317,9 @@ class _Base:
         full += list(zip(model.excitation.mean_stiffness, model.mesh_rows))
         for stage in dict.fromkeys(m.stage for m in model.spec.members.values()):
             planets = {m.id for m in model.spec.members.values() if m.stage == stage and m.is_planet}
-            columns = [index[label] for label in every if label.rsplit(".", 1)[0] in planets]
             if len(planets) < 2:
                 continue
+            columns = [index[label] for label in every if label.rsplit(".", 1)[0] in planets]
             P = sum((k * np.outer(a, a) for k, a in full if np.any(a[columns])), np.zeros((len(every),) * 2))
             central = [i for i, m in enumerate(self.member) if m.stage == stage and m.id not in planets]
             out.append((len(planets), P[np.ix_(self.keep, self.keep)], central))

@@ -76,7 +76,7 @@ MAX_STEP = 2.0  # largest Gauss-Newton step in log factor
 BATCH = 256  # candidates scored together (memory)
 POWERS = (-2, -1, 1, 2)  # a coefficient or stiffness entry times r^p: u = r theta converted too often or not at all
 CONVENTION = 1e-4  # a fitted inertia factor this close (relative) to a convention's factor is named as that one
-PAIR_POOL = 4  # pairs start from this many best exact single changes
+PAIR_POOL = 6  # pairs start from this many best exact single changes (a row on each of 6 planets)
 PAIR_MARGIN = 1e-2  # a pair is reported when it scores below this times the best single change
 
 
@@ -667,16 +667,12 @@ def _at_speed(base: _Base, trial: _Trial, evidence: np.ndarray) -> None:
 def _best_pair(base: _Base, scorer: _Scorer, trials: list[_Trial], partial: np.ndarray,
                speed: np.ndarray | None) -> tuple[_Trial | None, int]:
     """The best pair of exact changes (a fitted factor, fitted alone, would be wrong in a pair): each of the
-    :data:`PAIR_POOL` best exact changes at rest (one per set of equal frequencies) with every other exact change,
-    scored exactly, at speed for the :data:`PAIR_POOL` best at rest; and how many pairs were scored."""
+    :data:`PAIR_POOL` best exact changes at rest (a planet's row and its look-alikes on the other planets among
+    them, which frequencies alone cannot tell apart while the pair can) with every other exact change, scored
+    exactly, at speed for the :data:`PAIR_POOL` best at rest; and how many pairs were scored."""
     exact = [i for i in np.argsort(partial, kind="stable")
              if not trials[i].fitted and trials[i].candidate.kind not in ("no mistake", "held coordinates")]
-    first: list[_Trial] = []
-    for i in exact:
-        if len(first) == PAIR_POOL:
-            break
-        if not any(np.allclose(trials[i].rest, t.rest, rtol=EQUIVALENCE, atol=0.0) for t in first):
-            first.append(trials[i])
+    first = [trials[i] for i in exact[:PAIR_POOL]]
     pairs = [_Trial(Candidate(f"two changes: {a.candidate.term}; and {b.candidate.term}", "pair",
                               pair=[replace(a.candidate, equivalents=[]), replace(b.candidate, equivalents=[])]),
                     a.outer + b.outer, gyroscopic=a.gyroscopic and b.gyroscopic,

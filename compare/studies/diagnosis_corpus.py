@@ -71,6 +71,7 @@ def text(train: str) -> str:
 
 
 def stage(train: str, shaft: bool = True) -> Stage:
+    """A train's stage as the independent formulations read it."""
     return Stage.parse(text(train), shaft)
 
 
@@ -82,7 +83,8 @@ def reference(train: str, shaft: bool = True) -> LumpedModel:
 
 
 def _rows(f: Formulation, name: str, change: Callable[[np.ndarray, int], np.ndarray], label: str) -> Formulation:
-    """A formulation with row ``name``'s coefficient of ``label`` changed (K rebuilt from the rows)."""
+    """A formulation with row ``name``'s coefficient of ``label`` changed (K rebuilt from the rows: a pair changes
+    rows before entries)."""
     j = f.index(label)
     rows = [(n, k, change(a.copy(), j) if n == name else a) for n, k, a in f.rows]
     return replace(f, K=sum(k * np.outer(a, a) for _, k, a in rows), rows=rows)
@@ -121,6 +123,7 @@ def _mass(f: Formulation, labels: list[str], factor: float) -> Formulation:
 
 
 def _mesh(row: str) -> str:
+    """gearcheck's name of a formulation's row (a mesh by its mesh id)."""
     return row if row == "input_shaft" else f"stage1.{row}"
 
 

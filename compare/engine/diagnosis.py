@@ -159,6 +159,7 @@ class Diagnosis:
     tried: int  # one-term changes scored
     reduced_to: int | None = None  # coordinates of the reduced reference it was compared with, if reduced
     rigid_modes: dict[str, int] = field(default_factory=dict)  # zero frequencies: evidence's and reference's
+    pairs: int = 0  # pairs of changes scored (when no one-term change explains the evidence)
 
     @property
     def best(self) -> Candidate:
@@ -203,7 +204,8 @@ class Diagnosis:
             seen.append(f"{self.evidence['shapes']} mode shapes")
         if self.evidence["speed"]:
             seen.append(f"{self.evidence['speed']} frequencies at speed")
-        out.append(f"Evidence: {', '.join(seen)}; {self.tried} one-term changes tried.")
+        pairs = f" and {self.pairs} pairs" if self.pairs else ""
+        out.append(f"Evidence: {', '.join(seen)}; {self.tried} one-term changes{pairs} tried.")
         if not self.evidence["speed"]:
             out.append("Gyroscopic and centripetal terms are not checked: they need frequencies at speed.")
         return out
@@ -215,7 +217,7 @@ class Diagnosis:
         return {"train": self.train, "agrees": self.agrees, "reduced_to": self.reduced_to,
                 "reference_score": self.reference_score,
                 "held": list(self.held), "evidence": dict(self.evidence), "tried": self.tried,
-                "rigid_modes": dict(self.rigid_modes),
+                "rigid_modes": dict(self.rigid_modes), "pairs": self.pairs,
                 "candidates": [c.to_dict() for c in self.candidates]}
 
 
@@ -745,17 +747,16 @@ def diagnose(model: LumpedModel, evidence: Evidence, top: int = 3) -> Diagnosis:
         ranked.sort(key=lambda c: c[0] is not reference)
     candidates = [replace(c[0].candidate, equivalents=[] if c[0] is reference else [t.candidate for t in c[1:]])
                   for c in ranked[:top]]  # what looks like the reference is a change this evidence cannot see
-    tried = len(trials)
+    pairs = 0
     if candidates[0].score > AGREEMENT:
-        pair, scored = _best_pair(base, scorer, trials, partial, speed_evidence)
-        tried += scored
+        pair, pairs = _best_pair(base, scorer, trials, partial, speed_evidence)
         if pair is not None and pair.candidate.score < PAIR_MARGIN * candidates[0].score:
             candidates = [pair.candidate] + candidates[:top - 1]
     counts = {"rest": scorer.m, "shapes": 0 if scorer.E is None else scorer.m,
               "speed": 0 if speed_evidence is None else len(speed_evidence)}
     rigid = int(np.sum(scorer.f**2 <= RIGID_TOLERANCE * np.max(scorer.f) ** 2))
     return Diagnosis(model.spec.name, candidates, None if base.held else reference.candidate.score, base.held,
-                     counts, tried, rigid_modes={"evidence": rigid, "reference": base.rigid})
+                     counts, len(trials), rigid_modes={"evidence": rigid, "reference": base.rigid}, pairs=pairs)
 
 
 def diagnose_side(model: LumpedModel, side, modal=None, top: int = 3) -> Diagnosis:

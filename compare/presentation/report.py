@@ -610,7 +610,8 @@ def _diagnosis_schema() -> dict:
         "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
         "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
         "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"}),
-        "rigid_modes": _object({k: {"type": "integer"} for k in ("evidence", "reference")})}),
+        "rigid_modes": _object({k: {"type": "integer"} for k in ("evidence", "reference")}),
+        "pairs": {"type": "integer"}}),
         {"type": "null"}], "description": "a user's model: the term of the reference that best explains "
                                           "its modes; null otherwise"}
 

@@ -713,7 +713,8 @@ def constrained(model: LumpedModel, coordinates: list[str], T: np.ndarray) -> Lu
 
 def diagnose(model: LumpedModel, evidence: Evidence, top: int = 3) -> Diagnosis:
     """Rank one-term changes of the reference ``model`` by how well they explain ``evidence``: the ``top``
-    classes of look-alike candidates, best first (the reference first when it agrees)."""
+    classes of look-alike candidates, best first (the reference first when it agrees; a pair of exact changes
+    first when no one change explains the evidence and the pair scores below :data:`PAIR_MARGIN` times the best)."""
     base = _Base(model, list(evidence.labels))
     scorer = _Scorer(base, evidence)
     speed_evidence = evidence.frequencies_at_speed

@@ -614,7 +614,9 @@ def _diagnosis_schema() -> dict:
         "train": STRING, "agrees": BOOLEAN, "reduced_to": {"type": ["integer", "null"]},
         "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
         "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
-        "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"})}),
+        "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"}),
+        "rigid_modes": _object({k: {"type": "integer"} for k in ("evidence", "reference")}),
+        "pairs": {"type": "integer"}}),
         {"type": "null"}], "description": "a user's model: the term of the reference that best explains "
                                           "its modes; null otherwise"}
 
@@ -658,6 +660,6 @@ def _candidate_schema() -> dict:
     return _object({
         "term": STRING, "kind": {"enum": list(KINDS)}, "score": NUMBER,
         "parts": {"type": "object", "additionalProperties": NUMBER}, "row": STRING, "coordinate": STRING,
-        "member": STRING, "factor": NUMBER, "coordinates": _array(STRING),
-        "equivalents": _array({"$ref": "#/$defs/candidate"}),
-    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference")
+        "member": STRING, "factor": NUMBER, "stiffness": NUMBER, "coordinates": _array(STRING),
+        "equivalents": _array({"$ref": "#/$defs/candidate"}), "pair": _array({"$ref": "#/$defs/candidate"}),
+    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference (or a pair)")

@@ -139,3 +139,9 @@ def test_sensitivity_against_a_parameters_values(tmp_path, capsys):
     assert "does not depend on it" in capsys.readouterr().out
     assert pd.read_csv(tmp_path / "null" / "sensitivity_values.csv")["negligible"].all()
     assert not written["negligible"].all()
+    # every value is a valid train before anything is computed: 2.8 mm undercuts the RV reducer's discs
+    assert main(["sensitivity", "rv-reducer", "--parameter", "stages[0].crank.eccentricity_mm", "--values", "1.0",
+                 "2.8", "--out", str(tmp_path / "undercut")]) == 2
+    err = capsys.readouterr().err
+    assert "eccentricity_mm = 2.8 is no valid train" in err and "undercut" in err and err.count("\n") == 1
+    assert not (tmp_path / "undercut").exists()

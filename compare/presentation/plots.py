@@ -581,12 +581,13 @@ def _pin_force_against_angle(bx, loads) -> None:
 
 def sensitivity_values(frame, coordinate: str, title: str) -> bytes:
     """PNG of a :func:`~gearcheck.compare.studies.sensitivity.sensitivity_map` table over one parameter's values:
-    the amplitude of the first mesh harmonics of ``coordinate`` and their sensitivity d|Q|/dp against the value, a
+    the amplitude of the three largest harmonics of ``coordinate`` and their sensitivity d|Q|/dp against the value, a
     line style per speed (as Yang, Chen & Wang 2018 draw their Figs. 6, 8, 10), round-off drawn as zero (and said
     in the title when every derivative is); a logarithmic value axis when the values are positive and span a decade
     or more."""
     parameter = frame["parameter"].iloc[0]
-    harmonics = [h for h in dict.fromkeys(frame["harmonic"]) if h.endswith(", 0)") or "," not in h.strip("(,)")][:3]
+    largest = frame.groupby("harmonic", sort=False)["amplitude"].max().sort_values(ascending=False, kind="stable")
+    harmonics = list(largest.index[:3])  # the three largest: a translation answers the eccentrics, not the mesh
     speeds = list(dict.fromkeys(frame["speed_rpm"]))
     fig, axes = _figure(2, 1, figsize=(8, 5.5), sharex=True, squeeze=False, layout="constrained")
     styles = ["-", "--", ":", "-."]

@@ -215,8 +215,8 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
     rotating-frame terms); over values each value has its own.  ``grids`` default to :data:`MAP_GRIDS`.  A pandas
     DataFrame, one row per speed, parameter, value and harmonic (:data:`HARMONIC_NOTATION`), amplitudes and their
     derivatives in ``amplitude_unit`` (:func:`coordinate_unit`), ``d_amplitude_d_p`` per unit of the number;
-    ``negligible`` where d|Q_h|/d ln p or |Q_h| itself is round-off, below :data:`NULL` of the point's largest
-    harmonic (a harmonic the planets' phasing cancels; a
+    ``negligible`` where d|Q_h|/d ln p or |Q_h| itself is round-off, below :data:`NULL` of the largest harmonic of
+    any coordinate of its kind (rotations or translations) at that point (a harmonic the planets' phasing cancels; a
     response that does not depend on the number: an RV reducer's in-phase planets never load the sun's
     translations, so nothing depends on its support or its mass)."""
     import pandas as pd
@@ -234,6 +234,13 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v == 0:
                 raise GearcheckError(f"values: {v!r} is no value of {fields[0].path} to differentiate at (a finite, "
                                      "non-zero number in the file's unit)")
+        for v in values:  # every value a valid train before anything is computed
+            edited = tomllib.loads(text)
+            fields[0].set(edited, float(v))
+            try:
+                load_text(tomli_w.dumps(edited), source)
+            except GearcheckError as error:
+                raise GearcheckError(f"values: {fields[0].path} = {v:g} is no valid train: {error}") from None
         points = [(rpm, fields[0], [(fields[0], float(v))]) for rpm in speeds_rpm for v in values]
     contacts: dict = {}
     rows = []
@@ -246,6 +253,7 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
             raise GearcheckError(f"coordinate={coordinate!r}: not a coordinate of {model.spec.name}"
                                  + did_you_mean(coordinate, labels, n=3, cutoff=0))
         index = labels.index(coordinate)
+        alike = [i for i, label in enumerate(labels) if coordinate_unit(label) == coordinate_unit(coordinate)]
         base = parametric_problem(model, contacts=contacts, **grids)
         orders = lattice(base, orders)
         f_mesh = float(model.excitation.frequency.min())
@@ -253,7 +261,7 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
             h = STEP * value
             plus, minus = (_problem(text, source, field, value + s, rpm, contacts, grids) for s in (h, -h))
             full, truncated = _closed_form(base, _derivative(base, plus, minus, h), orders, method)
-            level = NULL * float(np.abs(full.response.amplitudes[:, index]).max())  # round-off of d|Q|/d ln p
+            level = NULL * float(np.abs(full.response.amplitudes[:, alike]).max())  # round-off of its kind
             for j, hk in enumerate(full.response.harmonics):
                 rows.append({"speed_rpm": float(rpm), "mesh_frequency_hz": f_mesh, "parameter": field.path,
                              "value": value, "harmonic": str(tuple(int(x) for x in hk)),

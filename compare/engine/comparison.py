@@ -229,6 +229,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     if modes_b is not None:  # a reduced model's modes against the reference reduced alike
         modal_reference, modes_a, reduction = reduced_reference(reference, test, (modes_a, modes_b))
     modal_rows = [] if modes_b is None else _modal_rows(spec, modal_reference, test, modes_a, modes_b)
+    if reduction and test.driven:
+        reduction = f"{reduction[:-1]}; its time histories are compared with the full reference's."
     told = [*test.notes] + ([reduction] if reduction else [])  # what was done to the test and the reference
     modal_tolerance = tolerances.lookup("modes", "frequency", "rel_error")
     assert modal_tolerance is not None  # the defaults hold it, and a tolerances file only overrides them

@@ -108,6 +108,9 @@ class AdoptedSide(Side):
                 value = getattr(side, name)
                 setattr(self, name, self._guarded(name, value) if callable(value) else value)
         self.references = tuple(self.references)
+        if isinstance(self.notes, str) or not all(isinstance(x, str) for x in self.notes):
+            raise GearcheckError(f"model={given}: its notes {shown(self.notes)} are not a list of sentences")
+        self.notes = tuple(self.notes)
         if isinstance(self.order, bool) or self.order not in (1, 2, 3, 4, 5, 6, 7, 8):
             raise GearcheckError(f"model={given}: its order {shown(self.order)} is no order of convergence (1-8)")
 

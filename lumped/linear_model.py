@@ -205,9 +205,10 @@ class LinearModel:
 
     @property
     def extra(self) -> list[str]:
-        """The coordinates that map to no train coordinate (a motor, a coupling, a generator)."""
+        """The coordinates that map to no train coordinate (a motor, a coupling, a generator) in a model that maps
+        some; none in a model that maps none (one compared by its own signals, as the published 4-DOF models)."""
         used = {c for combination in self.physical_map().values() for c in combination}
-        return [c for c in self.coordinates if c not in used]
+        return [c for c in self.coordinates if c not in used] if used else []
 
     def frame_terms(self, input_speed: float) -> tuple[np.ndarray, np.ndarray]:
         """(G, K_omega) with the train's input at ``input_speed`` (rad/s): G_per_speed Omega and

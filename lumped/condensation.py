@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
+from gearcheck.lumped.linear_model import LinearModel, Periodic
 
 MOVING = ("C", "G", "K_omega", "G_per_speed", "K_omega_per_speed2")  # terms that would make the condensation inexact
 
@@ -56,7 +56,7 @@ def condense_massless(model: LinearModel) -> LinearModel:
                    K_omega=reduce("K_omega"), G_per_speed=reduce("G_per_speed"),
                    K_omega_per_speed2=reduce("K_omega_per_speed2"),
                    F=None if model.F is None else T.T @ model.matrix("F"), stiffness=stiffness, forcing=forcing,
-                   meshes=[Mesh(x.id, np.asarray(x.row, dtype=float)[m], x.stiffness, x.damping) for x in model.meshes],
+                   meshes=[replace(x, row=np.asarray(x.row, dtype=float)[m]) for x in model.meshes],
                    physical=physical, descriptions={c: d for c, d in model.descriptions.items() if c in coordinates},
                    notes=[*model.notes, note])
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -82,6 +83,18 @@ class Periodic:
         phase = 2.0 * math.pi * np.multiply.outer(t, np.asarray(self.orders)) / self.period
         return self.mean_value + np.tensordot(np.cos(phase), self.cos, 1) + np.tensordot(np.sin(phase), self.sin, 1)
 
+    def rate(self) -> "Periodic":
+        """The time derivative: exact for a series; of samples, their central differences (second order),
+        linearly interpolated."""
+        if self.samples is None:
+            w = (2.0 * math.pi * np.asarray(self.orders, dtype=float) / self.period).reshape(
+                (-1,) + (1,) * (np.ndim(self.cos) - 1))
+            return Periodic(self.period, mean_value=np.zeros_like(self.mean_value), orders=self.orders,
+                            cos=w * self.sin, sin=-w * self.cos)
+        n = len(self.samples)
+        return Periodic(self.period, samples=(np.roll(self.samples, -1, 0) - np.roll(self.samples, 1, 0)) * n
+                        / (2.0 * self.period))
+
     def over_period(self, points: int = 64) -> np.ndarray:
         """Values over one period: the samples themselves, or the series at ``points`` phases."""
         if self.samples is not None:
@@ -92,13 +105,26 @@ class Periodic:
 @dataclass(frozen=True)
 class Mesh:
     """A mesh of the model: deflection ``row`` . q along the line of action (m), stiffness k(t) (N/m, a
-    :class:`Periodic` of scalars or a constant) and damping (N s/m).  ``id`` is the train's mesh id
-    (``stage1.planet1.sun``): the model then reports that mesh's force and transmission error."""
+    :class:`Periodic` of scalars or a constant), damping (N s/m) and static transmission error e(t) (m, a
+    :class:`Periodic` of scalars, or None): the mesh's force is k (row . q - e) + c (row . q' - e').  ``id`` is
+    the train's mesh id (``stage1.planet1.sun``): the model then reports that mesh's force and transmission
+    error."""
 
     id: str
     row: np.ndarray
     stiffness: Periodic | float
     damping: float = 0.0
+    error: Periodic | None = None
+
+    def transmission_error(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(e, e') at time ``t`` (s) or at each of an array of times: zero when the mesh has none."""
+        if self.error is None:
+            return np.zeros(np.shape(t)), np.zeros(np.shape(t))
+        return self.error(t), self._error_rate(t)
+
+    @cached_property
+    def _error_rate(self) -> Periodic:
+        return self.error.rate()
 
     def k(self, t) -> np.ndarray:
         """The stiffness at time ``t`` (s), or at each of an array of times."""
@@ -353,6 +379,11 @@ class LinearModel:
             values = np.asarray(mesh.stiffness.over_period(), dtype=float)
             if not (mesh.stiffness.period > 0 and np.all(np.isfinite(values))):
                 raise self._error(f"{where}.stiffness", f"{mesh.id}: needs a positive period and finite values")
+        if mesh.error is not None and not (isinstance(mesh.error, Periodic) and mesh.error.period > 0
+                                           and np.all(np.isfinite(mesh.error.over_period()))
+                                           and np.shape(mesh.error.over_period())[1:] == ()):
+            raise self._error(f"{where}.error", f"{mesh.id}: needs a Periodic of finite scalars (m) with a positive "
+                              "period")
         if not mesh.k_mean > 0 or mesh.damping < 0 or not math.isfinite(mesh.damping):
             raise self._error(f"{where}", f"{mesh.id}: mean stiffness {mesh.k_mean:.4g} N/m must be > 0 and damping "
                               f"{mesh.damping:.4g} N s/m >= 0")

@@ -104,10 +104,13 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
     A = model.mesh_rows
     t = np.arange(steps + 1) * dt
     stage_t = t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt  # where every fixed-step solver samples its drive
-    k_mesh = np.moveaxis(np.reshape([m.k(stage_t) for m in model.meshes], (len(model.meshes), *stage_t.shape)), 0, -1)
+    errors = [m.transmission_error(stage_t) for m in model.meshes]
+    k_mesh = _along_last([m.k(stage_t) for m in model.meshes], stage_t.shape)
+    e_mesh = _along_last([e for e, _ in errors], stage_t.shape)
+    c_de = _along_last([m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
 
-    def acceleration(ti, s, q, v, k):
-        stiffness_force = (model.K_at(ti) + K_omega) @ q + A.T @ (k * (A @ q))
+    def acceleration(ti, s, q, v, k, e, damping_rate):
+        stiffness_force = (model.K_at(ti) + K_omega) @ q + A.T @ (k * (A @ q - e) - damping_rate)
         return M_inv @ (model.F_at(ti) - D @ v - stiffness_force)
 
     q0, v = _start(model)
@@ -117,10 +120,11 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
     for i in range(steps + 1):
         if i % every == 0:
             j = i // every
-            Q[j], V[j], Qdd[j] = q, v, acceleration(t[i], 0, q, v, k_mesh[i, 0])
+            Q[j], V[j], Qdd[j] = q, v, acceleration(t[i], 0, q, v, k_mesh[i, 0], e_mesh[i, 0], c_de[i, 0])
         if i == steps:
             break
-        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(stage_t[i, s], s, q_, v_, k_mesh[i, s]), q, v, dt)
+        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(stage_t[i, s], s, q_, v_, k_mesh[i, s], e_mesh[i, s],
+                                                            c_de[i, s]), q, v, dt)
         if i % CHUNK == 0:
             if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
                 raise DivergenceError(float(t[i + 1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
@@ -134,6 +138,11 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
     info = RunInfo("linear-rk4", steps, 4, 4 * steps, wall,
                    {"method": f"{model.name}, rk4", "dt_s": dt, "steps": steps, "wall_time_s": wall})
     return linear_result(model, train, t[::every], Q, V, Qdd, q0, info)
+
+
+def _along_last(values: list, shape: tuple) -> np.ndarray:
+    """Per-mesh arrays over the times of ``shape``, stacked with the meshes along the last axis."""
+    return np.moveaxis(np.reshape(values, (len(values), *shape)), 0, -1)
 
 
 def _start(model) -> tuple[np.ndarray, np.ndarray]:
@@ -187,8 +196,9 @@ def _train_signals(model, train, t, q, v, qdd, q0):
     for m in model.meshes:
         row = np.asarray(m.row, dtype=float)
         k = m.k(t)
+        e, de = m.transmission_error(t)
         delta = q @ row
-        force = k * delta + m.damping * (v @ row)
+        force = k * (delta - e) + m.damping * (v @ row - de)
         static_force = m.k_mean * float(row @ q0)
         static[f"{m.id}.force"] = static_force
         signals += [by_name[f"{m.id}.{x}"] for x in ("force", "dte", "kv", "stiffness")]

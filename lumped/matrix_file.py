@@ -30,6 +30,10 @@ mesh_rows              m x n                   each mesh's deflection row
 mesh_stiffness         m, or m x N             N/m: constant, or samples over the period
 mesh_period            m (optional)            s, each mesh's own cycle (default: period)
 mesh_damping           m (optional)            N s/m
+mesh_interpolation     string (optional)       between the stiffness samples: "linear" (default) or "hold"
+                                               (each sample held over its cell: a stiffness with jumps)
+mesh_error             m x N (optional)        m, each mesh's static transmission error over the period:
+                                               its force is k (row . q - e) + c (row . q' - e')
 physical_labels        k strings               train coordinates the model has ...
 physical               k x n                   ... as combinations of its coordinates; a coordinate
                                                in no combination is extra (a motor, a coupling):
@@ -51,14 +55,15 @@ from pathlib import Path
 
 import numpy as np
 
-from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
+from gearcheck.lumped.linear_model import INTERPOLATIONS, LinearModel, Mesh, Periodic
 from gearcheck.shared.errors import TrainFileError, shown
 from gearcheck.train.files import read_arrays
 
 SUFFIXES = (".mat", ".npz")
 KNOWN = {"coordinates", "M", "K", "C", "G", "K_omega", "G_per_speed", "K_omega_per_speed2", "speed_of", "F", "period",
          "K_samples", "K_cos", "K_sin", "orders", "F_samples", "mesh_ids", "mesh_rows", "mesh_stiffness", "mesh_period",
-         "mesh_damping", "physical_labels", "physical", "name", "start", "reduction", "units"}
+         "mesh_damping", "mesh_interpolation", "mesh_error", "physical_labels", "physical", "name", "start",
+         "reduction", "units"}
 
 
 def read_matrix_file(path) -> LinearModel:
@@ -78,7 +83,8 @@ def read_matrix_file(path) -> LinearModel:
         raise TrainFileError(source, "units", f"{shown(units)}: give every matrix in SI units (kg, m, rad, N, s)")
     coordinates = get.strings("coordinates", required=True)
     n = len(coordinates)
-    period = get.scalar("period") if any(k in data for k in ("K_samples", "K_cos", "K_sin", "F_samples")) or (
+    period = get.scalar("period") if any(k in data for k in ("K_samples", "K_cos", "K_sin", "F_samples",
+                                                             "mesh_error")) or (
         "mesh_stiffness" in data and np.ndim(data["mesh_stiffness"]) == 2 and "mesh_period" not in data) else None
     stiffness = None
     if "K_samples" in data:
@@ -169,7 +175,7 @@ class _Reader:
 def _meshes(get: _Reader, source: str, n: int, period: float | None) -> list[Mesh]:
     ids = get.strings("mesh_ids")
     if not ids:
-        for name in ("mesh_rows", "mesh_stiffness", "mesh_damping"):
+        for name in ("mesh_rows", "mesh_stiffness", "mesh_damping", "mesh_error"):
             if name in get.data:
                 raise TrainFileError(source, name, "given without mesh_ids")
         return []
@@ -193,5 +199,17 @@ def _meshes(get: _Reader, source: str, n: int, period: float | None) -> list[Mes
     if k.shape[1] > 1 and not np.all(periods > 0):
         raise TrainFileError(source, "mesh_period", f"{periods.tolist()}: sampled mesh stiffness needs positive "
                              "periods (s)")
-    return [Mesh(i, rows[j], Periodic(float(periods[j]), samples=k[j]) if k.shape[1] > 1 else float(k[j, 0]),
-                 float(c[j])) for j, i in enumerate(ids)]
+    interpolation = get.string("mesh_interpolation", INTERPOLATIONS[0])
+    if interpolation not in INTERPOLATIONS:
+        raise TrainFileError(source, "mesh_interpolation", f"{shown(interpolation)}: choose "
+                             f"{' or '.join(INTERPOLATIONS)}")
+    errors = [None] * m
+    if "mesh_error" in get.data:
+        e = get.array("mesh_error")
+        if e.size % m or e.size < 2 * m:
+            raise TrainFileError(source, "mesh_error", f"shape {np.shape(get.data['mesh_error'])}, expected ({m}, N): "
+                                 "each mesh's samples over the period")
+        errors = [Periodic(period, samples=row) for row in e.reshape(m, -1)]
+    return [Mesh(i, rows[j], Periodic(float(periods[j]), samples=k[j], interpolation=interpolation)
+                 if k.shape[1] > 1 else float(k[j, 0]),
+                 float(c[j]), errors[j]) for j, i in enumerate(ids)]

@@ -33,10 +33,12 @@ def site(tmp_path_factory):
 
 def test_the_site_has_every_part_the_users_need(site):
     pages = {p.relative_to(site).as_posix() for p in site.rglob("*.html")}
-    for page in ("index.html", "getting-started.html", "train-file.html", "api.html", "physics.html",
+    for page in ("index.html", "getting-started.html", "model-file.html", "train-file.html", "api.html", "physics.html",
                  "rv-reducer/README.html", "helical-planetary/audit.html", "ci/README.html", "developer.html",
                  "teaching/notebooks/campbell.html", "teaching/notebooks/mesh_phasing.html"):
         assert page in pages, page
+    model_file = (site / "model-file.html").read_text(encoding="utf-8")  # the layout, variable by variable
+    assert all(name in model_file for name in ("mesh_error", "F_samples", "physical_labels", "-v7"))
     train_file = (site / "train-file.html").read_text(encoding="utf-8")
     assert "Your first train file" in train_file and "train.held" in train_file
     api = (site / "api.html").read_text(encoding="utf-8")

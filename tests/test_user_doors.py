@@ -71,7 +71,7 @@ def ring_eliminated(stiff=1.0, how="held", gyroscopic=False) -> LinearModel:
 
 def ring_eliminated_driven() -> LinearModel:
     """The reference (meshes, damping, forcing, G, K_omega) with the ring's rows and columns deleted."""
-    model, keep = _sampled(REF), np.ix_(KEEP, KEEP)
+    model, keep = REF, np.ix_(KEEP, KEEP)
     return LinearModel("ring-meshes", [model.coordinates[i] for i in KEEP], model.M[keep], model.K[keep],
                        C=model.C[keep], G=model.G[keep], K_omega=model.K_omega[keep], F=model.F[KEEP],
                        meshes=[replace(m, row=m.row[KEEP]) for m in model.meshes])
@@ -118,13 +118,6 @@ def _motor(model: LinearModel) -> LinearModel:
                        physical={c: {c: 1.0} for c in model.coordinates})
 
 
-def _sampled(model: LinearModel) -> LinearModel:
-    """``model`` with its meshes' stiffness samples interpolated linearly, as a matrix file gives them (the file
-    has no variable for held samples), so that every door carries the same model."""
-    return replace(model, meshes=[replace(m, stiffness=replace(m.stiffness, interpolation="linear"))
-                                  for m in model.meshes])
-
-
 W0 = SPEC.operating.input_speed
 PER_SPEED = {"G_per_speed": REF.G / W0, "K_omega_per_speed2": REF.K_omega / W0**2}
 
@@ -136,8 +129,8 @@ CONTENTS = {
     "G, K_omega per unit speed": (lambda: _mk(**PER_SPEED), PASS, None),
     "G at speed and per unit speed": (lambda: _mk(G=REF.G, G_per_speed=REF.G / W0), INVALID,
                                       "G_per_speed: given with G"),
-    "meshes, damping, forcing": (lambda: _sampled(REF), PASS, None),
-    "meshes, G, K_omega per unit speed": (lambda: _sampled(replace(REF, G=None, K_omega=None, **PER_SPEED)), PASS,
+    "meshes, damping, forcing": (lambda: REF, PASS, None),
+    "meshes, G, K_omega per unit speed": (lambda: replace(REF, G=None, K_omega=None, **PER_SPEED), PASS,
                                           None),
     "ring eliminated (held)": (lambda: ring_eliminated(), PASS, None),
     "ring condensed": (lambda: ring_eliminated(how="condensed"), PASS, None),
@@ -166,7 +159,8 @@ def variables(model: LinearModel, matlab: bool) -> dict:
         out |= {"mesh_ids": strings([m.id for m in model.meshes]), "mesh_rows": model.mesh_rows,
                 "mesh_stiffness": np.array([m.stiffness.samples for m in model.meshes]),
                 "mesh_period": np.array([m.stiffness.period for m in model.meshes]),
-                "mesh_damping": np.array([m.damping for m in model.meshes])}
+                "mesh_damping": np.array([m.damping for m in model.meshes]),
+                "mesh_interpolation": model.meshes[0].stiffness.interpolation}
     if model.physical is not None:
         labels = list(model.physical)
         out |= {"physical_labels": strings(labels),

@@ -18,12 +18,15 @@ import gearcheck
 from gearcheck.cli import main
 from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.mode_pairing import pair_modes
+from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
-from gearcheck.lumped.linear_model import LinearModel
+from gearcheck.lumped.linear_model import LinearModel, Periodic
 from gearcheck.lumped.matrix_file import read_matrix_file
 from gearcheck.lumped.side import LinearSide, LumpedSide
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.settings import RunSettings
+from gearcheck.train.periods import common_period
+from gearcheck.train.variants import edited, edited_text
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 TORSIONAL = f"{EXAMPLES / 'torsional_user_model.py'}:torsional_model"
@@ -62,11 +65,48 @@ def test_exported_reference_passes_the_crosscheck(tmp_path):
     assert set(report["volatile"]["cpu_time"]) == {"lumped_modes_s", "test_modes_s", "lumped_run_s", "lumped_check_s",
                                                    "test_run_s", "test_check_s"}  # the user's model is no "mujoco"
     assert 'class="fail"' not in (tmp_path / "report" / "report.html").read_text()
-    # the lines whose relative error exceeds their tolerance (the held samples move a jump by up to 1/4096 of a
+    # the lines whose relative error exceeds their tolerance (the held samples move a jump by up to 1/SAMPLES of a
     # mesh period, which the phasing of the sun's lines does not forgive) carry under a tenth of it
     beyond = [(s, q) for q in report["quantities"] for s in q["spectrum"] if s["status"] == "pass" and s["rel_error"]
               and q["tolerance_nrmse"] and abs(s["rel_error"]["value"]) > q["tolerance_nrmse"]["value"]]
     assert beyond and all(s["nrmse_part"]["value"] < 0.1 * q["tolerance_nrmse"]["value"] for s, q in beyond)
+
+
+EXCITED = [(r"^damping = \{ ratio = 0.05 \}",
+            "damping = { ratio = 0.05 }\nste = [{ harmonic = 1, amplitude_um = 4.0 }]"),
+           (r"^input_shaft_damping = .*", "input_shaft_damping = 2.0\n[[operating.ripple]]\nmember = \"output\"\n"
+                                          "order = 3.0\namplitude = 0.05")]
+
+
+def test_exported_reference_with_transmission_error_and_ripple(tmp_path, capsys):
+    """Transmission error and torque ripple travel in the file: each mesh's error (``mesh_error``) and the
+    torques' forcing (``F_samples``) sampled over the drive's common period (62 mesh periods: the ripple at 3x
+    the carrier speed is 3/62 of the mesh frequency), exact at the samples; read back, the model passes against
+    the reference with its mesh forces measured from the error (without it, the forces differ by k e: measured
+    NRMSE 0.5).  A drive that never repeats (a load ramp) cannot be written: one line, exit 2, nothing written."""
+    spec = edited("demo-3p", EXCITED, "excited")
+    path = tmp_path / "excited.mat"
+    model = reference_linear_model(spec)
+    write_matrix_file(model, path)
+    data = scipy.io.loadmat(path, squeeze_me=True)
+    exc = build_model(spec).excitation
+    period = common_period(exc)
+    assert data["period"] == pytest.approx(period, rel=1e-15) and period * exc.frequency[0] == pytest.approx(62)
+    times = np.arange(data["mesh_error"].shape[1]) * period / data["mesh_error"].shape[1]
+    np.testing.assert_allclose(data["mesh_error"].T, exc.transmission_error(times)[0], rtol=0, atol=1e-18)
+    np.testing.assert_allclose(data["F_samples"].T, [model.forcing(t) for t in times], rtol=1e-15, atol=1e-9)
+    result = gearcheck.crosscheck(spec, model=str(path), duration=0.05)
+    assert result.verdict == "PASS", result.failures
+    forces = [q.metrics["nrmse"] for q in result.quantities if q.name.endswith(".force") and q.status == "pass"]
+    assert len(forces) == 6 and max(forces) < 0.01
+    train = tmp_path / "ramped.toml"
+    train.write_text(edited_text("demo-3p", [*EXCITED, (r"^output_torque = 1500.0", "output_torque = 1500.0\n"
+                                                                                    "ramp_s = 0.01")]))
+    assert main(["export", str(train), "-o", str(tmp_path / "ramped.mat")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "transmission error" in err and "the load ramp over the first 0.01 s never repeats" in err, err
+    assert "\n" not in err
+    assert not (tmp_path / "ramped.mat").exists()
 
 
 def test_torsional_model_is_the_reference_with_rigid_translations():
@@ -309,3 +349,21 @@ def test_a_model_of_mass_and_stiffness_only_gets_a_modal_verdict(tmp_path, capsy
         assert any("nothing that drives it" in note for note in data["notes"])
         assert {m["status"] for m in data["modes"]} == ({"pass"} if status == 0 else {"fail"})
         assert (out / "natural_frequencies.png").exists() and not (out / "time_histories.png").exists()
+
+
+def test_periodic_rate_is_the_derivative():
+    """A series differentiates exactly; N samples by central differences, whose relative error on a harmonic
+    of order o is 1 - sin(x)/x with x = 2 pi o / N (second order)."""
+    period, N = 0.01, 128
+    series = Periodic(period, mean_value=np.array(2.0), orders=np.array([1.0, 3.0]), cos=np.array([0.5, 0.0]),
+                      sin=np.array([0.0, 0.25]))
+    t = np.linspace(0.0, period, 7)
+    w = 2 * np.pi / period
+    exact = -0.5 * w * np.sin(w * t) + 0.75 * w * np.cos(3 * w * t)
+    np.testing.assert_allclose(series.rate()(t), exact, rtol=1e-14, atol=1e-12 * w)
+    sampled = Periodic(period, samples=series(np.arange(N) * period / N)).rate()
+    at = np.arange(N) * period / N
+    x = 2 * np.pi * np.array([1.0, 3.0]) / N
+    expected = (-0.5 * w * np.sin(w * at) * np.sin(x[0]) / x[0]
+                + 0.75 * w * np.cos(3 * w * at) * np.sin(x[1]) / x[1])
+    np.testing.assert_allclose(sampled(at), expected, rtol=0, atol=1e-12 * w)

@@ -135,6 +135,8 @@ CONTENTS = {
     "ring eliminated (held)": (lambda: ring_eliminated(), PASS, None),
     "ring condensed": (lambda: ring_eliminated(how="condensed"), PASS, None),
     "ring eliminated, 10 % stiff": (lambda: ring_eliminated(1.1), FAIL, None),
+    "reduction misspelt": (lambda: replace(ring_eliminated(), reduction="fixed"), INVALID,
+                           "reduction: 'fixed': choose held or condensed"),
     # its modes are the held reference's, but its forced response is not the train's, whose ring is supported
     "ring eliminated, meshes": (lambda: ring_eliminated_driven(), FAIL, None),
     "extra coordinate (motor)": (lambda: _motor(_mk()), PASS, None),

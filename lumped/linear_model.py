@@ -321,6 +321,9 @@ class LinearModel:
             if member not in spec.members:
                 raise self._error("speed_of", f"{self.speed_of!r}: 'input' or a member of {spec.name} "
                                   f"({', '.join(spec.members)})")
+            if not self.operating_speed:
+                raise self._error("speed_of", f"{self.speed_of!r}: {spec.name} does not turn (input speed 0), so no "
+                                  "ratio of speeds: give the per-unit-speed forms per rad/s of the input")
             self.speed_ratio = kinematics(spec).speeds[member] / self.operating_speed
 
     def _error(self, field_name: str, message: str) -> TrainFileError:

@@ -87,7 +87,10 @@ class LumpedModel:
     def at_speed(self, input_speed: float) -> "LumpedModel":
         """The rotating-frame terms at another input speed (rad/s; 0 allowed): Coriolis and circulatory
         terms scale with the speed, centripetal ones with its square; nothing else depends on it.  For
-        modal analysis (the excitation and the static loads stay those of the train's own speed)."""
+        modal analysis (the excitation and the static loads stay those of the train's own speed).  A train at
+        rest has no such terms to scale: they are built at ``input_speed``."""
+        if not self.spec.operating.input_speed:
+            return build_model(self.spec.with_operating(input_speed=input_speed)) if input_speed else self
         r = input_speed / self.spec.operating.input_speed
         return replace(self, G=r * self.G, K_centripetal=r * r * self.K_centripetal,
                        K_circulatory=r * self.K_circulatory)

@@ -47,7 +47,8 @@ def describe(spec) -> dict:
     for j, mesh in enumerate(spec.meshes):
         g = mesh.geometry
         out["meshes"].append({
-            "mesh": mesh.id, "contact_ratio": g.contact_ratio, "face_contact_ratio": g.face_contact_ratio,
+            "mesh": mesh.id, "contact_ratio": None if mesh.central_gear.idealised else g.contact_ratio,
+            "face_contact_ratio": g.face_contact_ratio,
             "base_helix_angle_deg": math.degrees(g.base_helix_angle), "operating_pressure_angle_deg":
                 math.degrees(g.pressure_angle), "mesh_frequency_hz": kin.mesh_frequency[mesh.id],
             "phase_cycles": kin.mesh_phase[mesh.id], "loaded_flank": kin.flanks[mesh.id],

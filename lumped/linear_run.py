@@ -29,6 +29,7 @@ from gearcheck.shared.results import TimeResult, coordinate_signals, train_signa
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
+from gearcheck.train.spec import AXIAL
 
 CHUNK = 2000  # steps between progress reports
 EXTRA_DOMINATED = 0.5  # a mode with more of its kinetic energy in the extra coordinates is theirs, not the train's
@@ -192,6 +193,9 @@ def _train_signals(model, train, t, q, v, qdd, q0):
         if has[th]:
             signals.append(by_name[f"{mid}.alpha"])
             columns.append(acc[:, j, 2])
+        if train.spec.members[mid].axial and has[f"{mid}.{AXIAL}"]:
+            signals.append(by_name[f"{mid}.az"])
+            columns.append(acc[:, j, 3])
     static = {}
     for m in model.meshes:
         row = np.asarray(m.row, dtype=float)

@@ -11,14 +11,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from gearcheck.train.spec import AXIAL
+
 
 def member_motion(spec, kin, dofs, t, q, v, qdd, rotating_frame_terms: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """(acc, angle): acc (n_t, n_members, 3) the inertial acceleration of each member's centre along its
-    carrier's axes and its angular acceleration, angle (n_t, n_members) the angle of those axes (world =
-    R(angle) carrier), from q, q', q'' (n_t, n) over the coordinates ``dofs``
+    """(acc, angle): acc (n_t, n_members, 4) the inertial acceleration of each member's centre along its carrier's axes,
+    its angular acceleration and its acceleration along the stage axis (0 for a member that does not slide: the
+    axis is the frame's axis of rotation, so no frame term enters it), angle (n_t, n_members) the angle of those
+    axes (world = R(angle) carrier), from q, q', q'' (n_t, n) over the coordinates ``dofs``
     (:class:`~gearcheck.lumped.assembly.DofMap`); ``kin`` the train's kinematics."""
     members = list(spec.members)
-    acc = np.empty((t.size, len(members), 3))
+    acc = np.zeros((t.size, len(members), 4))
     angle = np.empty((t.size, len(members)))
     for j, mid in enumerate(members):
         member = spec.members[mid]
@@ -28,6 +31,8 @@ def member_motion(spec, kin, dofs, t, q, v, qdd, rotating_frame_terms: bool = Tr
         acc[:, j, 0] = qdd[:, iu] - 2 * omega * v[:, iv] - omega**2 * (q[:, iu] + member.radius)
         acc[:, j, 1] = qdd[:, iv] + 2 * omega * v[:, iu] - omega**2 * q[:, iv]
         acc[:, j, 2] = qdd[:, ith]
+        if member.axial:
+            acc[:, j, 3] = qdd[:, dofs(mid, AXIAL)]
         angle[:, j] = kin.speeds[carrier] * t + member.angle + q[:, dofs(carrier, "theta")]
         if member.eccentric:  # its nominal orbit e(phi) at the crank's absolute speed w_H
             ecc = member.eccentric

@@ -37,6 +37,7 @@ class LumpedSide(Side):
     :func:`gearcheck.lumped.time_solver.simulate`)."""
 
     solver = "lumped"
+    kind = "reference lumped model"
     order = stepping.ORDER  # RK4, the drive set at every stage, contact events located
 
     def __init__(self, spec, method: str = "rk4"):
@@ -97,6 +98,8 @@ class LinearSide(Side):
     coordinates condensed out (:func:`~gearcheck.lumped.condensation.condense_massless`).  Its modes are the
     train's: those its extra coordinates dominate are set aside (:func:`~gearcheck.lumped.linear_run.set_aside`)
     and named in its notes."""
+
+    kind = "user model"
 
     def __init__(self, model: LinearModel, spec, references: tuple[str, ...] = ()):
         self.spec = spec
@@ -160,6 +163,8 @@ class PublishedSide(LinearSide):
     """A 4-DOF model of Matejic et al. (2021) (``name`` one of
     :data:`gearcheck.train.published_parameters.MODELS`), from rest under the paper's excitation
     (``load``: with the output load on ring b), through the same door as any user's model."""
+
+    kind = "published model"
 
     def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1):
         self.model = four_dof_model(spec, name, planet_sets)

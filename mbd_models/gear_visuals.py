@@ -38,6 +38,22 @@ HELIX_SLICES = 4  # extrusion slices of a helical gear
 RIM = 2.0  # ring rim outside the root circle, in modules
 UNIT = 1e-6  # vertex coordinates are written in integer micrometres (mesh scale)
 DISC_POINTS = 8  # profile points per lobe of a cycloid disc
+IDEALISED_POINTS = 96  # points on the drawn circle of an idealised gear (no teeth)
+IDEALISED_WIDTH = 0.02  # m: how wide an idealised gear that gives no face width is drawn
+IDEALISED_MODULE = 0.02  # of its pitch radius: the size of an idealised gear's rim and marker
+
+
+def face_width(gear: Gear) -> float:
+    """The width the gear is drawn with: its face width, or ``IDEALISED_WIDTH`` for an idealised gear without."""
+    return gear.face_width or IDEALISED_WIDTH
+
+
+def module(gear: Gear, normal: bool = False) -> float:
+    """What rims and markers are sized by: the gear's (normal) module, or ``IDEALISED_MODULE`` of an idealised
+    gear's pitch radius."""
+    if gear.idealised:
+        return IDEALISED_MODULE * gear.pitch_radius
+    return gear.normal_module if normal else gear.module
 
 
 def relief(gear: Gear, r: np.ndarray) -> np.ndarray:
@@ -83,7 +99,11 @@ def tooth_outline(gear: Gear, flank_points: int = FLANK_POINTS) -> tuple[np.ndar
 
 
 def section(gear: Gear, flank_points: int = FLANK_POINTS) -> tuple[np.ndarray, np.ndarray]:
-    """The whole transverse boundary of the teeth (r, phi), tooth k centred on 2 pi k / z, phi increasing."""
+    """The whole transverse boundary of the teeth (r, phi), tooth k centred on 2 pi k / z, phi increasing; an
+    idealised gear's pitch circle in ``IDEALISED_POINTS`` points."""
+    if gear.idealised:
+        phi = np.arange(IDEALISED_POINTS) * 2 * math.pi / IDEALISED_POINTS
+        return np.full(IDEALISED_POINTS, gear.pitch_radius), phi
     r, phi = tooth_outline(gear, flank_points)
     pitch = 2 * math.pi / gear.teeth
     return np.tile(r, gear.teeth), np.concatenate([phi + k * pitch for k in range(gear.teeth)])
@@ -110,11 +130,13 @@ def gear_mesh(gear: Gear, flank_points: int = FLANK_POINTS) -> tuple[np.ndarray,
     r, phi = section(gear, flank_points)
     n = len(r)
     slices = HELIX_SLICES if gear.helix_angle else 1
-    zs = np.linspace(-0.5 * gear.face_width, 0.5 * gear.face_width, slices + 1)
+    width = face_width(gear)
+    zs = np.linspace(-0.5 * width, 0.5 * width, slices + 1)
     twist = zs * math.tan(gear.helix_angle) / gear.pitch_radius
+    teeth = gear.teeth or IDEALISED_POINTS  # an idealised ring's rim: a point beside each of its circle's
     if gear.internal:
-        outer_phi = np.arange(gear.teeth) * 2 * math.pi / gear.teeth  # tooth centres
-        rings = [(r, phi), (np.full(len(outer_phi), gear.root_radius + RIM * gear.normal_module), outer_phi)]
+        outer_phi = np.arange(teeth) * 2 * math.pi / teeth  # tooth centres
+        rings = [(r, phi), (np.full(len(outer_phi), gear.root_radius + RIM * module(gear, normal=True)), outer_phi)]
     else:
         rings = [(r, phi)]
     per_slice = sum(len(x) for x, _ in rings)
@@ -134,7 +156,7 @@ def gear_mesh(gear: Gear, flank_points: int = FLANK_POINTS) -> tuple[np.ndarray,
     top = slices * per_slice
     if gear.internal:
         wall(n, len(rings[1][0]), True)
-        for a, b, c in _ring_cap(gear.teeth, n // gear.teeth):  # top (+z) and bottom (-z) caps
+        for a, b, c in _ring_cap(teeth, n // teeth):  # top (+z) and bottom (-z) caps
             faces += [(top + a, top + b, top + c), (a, c, b)]
     else:  # fans to a centre vertex on each end
         centre = len(zs) * per_slice
@@ -163,6 +185,10 @@ def phases(spec: TrainSpec) -> dict[tuple[str, str], float]:
             c, p = key(mesh.central, mesh.central_gear), key(mesh.planet, mesh.planet_gear)
             placed[c] = 0.0
         todo.remove(mesh)
+        if mesh.central_gear.idealised:  # no teeth to mesh: every gear at its own angle 0
+            placed.setdefault(c, 0.0)
+            placed.setdefault(p, 0.0)
+            continue
         psi = spec.members[mesh.planet].angle
         zc, zp = mesh.central_gear.teeth, mesh.planet_gear.teeth
         internal = mesh.internal

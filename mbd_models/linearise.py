@@ -237,7 +237,7 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
     """The undamped modes of the twin turning with its input at ``input_speed`` (rad/s, 0 allowed), every
     mesh at its mean stiffness (solver "mujoco"; see the module doc)."""
     m = mb.model
-    ratio = input_speed / mb.spec.operating.input_speed
+    ratio = input_speed / mb.spec.operating.input_speed if mb.spec.operating.input_speed else 0.0  # at rest: 0
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.tendon_damping.copy(), m.dof_damping.copy(),
              m.actuator_gainprm.copy(), m.actuator_biasprm.copy(), m.wrap_prm.copy())
     try:

@@ -83,7 +83,8 @@ def _geoms(spec: TrainSpec, member, phase: dict, z: dict, meshes: dict) -> list[
     if member.kind == "carrier":
         stage = spec.stage_of(member.id)
         zc, h, tip = plate(spec, stage, z)
-        module = max((g.module for p in stage.planets for g in spec.members[p].gears.values()), default=0.005)
+        module = max((gear_visuals.module(g) for p in stage.planets for g in spec.members[p].gears.values()),
+                     default=0.005)
         radius = min([stage.carrier_radius + tip] + [ELEMENTS[p.element].bore(p, stage) for p in spec.parts])
         size, at = vec(radius, h), (0.5 * stage.carrier_radius, zc + h)
         return [f'<geom name="{member.label}_visual" type="cylinder" size="{size}" pos="{vec(0, 0, zc)}" '
@@ -94,8 +95,9 @@ def _geoms(spec: TrainSpec, member, phase: dict, z: dict, meshes: dict) -> list[
         lines.append(f'<geom name="{member.label}_{name}_visual" type="mesh" mesh="{meshes[gear]}" '
                      f'pos="{vec(0, 0, z[key])}" euler="{vec(0, 0, phase[key])}" rgba="{rgba}" {VISUAL}/>')
     name, gear = next(iter(member.gears.items()))
-    r = gear.tip_radius + gear.module if gear.internal else 0.5 * gear.root_radius
-    return lines + [marker(member, r, z[member.id, name] + 0.5 * gear.face_width, 0.8 * gear.module)]
+    size = gear_visuals.module(gear)
+    r = gear.tip_radius + size if gear.internal else 0.5 * gear.root_radius
+    return lines + [marker(member, r, z[member.id, name] + 0.5 * gear_visuals.face_width(gear), 0.8 * size)]
 
 
 def mesh_names(spec: TrainSpec) -> dict:
@@ -114,7 +116,7 @@ def _assets(spec: TrainSpec) -> list[str]:
 
 def _camera(spec: TrainSpec) -> str:
     """A camera on the axis, in front of the first stage, framing the largest gear (narrow: little perspective)."""
-    reach = max([g.root_radius + gear_visuals.RIM * g.normal_module if g.internal else g.tip_radius
+    reach = max([g.root_radius + gear_visuals.RIM * gear_visuals.module(g, normal=True) if g.internal else g.tip_radius
                  for m in spec.members.values() for g in m.gears.values()] + _hook(spec, "reach"), default=0.1)
     return f'<camera name="front" pos="{vec(0, 0, 6.5 * reach)}" fovy="20"/>'
 

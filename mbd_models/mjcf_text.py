@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from gearcheck.mbd_models.gear_visuals import face_width
+
 RGBA = {
     "sun": "0.95 0.6 0.1 1",
     "ring": "0.62 0.62 0.68 1",
@@ -212,7 +214,7 @@ def gear_z(spec) -> dict[tuple[str, str], float]:
     z = {}
     for mid, member in spec.members.items():
         if member.is_planet:
-            step = 1.5 * max(g.face_width for g in member.gears.values())
+            step = 1.5 * max(face_width(g) for g in member.gears.values())
             for i, name in enumerate(member.gears):
                 z[mid, name] = (i - 0.5 * (len(member.gears) - 1)) * step
     for mesh in spec.meshes:
@@ -226,7 +228,7 @@ def gear_z(spec) -> dict[tuple[str, str], float]:
 def plate(spec, stage, z: dict) -> tuple[float, float, float]:
     """(axial offset of its centre, half thickness, the planets' tip radius) of a carrier's plate behind the
     planets (``z``: :func:`gear_z`)."""
-    back = min((z[p, n] - 0.5 * g.face_width for p in stage.planets for n, g in spec.members[p].gears.items()),
+    back = min((z[p, n] - 0.5 * face_width(g) for p in stage.planets for n, g in spec.members[p].gears.items()),
                default=0.0)
     tip = max((g.tip_radius for p in stage.planets for g in spec.members[p].gears.values()), default=0.01)
     h = max(0.25 * tip, 0.002)

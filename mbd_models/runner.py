@@ -560,7 +560,7 @@ def _body_clock(mb: MbdModel):
         carrier = spec.stage_of(mesh.planet).carrier
         rel = kin.speeds[mesh.central] - kin.speeds[carrier]
         rows.append((mb.qadr[mesh.central][2], mb.qadr[carrier][2],
-                     math.copysign(1.0, rel) * mesh.central_gear.teeth / (2 * math.pi)))
+                     math.copysign(1.0, rel) * (mesh.central_gear.teeth or 0) / (2 * math.pi)))
     return tuple(np.array(x) for x in zip(*rows))
 
 
@@ -590,7 +590,8 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     angle = columns("angle", 0, carriers) + [member.angle for member in members]
     c, s = np.cos(angle), np.sin(angle)
     lin_x, lin_y = columns("linacc", 0, labels), columns("linacc", 1, labels)
-    acc = np.stack([c * lin_x + s * lin_y, -s * lin_x + c * lin_y, columns("angacc", 2, labels)], axis=-1)
+    acc = np.stack([c * lin_x + s * lin_y, -s * lin_x + c * lin_y, columns("angacc", 2, labels),
+                    columns("linacc", 2, labels)], axis=-1)  # the world's z is the stages' axis
     delta = columns("deflection", 0, [m.label for m in spec.meshes])
     mesh_force, bearing_force = stepper.reader.forces(stepper.forces[:stepper.j])
     k = (mb.excitation.stiffness(t + STAGE_OFFSETS[0] * info["dt_s"]) if stepper.stiffness is None

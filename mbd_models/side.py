@@ -30,6 +30,7 @@ class MujocoSide(Side):
     :func:`gearcheck.mbd_models.runner.simulate_mujoco`)."""
 
     solver = "mujoco"
+    kind = "MuJoCo twin"
     order = stepping.ORDER  # RK4, the drive set at every stage, contact events located
     references = ("todorov-2012",)
 
@@ -45,7 +46,9 @@ class MujocoSide(Side):
         return linearise.modes(self.model)
 
     def modes_at_speed(self, input_speed: float) -> ModalResult:
-        return linearise.modes_at_speed(self.model, input_speed)
+        turning = self.spec.operating.input_speed or not input_speed  # a twin at rest: one turning at that speed
+        model = self.model if turning else compile_train(self.spec.with_operating(input_speed=input_speed))
+        return linearise.modes_at_speed(model, input_speed)
 
     def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray, np.ndarray]:
         """(coordinate labels, mass matrix, the shapes of ``modal``) in the train's physical coordinates, mapped
@@ -83,6 +86,7 @@ class PublishedTwinSide(Side):
     A run needs its step: the 4-DOF models and their twin are compared on one time grid."""
 
     solver = "mujoco"
+    kind = "MuJoCo twin of a published model"
     references = ("todorov-2012", "matejic2021")
 
     def __init__(self, spec, name: str, load: bool = True, planet_sets: int = 1, y1: str | None = None,

@@ -234,7 +234,7 @@ FILES = [
     ("baseline-not-json", raw_file("b.json", b"{"), lambda f: ["crosscheck", "demo-3p", "--baseline", f],
      "the baseline is not JSON"),
     ("baseline-a-list", raw_file("b.json", b"[1, 2]"), lambda f: ["crosscheck", "demo-3p", "--baseline", f],
-     "not a gearcheck baseline of version 1 (found 'list')"),
+     "not a gearcheck baseline of version 2 or 1 (found 'list')"),
     ("baseline-truncated", raw_file("b.json", b'{"baseline_version": 1, "train": "demo-3p", "duration_s": 0.05}'),
      lambda f: ["crosscheck", "demo-3p", "--baseline", f], "not a valid baseline: input_speed_rpm missing"),
     ("torque-csv-not-numbers", raw_file("p.csv", b"time,torque\n0,a\n1,b\n"),

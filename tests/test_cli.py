@@ -101,3 +101,41 @@ def test_sensitivity_states_its_units_and_harmonic_notation(tmp_path, capsys):
     assert main(["sensitivity", "demo-3p", "--parameter", "stages[0].sun.mass", "--coordinate", "stage1.sun.x",
                  "--out", str(tmp_path / "x")]) == 0
     assert set(pd.read_csv(tmp_path / "x" / "sensitivity.csv")["amplitude_unit"]) == {"m"}
+
+
+def test_sensitivity_against_a_parameters_values(tmp_path, capsys):
+    """Yang, Chen & Wang's (2018) Figs. 6, 8, 10 as a command: d|Q_h|/dp at a constant speed over the parameter's
+    values.  Its derivative is the slope of its own amplitudes: between two values 1 % apart the difference
+    quotient equals the mean of the two derivatives to O(dp^2) (measured 6e-6 to 2e-4 relative: the third harmonic
+    barely depends on the support, d ln|Q|/d ln p = -5e-7);
+    at the file's own value it is the speed map's row at that speed to round-off."""
+    from gearcheck.compare.studies.sensitivity import sensitivity_map
+    from gearcheck.train.loader import read_train_text
+
+    text, source = read_train_text("demo-3p")
+    path = "stages[0].sun.support.radial_stiffness"
+    k = 1.0e8  # the file's value
+    frame = sensitivity_map(text, source, [path], [1500.0], "stage1.carrier.theta", values=[0.5 * k, 0.505 * k, k])
+    over_speed = sensitivity_map(text, source, [path], [1500.0], "stage1.carrier.theta")
+    for h, rows in frame.groupby("harmonic"):
+        a, b, own = (rows[rows["value"] == v].iloc[0] for v in (0.5 * k, 0.505 * k, k))
+        slope = (b["amplitude"] - a["amplitude"]) / (b["value"] - a["value"])
+        mean = 0.5 * (a["d_amplitude_d_p"] + b["d_amplitude_d_p"])
+        quotient_round_off = 1e-10 * a["amplitude"] / (b["value"] - a["value"])  # the solves' relative precision
+        assert slope == pytest.approx(mean, rel=1e-3, abs=quotient_round_off), h
+        speed_row = over_speed[over_speed["harmonic"] == h].iloc[0]
+        assert own["d_amplitude_d_ln_p"] == pytest.approx(speed_row["d_amplitude_d_ln_p"], rel=1e-9, abs=1e-30), h
+    assert main(["sensitivity", "demo-3p", "--parameter", path, "--values", "5e7", "1e8", "2e8", "--speeds",
+                 "1000:2000:2", "--out", str(tmp_path)]) == 0
+    written = pd.read_csv(tmp_path / "sensitivity_values.csv")
+    assert len(written) == 2 * 3 * 3 and (tmp_path / "sensitivity_values.png").stat().st_size > 10_000
+    assert main(["sensitivity", "demo-3p", "--parameter", path, "--parameter", "stages[0].sun.mass", "--values", "1",
+                 "--out", str(tmp_path / "two")]) == 2
+    assert "takes one parameter" in capsys.readouterr().err and not (tmp_path / "two").exists()
+    # a number nothing depends on is said to be so: the RV reducer's in-phase planets never load the sun's
+    # translations (its mass moves |Q_h| by 1e-26 relative, round-off)
+    assert main(["sensitivity", "rv-reducer", "--parameter", "stages[0].sun.mass", "--values", "0.65", "1.3",
+                 "--out", str(tmp_path / "null")]) == 0
+    assert "does not depend on it" in capsys.readouterr().out
+    assert pd.read_csv(tmp_path / "null" / "sensitivity_values.csv")["negligible"].all()
+    assert not written["negligible"].all()

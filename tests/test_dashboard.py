@@ -96,11 +96,11 @@ def test_append_is_idempotent_and_reads_back(scratch, tmp_path):
     row = after[(after["commit"] == "c1") & (after["item"] == q["name"])].set_index("metric")
     assert row.loc["nrmse", "value"] == q["errors"]["nrmse"]["value"]
     assert row.loc["nrmse", "tolerance"] == q["tolerance_nrmse"]["value"] and row.loc["nrmse", "gated"]
-    assert row.loc["lumped.peak_to_peak", "value"] == q["lumped"]["peak_to_peak"]["value"]
-    assert row.loc["integration_error.mujoco", "value"] == q["integration_error"]["mujoco"]["value"]
+    assert row.loc["reference.peak_to_peak", "value"] == q["reference"]["peak_to_peak"]["value"]
+    assert row.loc["integration_error.test", "value"] == q["integration_error"]["test"]["value"]
     mode = reports[1]["modes"][3]
     row = after[(after["commit"] == "c1") & (after["item"] == f"mode {mode['mode']}")].set_index("metric")
-    assert row.loc["lumped.frequency", "value"] == mode["lumped"]["value"]
+    assert row.loc["reference.frequency", "value"] == mode["reference"]["value"]
     assert row.loc["rel_error", "status"] == mode["status"]
     assert set(after.loc[after["item"] == "wall_time", "metric"]) == set(reports[0]["volatile"]["wall_time"])
     assert set(after.loc[after["item"] == "cpu_time", "metric"]) == set(reports[0]["volatile"]["cpu_time"])
@@ -127,13 +127,33 @@ def test_a_failed_append_leaves_the_store_as_it_was(scratch, tmp_path):
     twice["quantities"].append(twice["quantities"][0])  # fails inside the transaction, on its last insert
     for args, reason in [((broken, "c1"), "malformed field 'errors'"), ((scratch.reports[1], " "), "commit id"),
                          (({"schema": "gearcheck.summary", "schema_version": 1}, "c1"),
-                          "records gearcheck.crosscheck version 1 reports, not ('gearcheck.summary', 1)"),
+                          "records gearcheck.crosscheck version 2 reports, not ('gearcheck.summary', 1)"),
                          ((scratch.reports[1], "c1", "yesterday"), "not an ISO 8601 date"),
                          ((twice, "c1"), "UNIQUE constraint failed")]:
         with pytest.raises(GearcheckError) as info:
             history.append(store, *args)
         assert reason in str(info.value) and "\n" not in str(info.value)
     assert store.read_bytes() == snapshot and history.commits(store) == ["c0"]
+
+
+def test_a_version_1_store_is_brought_to_version_2_by_the_next_record(scratch, tmp_path):
+    """Version 1 named the sides' metrics lumped.* and mujoco.* whatever they were: reading such a store is
+    refused in one line saying how to upgrade it; recording a run renames them reference.* and test.*, the
+    values kept."""
+    store = tmp_path / "old.sqlite"
+    history.append(store, scratch.reports[0], "c0")
+    before = history.read(store)
+    with sqlite3.connect(store) as con:  # what version 1 wrote
+        con.execute("UPDATE metrics SET metric = replace(replace(metric, 'reference', 'lumped'), 'test', 'mujoco')")
+        con.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
+    with pytest.raises(GearcheckError, match="version 1; recording a run in it"):
+        history.read(store)
+    history.append(store, scratch.reports[1], "c1")
+    after = history.read(store)
+    old = after[after["commit"] == "c0"].reset_index(drop=True)
+    pd.testing.assert_frame_equal(old, before.reset_index(drop=True))
+    assert not after["metric"].str.match(r"(integration_error\.)?(lumped|mujoco)\b").any()  # timings keep solver names
+    assert after["metric"].str.match(r"(integration_error\.)?(reference|test)\b").any()
 
 
 def test_a_bad_store_is_one_line_naming_the_file(scratch, tmp_path):
@@ -145,9 +165,9 @@ def test_a_bad_store_is_one_line_naming_the_file(scratch, tmp_path):
     future = tmp_path / "future.sqlite"
     history.append(future, scratch.reports[0], "c0")
     with sqlite3.connect(future) as con:
-        con.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
+        con.execute("UPDATE meta SET value = '3' WHERE key = 'schema_version'")
     for path, reason in [(text, "file is not a database"), (other, "not a gearcheck history store"),
-                         (future, "version 2"), (tmp_path / "missing.sqlite", "no such file"),
+                         (future, "version 3"), (tmp_path / "missing.sqlite", "no such file"),
                          (tmp_path, "is a folder")]:
         calls = {"read": lambda: history.read(path), "render": lambda: dashboard.render(path, tmp_path / "site"),
                  "append": lambda: history.append(path, scratch.reports[0], "c1")}
@@ -193,8 +213,8 @@ def test_the_stiffened_commit_and_only_it_is_a_change_point(scratch):
     assert marked == {"index.html": {stiff}, "preset-demo-3p.html": {stiff}}
     preset = site["preset-demo-3p.html"]
     metrics = set(re.findall(r'class="change-point" data-commit="[0-9a-f]+" data-metric="([^"]+)"', preset))
-    assert "mode 18 lumped.frequency" in metrics  # a mesh-dominated mode: about sqrt(1.3)
-    assert "stage1.planet1.sun.dte lumped.rms" in metrics  # the same load on stiffer teeth
+    assert "mode 18 reference.frequency" in metrics  # a mesh-dominated mode: about sqrt(1.3)
+    assert "stage1.planet1.sun.dte reference.rms" in metrics  # the same load on stiffer teeth
     assert not any(m.endswith(" nrmse") for m in metrics)  # both solvers moved together: the check still agrees
     assert f"&#9670; {stiff[:7]}</text>" in preset and preset.count('<svg') > 60
     for other in (good, notes):

@@ -123,3 +123,20 @@ def test_evidence_in_unknown_coordinates_is_refused(demo):
         diagnose(demo, replace(evidence, labels=["stage1.moon.x", *evidence.labels[1:]]))
     with pytest.raises(GearcheckError, match="ascending"):
         diagnose(demo, replace(evidence, frequencies=evidence.frequencies[::-1]))
+
+
+def test_n_rc_k_for_n_rc2_k_is_named_and_the_lost_rigid_mode_said(demo):
+    """Issue 28: on a torque-driven train (no input shaft) the carrier's N r_c^2 k written N r_c k holds the rigid
+    turn; in K that is exactly a spring from the carrier's rotation to ground, so both are named, the exact entry
+    first."""
+    free = replace(demo, rows=[r for r in demo.rows if r.name != "input_shaft"])
+    i, r_c = free.dofs("stage1.carrier", "theta"), demo.spec.members["stage1.planet1"].radius
+    bug = replace(free.rows[0], name="bug", stiffness=free.K_mean[i, i] * (1.0 / r_c - 1.0), a=np.eye(free.n)[i])
+    diagnosis = diagnose(free, Evidence.of_model(replace(free, rows=[*free.rows, bug])))
+    best = diagnosis.best
+    carrier = "stage1.carrier"
+    assert (best.kind, best.member, best.coordinates) == ("radius power", carrier, [f"{carrier}.theta"] * 2)
+    assert best.factor == pytest.approx(1.0 / r_c, rel=1e-12) and best.score < ROUND_OFF
+    assert [(e.kind, e.coordinates) for e in best.equivalents] == [("extra spring", ["stage1.carrier.theta"])]
+    assert diagnosis.rigid_modes == {"evidence": 0, "reference": 1}
+    assert diagnosis.lines()[0].startswith("Rigid-body modes lost: 1")

@@ -42,7 +42,7 @@ def test_readme_example_gives_what_the_command_line_gives(tmp_path, capsys):
     for data in (python, cli):
         data.pop("volatile")
     assert python == cli
-    rows = [f"{m['quantity']} {m['metric']} {m['measured']['value']} {m['lumped']['value']} {m['mujoco']['value']}"
+    rows = [f"{m['quantity']} {m['metric']} {m['measured']['value']} {m['reference']['value']} {m['test']['value']}"
             for m in cli["measurements"]]
     assert printed[1:] == rows
 

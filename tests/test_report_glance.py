@@ -169,7 +169,7 @@ def test_measured_values_are_explained(hub):
     assert "the train file's own parameters (preset:hub-drive), which are not calibrated" in md
     assert "docs/hub-drive-calibration/" in md
     for row in data["measurements"]:
-        errors = row["error_lumped"]["value"], row["error_mujoco"]["value"]
+        errors = row["error_reference"]["value"], row["error_test"]["value"]
         if min(map(abs, errors)) > MISS:  # both solvers miss Table 1 alike: the model, not the solvers
             assert f"{row['quantity']} {row['metric']}: both solvers miss the test by the same amount" in md
     assert "it is the model, its parameters, not the solvers, that disagrees with the test" in md
@@ -223,10 +223,10 @@ def test_junit_is_reproducible_but_for_its_times_and_reports_a_moved_baseline(hu
     assert untimed[0] == untimed[1] and junit_xml([data]) != junit_xml([again])
     assert junit_xml([data]) == junit_xml([json.loads(json.dumps(data))])
     assert ET.fromstring(junit_xml([data])).find(".//testcase[@name='baseline']") is None  # none was checked
-    again["verdict"]["moved_from_baseline"] = ["II.carrier.ay.world lumped_rms: 1 -> 2"]
+    again["verdict"]["moved_from_baseline"] = ["II.carrier.ay.world reference_rms: 1 -> 2"]
     suite = ET.fromstring(junit_xml([again])).find("testsuite")
     failure = suite.find("testcase[@name='baseline']/failure")
-    assert failure.get("message") == "1 metrics moved from the baseline" and "lumped_rms" in failure.text
+    assert failure.get("message") == "1 metrics moved from the baseline" and "reference_rms" in failure.text
     assert int(suite.get("tests")) == len(suite.findall("testcase"))
 
 

@@ -21,7 +21,8 @@ from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.outputs import write_file
 
 BASELINE_DIR = Path(__file__).parent / "baselines"
-VERSION = 1
+VERSION = 2  # 2: the sides' metrics keyed reference_* and test_* (1: lumped_* and mujoco_*, read as 2's)
+RENAMED = (("lumped_", "reference_"), ("mujoco_", "test_"))
 
 
 def snapshot(result) -> dict:
@@ -30,13 +31,14 @@ def snapshot(result) -> dict:
         m = q.metrics
         quantities[q.name] = {
             "kind": q.kind, "status": q.status, "tolerance": q.tolerance, "nrmse": m["nrmse"],
-            "lumped_rms": m["reference"]["rms"], "mujoco_rms": m["test"]["rms"],
-            "lumped_peak_to_peak": m["reference"]["peak_to_peak"], "mujoco_peak_to_peak": m["test"]["peak_to_peak"],
+            "reference_rms": m["reference"]["rms"], "test_rms": m["test"]["rms"],
+            "reference_peak_to_peak": m["reference"]["peak_to_peak"], "test_peak_to_peak": m["test"]["peak_to_peak"],
         }
     return {
         "baseline_version": VERSION, "train": result.spec.name,
         "duration_s": result.settings["duration_s"], "input_speed_rpm": result.settings["input_speed_rpm"],
-        "modes": [{"mode": r["mode"], "lumped_hz": r["reference_hz"], "mujoco_hz": r["test_hz"]} for r in result.modal],
+        "modes": [{"mode": r["mode"], "reference_hz": r["reference_hz"], "test_hz": r["test_hz"]}
+                  for r in result.modal],
         "modes_tolerance": result.modal_tolerance, "quantities": quantities,
     }
 
@@ -46,7 +48,7 @@ def write_baseline(result, path: str | Path) -> None:
 
 
 NUMBER = (int, float)
-QUANTITY_KEYS = ("lumped_rms", "mujoco_rms", "lumped_peak_to_peak", "mujoco_peak_to_peak")
+QUANTITY_KEYS = ("reference_rms", "test_rms", "reference_peak_to_peak", "test_peak_to_peak")
 
 
 def read_baseline(path: str | Path) -> dict:
@@ -55,9 +57,11 @@ def read_baseline(path: str | Path) -> dict:
         data = json.loads(read_text(path, "baseline"))
     except json.JSONDecodeError as exc:
         raise GearcheckError(f"{path}: the baseline is not JSON: {exc}") from None
+    if isinstance(data, dict) and data.get("baseline_version") == 1:
+        data = _renamed(data)
     if not isinstance(data, dict) or data.get("baseline_version") != VERSION:
         found = data.get("baseline_version") if isinstance(data, dict) else type(data).__name__
-        raise GearcheckError(f"{path}: not a gearcheck baseline of version {VERSION} (found {found!r})")
+        raise GearcheckError(f"{path}: not a gearcheck baseline of version {VERSION} or 1 (found {found!r})")
 
     def need(ok: bool, what: str):
         if not ok:
@@ -67,15 +71,29 @@ def read_baseline(path: str | Path) -> dict:
                       ("modes_tolerance", NUMBER), ("modes", list), ("quantities", dict)):
         need(isinstance(data.get(key), kind), f"{key} missing or not a {getattr(kind, '__name__', 'number')}")
     for mode in data["modes"]:
-        need(isinstance(mode, dict) and all(isinstance(mode.get(k), NUMBER) for k in ("mode", "lumped_hz",
-                                                                                       "mujoco_hz")),
-             f"modes entry {mode!r} needs numbers mode, lumped_hz, mujoco_hz")
+        need(isinstance(mode, dict) and all(isinstance(mode.get(k), NUMBER) for k in ("mode", "reference_hz",
+                                                                                       "test_hz")),
+             f"modes entry {mode!r} needs numbers mode, reference_hz, test_hz")
     for name, q in data["quantities"].items():
         need(isinstance(q, dict) and all(isinstance(q.get(k), NUMBER) for k in QUANTITY_KEYS)
              and isinstance(q.get("status"), str) and isinstance(q.get("tolerance"), (*NUMBER, type(None)))
              and isinstance(q.get("nrmse"), (*NUMBER, type(None))),
              f"quantity {name!r} needs {', '.join(QUANTITY_KEYS)}, status, tolerance and nrmse")
     return data
+
+
+def _renamed(data: dict) -> dict:
+    """A version 1 baseline with version 2's keys (its entries' lumped_* and mujoco_* as reference_* and test_*)."""
+    def keys(entry):
+        if not isinstance(entry, dict):
+            return entry
+        for old, new in RENAMED:
+            entry = {new + k[len(old):] if k.startswith(old) else k: v for k, v in entry.items()}
+        return entry
+    quantities = data.get("quantities")
+    return {**data, "baseline_version": VERSION,
+            "modes": [keys(m) for m in data["modes"]] if isinstance(data.get("modes"), list) else data.get("modes"),
+            "quantities": {k: keys(q) for k, q in quantities.items()} if isinstance(quantities, dict) else quantities}
 
 
 def _moved_rel(new, old, tol) -> bool:
@@ -106,7 +124,7 @@ def compare_to_baseline(result, baseline: dict) -> list[str]:
     check_settings(baseline, now["duration_s"], now["input_speed_rpm"])
     tol_f = baseline["modes_tolerance"]
     for old, new in zip(baseline["modes"], now["modes"]):
-        for key in ("lumped_hz", "mujoco_hz"):
+        for key in ("reference_hz", "test_hz"):
             if _moved_rel(new[key], old[key], tol_f):
                 moved.append(f"mode {old['mode']} {key}: {old[key]:.9g} -> {new[key]:.9g}")
     if len(baseline["modes"]) != len(now["modes"]):

@@ -124,6 +124,7 @@ class CrosscheckResult:
     steady_how: str | None = None  # detected | decayed | transient | None (no steady state)
     settle_s: float | None = None  # the reference's free vibration decay time (steady-state runs)
     solvers: tuple = ("lumped", "mujoco")  # the reference's and the test's names
+    kinds: tuple = ("reference lumped model", "MuJoCo twin")  # what each is (Side.kind)
     diagnosis: object | None = None  # a user's model: the term of the reference that best explains its modes
 
     @property
@@ -309,8 +310,8 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
 
     run_settings = {
         "duration_s": asked, "simulated_s": duration, **plan.operating,
-        "lumped": {k: a.info[k] for k in SIDE_SETTINGS if k in a.info},
-        "mujoco": {k: v for k, v in b.info.items() if k != "wall_time_s" and _plain(v)},
+        "reference": {k: a.info[k] for k in SIDE_SETTINGS if k in a.info},
+        "test": {k: v for k, v in b.info.items() if k != "wall_time_s" and _plain(v)},
         "common_sample_rate_hz": fs, "steady_cycle_s": plan.cycle, "steady_cycle_of": plan.cycle_of,
         "integration_check_steps_s": [c.info["dt_s"] if c is not None else None for c in (a_check, b_check)],
         "sensor_band_hz": list(sensor_band) if sensor_band else None,
@@ -321,7 +322,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
                             (modes_a, modes_b),
                             grid, series, clock.wall, clock.cpu, notes=notes, references=references,
                             steady_how=how, settle_s=plan.settle if plan.detect_steady else None,
-                            solvers=(reference.solver, test.solver))
+                            solvers=(reference.solver, test.solver), kinds=(reference.kind, test.kind))
 
 
 def _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_tolerance, modal_results, clock,
@@ -333,13 +334,14 @@ def _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_toler
                  "no time-varying force. Its runs would sit at their static state, so only its modes are compared; "
                  "give its meshes as mesh rows (or its stiffness and forcing as functions of time) for the "
                  "time-domain comparison.")
-    settings = {"duration_s": 0.0, "simulated_s": 0.0, **plan.operating, "lumped": {}, "mujoco": {},
+    settings = {"duration_s": 0.0, "simulated_s": 0.0, **plan.operating, "reference": {}, "test": {},
                 "common_sample_rate_hz": 0.0, "steady_cycle_s": plan.cycle, "steady_cycle_of": plan.cycle_of,
                 "integration_check_steps_s": [None, None], "sensor_band_hz": None,
                 "tolerances": dict(sorted(tolerances.values.items()))}
     return CrosscheckResult(spec, settings, modal_rows, modal_tolerance, [], 0.0, True, (None, None), modal_results,
                             np.zeros(0), {}, clock.wall, clock.cpu, notes=notes, references=references,
-                            steady_how="modes only", solvers=(reference.solver, test.solver))
+                            steady_how="modes only", solvers=(reference.solver, test.solver),
+                            kinds=(reference.kind, test.kind))
 
 
 @dataclass

@@ -21,6 +21,7 @@ from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.progress import shows_progress
 from gearcheck.shared.units import rad_s_to_rpm
+from gearcheck.train.kinematics import require_mesh_cycle
 from gearcheck.train.loader import load_train
 
 __all__ = ["MODELS", "crosscheck"]
@@ -83,6 +84,7 @@ def crosscheck(train, *, speed: float | None = None, duration: float | None = No
         (``result[name]``), ``.measurements``, ``.moved`` (metrics moved from the baseline), ``.write(directory)``.
     """
     spec = load_train(train, speed)
+    require_mesh_cycle(spec, "a cross-check (its time runs)")
     pair = resolve_model(spec, model, against, results, columns, modes, sides)
     _check_band(sensor_band)
     tol = Tolerances.for_train(spec, tolerances)

@@ -50,16 +50,16 @@ def attach(result, entries) -> None:
             continue
         q = by_name[entry["quantity"]]  # known: check_quantities ran before the runs
         metric, band, value = entry["metric"], entry.get("sensor_band_hz"), entry["value"]
-        lumped, mujoco = (chain_statistic(x, window, fs, metric, band) for x in result.series[q.name])
+        reference, test = (chain_statistic(x, window, fs, metric, band) for x in result.series[q.name])
         published = entry.get("published_model")
         row = {
             "quantity": q.name, "metric": metric, "source": entry.get("source", ""),
             "sensor_band": None if band is None else {"value": list(band), "unit": "Hz"},
-            "measured": {"value": value, "unit": q.unit}, "lumped": {"value": lumped, "unit": q.unit},
-            "mujoco": {"value": mujoco, "unit": q.unit},
+            "measured": {"value": value, "unit": q.unit}, "reference": {"value": reference, "unit": q.unit},
+            "test": {"value": test, "unit": q.unit},
             "published_model": None if published is None else {"value": published, "unit": q.unit},
-            "error_lumped": {"value": _error(lumped, value), "unit": "1"},
-            "error_mujoco": {"value": _error(mujoco, value), "unit": "1"},
+            "error_reference": {"value": _error(reference, value), "unit": "1"},
+            "error_test": {"value": _error(test, value), "unit": "1"},
             "error_published_model": None if published is None else {"value": _error(published, value), "unit": "1"},
         }
         q.measured.append(row)

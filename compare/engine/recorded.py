@@ -383,6 +383,7 @@ class RecordedSide(Side):
     :meth:`run` returns the recording whatever its settings ask (the engine compares the overlap)."""
 
     rerunnable = False
+    kind = "recording"
 
     def __init__(self, spec, series_path: str | Path, columns: ColumnMap | Mapping | str | Path,
                  modes_path: str | Path | None = None):

@@ -101,6 +101,8 @@ class AdoptedSide(Side):
     raises (``sys.exit`` too) and what it returns that is not what a side returns (:data:`RETURNS`) become one
     line naming the model and the method."""
 
+    kind = "user model"
+
     def __init__(self, side, spec, given: str):
         self.side, self.spec, self.solver, self.given = side, spec, side.solver, given
         for name in CAPABILITIES:
@@ -111,6 +113,8 @@ class AdoptedSide(Side):
         if isinstance(self.notes, str) or not all(isinstance(x, str) for x in self.notes):
             raise GearcheckError(f"model={given}: its notes {shown(self.notes)} are not a list of sentences")
         self.notes = tuple(self.notes)
+        if not isinstance(self.kind, str) or not self.kind.strip():
+            raise GearcheckError(f"model={given}: its kind {shown(self.kind)} is no words for what it is (a string)")
         if isinstance(self.order, bool) or self.order not in (1, 2, 3, 4, 5, 6, 7, 8):
             raise GearcheckError(f"model={given}: its order {shown(self.order)} is no order of convergence (1-8)")
 

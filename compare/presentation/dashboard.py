@@ -317,8 +317,8 @@ def _preset_page(p: Preset) -> str:
                     f"{_badge(status) if status else ''}</h3><div class=\"grid\">")
         body.append(_figure("NRMSE", p.chart([p.line(item, "nrmse", "NRMSE", PALETTE[0])], log=True,
                                              limits=_tolerance(info))))
-        amplitude = [p.relative(item, "lumped.rms", "lumped RMS", PALETTE[0]),
-                     p.relative(item, "lumped.peak_to_peak", "lumped peak-to-peak", PALETTE[1])]
+        amplitude = [p.relative(item, "reference.rms", "reference RMS", PALETTE[0]),
+                     p.relative(item, "reference.peak_to_peak", "reference peak-to-peak", PALETTE[1])]
         body.append(_figure("Amplitude, change from the first run (%)", p.chart(amplitude, unit="%")))
         body.append("</div></div>")
     return page(f"{p.name}: gearcheck regression dashboard", "".join(body))
@@ -351,9 +351,9 @@ def _overview(p: Preset) -> list:
         line = p.aggregate("max modal rel. error", values, "modes max-rel-error", tol)
         out.append(("Modal max relative error", p.chart([line], log=True, limits=[(tol, "tolerance")] if tol else [])))
     lines = [p.relative(*key, key[0], PALETTE[j % len(PALETTE)])
-             for j, key in enumerate(k for k in p.series if k[1] == "lumped.frequency")]
+             for j, key in enumerate(k for k in p.series if k[1] == "reference.frequency")]
     if lines:
-        out.append(("Natural frequencies (lumped), change from the first run (%)", p.chart(lines, unit="%",
+        out.append(("Natural frequencies (reference), change from the first run (%)", p.chart(lines, unit="%",
                                                                                         legend=False)))
     bounds = [k for k in p.series if k[1].startswith("integration_error.")]
     if bounds:

@@ -54,8 +54,9 @@ import pandas as pd
 from gearcheck.shared.errors import GearcheckError, shown
 
 SCHEMA = "gearcheck.history"
-SCHEMA_VERSION = 1
-REPORT_SCHEMA, REPORT_SCHEMA_VERSION = "gearcheck.crosscheck", 1  # what it records
+SCHEMA_VERSION = 2  # 2: the sides' metrics named reference.* and test.* (1: lumped.* and mujoco.*)
+REPORT_SCHEMA, REPORT_SCHEMA_VERSION = "gearcheck.crosscheck", 2  # what it records
+RENAMED = (("lumped", "reference"), ("mujoco", "test"))  # version 1's side names, version 2's
 
 WINDOW = 8  # points before a candidate whose median is the level it moved from
 CONFIRM = 3  # points from a candidate on whose median the move must persist
@@ -147,7 +148,7 @@ def append(store, data: dict, commit: str, date: str | None = None, machine: str
                     con.execute(statement)
                 con.executemany("INSERT INTO meta VALUES (?, ?)",
                                 [("schema", SCHEMA), ("schema_version", str(SCHEMA_VERSION))])
-            _check(con, store)
+            _check(con, store, upgrade=True)
             known = con.execute("SELECT date FROM commits WHERE commit_id = ?", (commit,)).fetchone()
             if known is None:
                 seq = con.execute("SELECT coalesce(max(seq), 0) + 1 FROM commits").fetchone()[0]
@@ -267,11 +268,11 @@ def _record(data: dict, machine: str | None) -> tuple[str, dict, list[tuple]]:
         tol, status = _value(q.get("tolerance_nrmse")), q.get("status")
         rows.append((q["name"], "nrmse", q["kind"], "1", _value(q["errors"]["nrmse"]), tol, status,
                      tol is not None and status != "negligible"))
-        for solver in ("lumped", "mujoco"):
+        for solver in ("reference", "test"):
             for stat in ("rms", "peak_to_peak"):
                 rows.append((q["name"], f"{solver}.{stat}", q["kind"], q["unit"],
                              _value((q.get(solver) or {}).get(stat)), None, None, False))
-        for solver in ("lumped", "mujoco"):
+        for solver in ("reference", "test"):
             rows.append((q["name"], f"integration_error.{solver}", q["kind"], "1",
                          _value((q.get("integration_error") or {}).get(solver)), tol, None, False))
     mode_tol = _value(data.get("modes_tolerance"))
@@ -279,7 +280,7 @@ def _record(data: dict, machine: str | None) -> tuple[str, dict, list[tuple]]:
         item = f"mode {m['mode']}"
         rows.append((item, "rel_error", m.get("type"), "1", _value(m["rel_error"]), mode_tol, m.get("status"),
                      mode_tol is not None))
-        for solver in ("lumped", "mujoco"):
+        for solver in ("reference", "test"):
             rows.append((item, f"{solver}.frequency", m.get("type"), "Hz", _value(m.get(solver)), None, None, False))
     for clock in TIMES:
         for name, value in sorted(((data.get("volatile") or {}).get(clock) or {}).items()):
@@ -337,12 +338,30 @@ def _connect(store, write: bool = False):
             con.close()
 
 
-def _check(con: sqlite3.Connection, store) -> None:
-    """Refuse a SQLite file that is not a history store of this schema version."""
+def _upgrade(con: sqlite3.Connection) -> None:
+    """Version 1 to 2: the sides' metrics renamed, lumped.* to reference.* and mujoco.* to test.* (and
+    integration_error.lumped to integration_error.reference, ...), as report.json version 2 keys them."""
+    for old, new in RENAMED:
+        con.execute("UPDATE metrics SET metric = ? || substr(metric, ?) WHERE metric LIKE ?",
+                    (new, len(old) + 1, f"{old}.%"))
+        con.execute("UPDATE metrics SET metric = ? WHERE metric = ?",
+                    (f"integration_error.{new}", f"integration_error.{old}"))
+    con.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
+
+
+def _check(con: sqlite3.Connection, store, upgrade: bool = False) -> None:
+    """Refuse a SQLite file that is not a history store of this schema version; with ``upgrade`` (inside a write
+    transaction) bring a version 1 store to version 2 first (:func:`_upgrade`)."""
     tables = {row[0] for row in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
     if "meta" not in tables:
         raise GearcheckError(f"history store {store}: a SQLite file but not a gearcheck history store")
     meta = dict(con.execute("SELECT key, value FROM meta").fetchall())
+    if upgrade and meta.get("schema") == SCHEMA and meta.get("schema_version") == "1":
+        _upgrade(con)
+        meta["schema_version"] = str(SCHEMA_VERSION)
+    if meta.get("schema") == SCHEMA and meta.get("schema_version") == "1":
+        raise GearcheckError(f"history store {store}: version 1; recording a run in it (--history) brings it to "
+                             f"version {SCHEMA_VERSION}, whose metrics name the sides reference and test")
     if meta.get("schema") != SCHEMA or meta.get("schema_version") != str(SCHEMA_VERSION):
         raise GearcheckError(f"history store {store}: schema {meta.get('schema')} version "
                              f"{meta.get('schema_version')}, this gearcheck reads {SCHEMA} version {SCHEMA_VERSION}")

@@ -51,8 +51,8 @@ def _quantity_case(suite, data, q) -> None:
                  {"status": q["status"], "nrmse": _number(nrmse), "tolerance_nrmse": _number(tol), "unit": q["unit"]})
     if q["status"] == "fail":
         lines = [s for s in q["spectrum"] if s["status"] == "fail"]
-        detail = [f"RMS {A} {_number(q['lumped']['rms']['value'])} {q['unit']}, {B} "
-                  f"{_number(q['mujoco']['rms']['value'])} {q['unit']}; correlation "
+        detail = [f"RMS {A} {_number(q['reference']['rms']['value'])} {q['unit']}, {B} "
+                  f"{_number(q['test']['rms']['value'])} {q['unit']}; correlation "
                   f"{_number(q['errors']['correlation'] and q['errors']['correlation']['value'])}; lag "
                   f"{_number(q['errors']['lag']['value'])} s"]
         detail += [f"spectral line {s['line']} ({_number(s['frequency']['value'])} Hz): relative error "
@@ -61,7 +61,7 @@ def _quantity_case(suite, data, q) -> None:
                       type="ToleranceExceeded").text = "\n".join(detail)
     elif q["status"] == "unresolved":
         errors = q["integration_error"]
-        bounds = " + ".join(_number(e and e["value"]) for e in (errors["lumped"], errors["mujoco"]))
+        bounds = " + ".join(_number(e and e["value"]) for e in (errors["reference"], errors["test"]))
         ET.SubElement(case, "error", type="Unresolved",
                       message=f"integration error estimates {bounds} reach the tolerance {_number(tol)}: the comparison "
                               f"cannot decide (NRMSE {_number(nrmse)})")
@@ -71,12 +71,12 @@ def _mode_case(suite, data, m) -> None:
     A, B = solver_names(data)
     tol, rel = data["modes_tolerance"]["value"], m["rel_error"]["value"]
     case = _case(suite, f"gearcheck.{data['train']['name']}.modes", f"mode {m['mode']}",
-                 {"status": m["status"], "type": m["type"], "frequency_hz": _number(m["lumped"]["value"]),
+                 {"status": m["status"], "type": m["type"], "frequency_hz": _number(m["reference"]["value"]),
                   "rel_error": _number(rel), "tolerance": _number(tol)})
     if m["status"] == "fail":
         ET.SubElement(case, "failure", type="ToleranceExceeded",
                       message=f"relative frequency difference {_number(rel)} > tolerance {_number(tol)} ({A} "
-                              f"{_number(m['lumped']['value'])} Hz, {B} {_number(m['mujoco']['value'])} Hz)")
+                              f"{_number(m['reference']['value'])} Hz, {B} {_number(m['test']['value'])} Hz)")
 
 
 def _suite(root: ET.Element, data: dict) -> ET.Element:

@@ -67,9 +67,9 @@ def _title(result, what: str) -> str:
     s = result.settings
     a, b = result.solver_names
     return (f"{result.spec.name} at {s['input_speed_rpm']:.6g} rpm: {what}\n"
-            f"{a} {s['lumped'].get('method', '')} dt={s['lumped'].get('dt_s', float('nan')):.3g} s, "
-            f"{b} {s['mujoco'].get('integrator', s['mujoco'].get('method', ''))} "
-            f"dt={s['mujoco'].get('dt_s', float('nan')):.3g} s")
+            f"{a} {s['reference'].get('method', '')} dt={s['reference'].get('dt_s', float('nan')):.3g} s, "
+            f"{b} {s['test'].get('integrator', s['test'].get('method', ''))} "
+            f"dt={s['test'].get('dt_s', float('nan')):.3g} s")
 
 
 def time_histories_figure(result, names=None, cycles: int = 4) -> Figure:
@@ -577,6 +577,41 @@ def _pin_force_against_angle(bx, loads) -> None:
                  f"4 T/(Z_p r_c) (rigid disc: {rigid.min()}-{rigid.max()} pins)", fontsize=10)
     bx.legend(loc="upper left", fontsize=7.5, frameon=False)
     bx.grid(True, lw=0.3)
+
+
+def sensitivity_values(frame, coordinate: str, title: str) -> bytes:
+    """PNG of a :func:`~gearcheck.compare.studies.sensitivity.sensitivity_map` table over one parameter's values:
+    the amplitude of the first mesh harmonics of ``coordinate`` and their sensitivity d|Q|/dp against the value, a
+    line style per speed (as Yang, Chen & Wang 2018 draw their Figs. 6, 8, 10), round-off drawn as zero (and said
+    in the title when every derivative is); a logarithmic value axis when the values are positive and span a decade
+    or more."""
+    parameter = frame["parameter"].iloc[0]
+    harmonics = [h for h in dict.fromkeys(frame["harmonic"]) if h.endswith(", 0)") or "," not in h.strip("(,)")][:3]
+    speeds = list(dict.fromkeys(frame["speed_rpm"]))
+    fig, axes = _figure(2, 1, figsize=(8, 5.5), sharex=True, squeeze=False, layout="constrained")
+    styles = ["-", "--", ":", "-."]
+    for i, h in enumerate(harmonics):
+        for j, rpm in enumerate(speeds):
+            r = frame[(frame["harmonic"] == h) & (frame["speed_rpm"] == rpm)]
+            label = f"h = {h}, {rpm:.6g} rpm"
+            axes[0, 0].semilogy(r["value"], r["amplitude"], color=f"C{i}", ls=styles[j % 4], lw=1.2, label=label)
+            slope = r["d_amplitude_d_p"].where(~r["negligible"].astype(bool), 0.0)  # round-off drawn as zero
+            axes[1, 0].plot(r["value"], slope, color=f"C{i}", ls=styles[j % 4], lw=1.2, marker=".")
+    values = frame["value"]
+    if (values > 0).all() and values.max() >= 10 * values.min():
+        axes[1, 0].set_xscale("log")
+    unit = frame["amplitude_unit"].iloc[0]
+    axes[0, 0].set_ylabel(f"|Q_h| of {coordinate} ({unit})", fontsize=8)
+    axes[1, 0].set_ylabel(f"d|Q_h|/dp ({unit} per unit of p)", fontsize=8)
+    axes[1, 0].axhline(0.0, color="0.5", lw=0.6)
+    axes[1, 0].set_xlabel(f"{parameter} (the train file's unit)")
+    axes[0, 0].legend(fontsize=7, ncol=2)
+    for ax in axes[:, 0]:
+        ax.grid(alpha=0.3)
+    null = bool(frame["negligible"].astype(bool).all())
+    fig.suptitle(title + ("\nthe response does not depend on it: every derivative is round-off (negligible)" if null
+                          else ""), fontsize=9)
+    return _png(fig)
 
 
 def sensitivity_map(frame, coordinate: str, title: str) -> bytes:

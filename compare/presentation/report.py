@@ -43,7 +43,7 @@ from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.side import display_name
 
 SCHEMA = "gearcheck.crosscheck"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2  # 2: the sides keyed 'reference' and 'test' (1: 'lumped' and 'mujoco'), 'sides' added
 RATIO = "1"
 STATUSES = ("fail", "unresolved", "pass", "negligible")  # the order of every table's rows
 STATUS_WORDS = {"fail": "fail", "unresolved": "inconclusive (unresolved)", "pass": "pass",
@@ -82,7 +82,7 @@ def provenance(result) -> dict:
         "gearcheck_version": version, "git_revision": git_revision(), "mujoco_version": mujoco.__version__,
         "numpy_version": np.__version__, "python": platform.python_version(),
         "machine": f"{platform.system()} {platform.machine()}",
-        "lumped_solver": result.settings["lumped"], "mujoco_solver": result.settings["mujoco"],
+        "reference_solver": result.settings["reference"], "test_solver": result.settings["test"],
         "train_file": result.spec.path, "train_sha256": result.spec.text_hash,
     }
 
@@ -145,23 +145,23 @@ def to_dict(result) -> dict:
         quantities.append({
             "name": q.name, "kind": q.kind, "unit": q.unit, "description": q.description, "status": q.status,
             "tolerance_nrmse": _u(q.tolerance, RATIO),
-            "lumped": stats_units(q, m["reference"]), "mujoco": stats_units(q, m["test"]),
+            "reference": stats_units(q, m["reference"]), "test": stats_units(q, m["test"]),
             "errors": {"rel_rms": _u(m["rel_rms"], RATIO), "rel_peak_to_peak": _u(m["rel_peak_to_peak"], RATIO),
                        "rel_peak": _u(m["rel_peak"], RATIO), "nrmse": _u(m["nrmse"], RATIO),
                        "nrmse_ac": _u(m["nrmse_ac"], RATIO), "correlation": _u(m["correlation"], RATIO),
                        "lag": _u(m["lag_s"], "s")},
-            "integration_error": {"lumped": _u(m["integration_error"]["reference"], RATIO),
-                                  "mujoco": _u(m["integration_error"]["test"], RATIO)},
+            "integration_error": {"reference": _u(m["integration_error"]["reference"], RATIO),
+                                  "test": _u(m["integration_error"]["test"], RATIO)},
             "spectrum": [{"line": s["line"], "frequency": _u(s["frequency_hz"], "Hz"),
-                          "lumped": _u(s["reference"], q.unit), "mujoco": _u(s["test"], q.unit),
+                          "reference": _u(s["reference"], q.unit), "test": _u(s["test"], q.unit),
                           "rel_error": _u(s["rel_error"], RATIO),
                           "nrmse_part": _u(nrmse_part(s, rms), RATIO),
                           "status": line_status(s, q.status, q.tolerance, rms)} for s in q.spectrum],
             "measured": q.measured,
         })
     modes = [{"mode": r["mode"], "type": r["type"], "multiplicity": r["multiplicity"],
-              "lumped": _u(r["reference_hz"], "Hz"), "mujoco": _u(r["test_hz"], "Hz"),
-              "mujoco_type": r["test_type"], "rel_error": _u(r["rel_error"], RATIO),
+              "reference": _u(r["reference_hz"], "Hz"), "test": _u(r["test_hz"], "Hz"),
+              "test_type": r["test_type"], "rel_error": _u(r["rel_error"], RATIO),
               "status": "pass" if r["rel_error"] <= result.modal_tolerance else "fail"} for r in result.modal]
     counts = {"quantities": _count((q["status"] for q in quantities), STATUSES),
               "modes": _count((m["status"] for m in modes), ("fail", "pass")),
@@ -180,6 +180,7 @@ def to_dict(result) -> dict:
         "modes": modes,
         "modes_tolerance": _u(result.modal_tolerance, RATIO),
         "solvers": {"reference": result.solvers[0], "test": result.solvers[1]},
+        "sides": {"reference": result.kinds[0], "test": result.kinds[1]},
         "diagnosis": result.diagnosis.to_dict() if result.diagnosis is not None else None,
         "quantities": quantities,
         "measurements": result.measurements,
@@ -276,17 +277,17 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], list[st
     if data["modes"]:  # a recording without a modes file has none
         tables.append(("Natural frequencies", ["mode", "type", "mult.", f"{A} [Hz]", f"{B} [Hz]", "rel. diff.",
                                                "tol.", "status"],
-                       [[str(m["mode"]), m["type"], str(m["multiplicity"]), f"{m['lumped']['value']:.6f}",
-                         f"{m['mujoco']['value']:.6f}", f"{m['rel_error']['value']:.2e}",
+                       [[str(m["mode"]), m["type"], str(m["multiplicity"]), f"{m['reference']['value']:.6f}",
+                         f"{m['test']['value']:.6f}", f"{m['rel_error']['value']:.2e}",
                          f"{data['modes_tolerance']['value']:.0e}", m["status"]] for m in data["modes"]], []))
     rows = []
     for q in data["quantities"]:
         e, ie = q["errors"], q["integration_error"]
-        rows.append([q["name"], q["unit"], _fmt(q["lumped"]["rms"]["value"]), _fmt(q["mujoco"]["rms"]["value"]),
-                     _fmt(q["lumped"]["peak_to_peak"]["value"]), _fmt(q["mujoco"]["peak_to_peak"]["value"]),
+        rows.append([q["name"], q["unit"], _fmt(q["reference"]["rms"]["value"]), _fmt(q["test"]["rms"]["value"]),
+                     _fmt(q["reference"]["peak_to_peak"]["value"]), _fmt(q["test"]["peak_to_peak"]["value"]),
                      _fmt(e["rel_rms"] and e["rel_rms"]["value"], 3), _fmt(e["nrmse"] and e["nrmse"]["value"], 3),
                      _fmt(e["correlation"] and e["correlation"]["value"], 6), _fmt(e["lag"]["value"] * 1e6, 3),
-                     _fmt(ie["lumped"] and ie["lumped"]["value"], 2), _fmt(ie["mujoco"] and ie["mujoco"]["value"], 2),
+                     _fmt(ie["reference"] and ie["reference"]["value"], 2), _fmt(ie["test"] and ie["test"]["value"], 2),
                      _fmt(q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"], 3), q["status"]])
     tables.append(("Time-domain quantities (steady window)",
                    ["quantity", "unit", f"RMS {A}", f"RMS {B}", f"p-p {A}", f"p-p {B}", "rel. RMS err.",
@@ -297,8 +298,8 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], list[st
         if q["name"].endswith(".ay.world") or q["name"].endswith(".force"):
             tol = _fmt(q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"], 3)
             for s in q["spectrum"]:
-                rows.append([q["name"], s["line"], f"{s['frequency']['value']:.6g}", _fmt(s["lumped"]["value"]),
-                             _fmt(s["mujoco"]["value"]), _fmt(s["rel_error"] and s["rel_error"]["value"], 3),
+                rows.append([q["name"], s["line"], f"{s['frequency']['value']:.6g}", _fmt(s["reference"]["value"]),
+                             _fmt(s["test"]["value"]), _fmt(s["rel_error"] and s["rel_error"]["value"], 3),
                              _fmt(s["nrmse_part"] and s["nrmse_part"]["value"], 2), tol, s["status"]])
     tables.append(("Spectral lines (Hann-windowed amplitude)",
                    ["quantity", "line", "f [Hz]", A, B, "rel. err.", "NRMSE part", "tol.", "status"], rows,
@@ -312,8 +313,9 @@ def markdown_tables(data) -> list[tuple[str, list[str], list[list[str]], list[st
                         "err. published", f"err. {A}", f"err. {B}", "source"],
                        [[m["quantity"], m["metric"], "—" if m["sensor_band"] is None else
                          "–".join(f"{f:g}" for f in m["sensor_band"]["value"]), value(m["measured"]),
-                         value(m["published_model"]), value(m["lumped"]), value(m["mujoco"]),
-                         value(m["error_published_model"], 3), value(m["error_lumped"], 3), value(m["error_mujoco"], 3),
+                         value(m["published_model"]), value(m["reference"]), value(m["test"]),
+                         value(m["error_published_model"], 3), value(m["error_reference"], 3),
+                         value(m["error_test"], 3),
                          m["source"]] for m in data["measurements"]],
                        measurement_notes(data)))
     return [(title, header, failing_first(rows), note) for title, header, rows, note in tables]
@@ -344,8 +346,8 @@ def measurement_notes(data) -> list[str]:
     tolerance = {q["name"]: q["tolerance_nrmse"] and q["tolerance_nrmse"]["value"] for q in data["quantities"]}
     for m in data["measurements"]:
         what = f"{m['quantity']} {m['metric']}"
-        a, b, measured = m["lumped"]["value"], m["mujoco"]["value"], m["measured"]["value"]
-        ea, eb = m["error_lumped"]["value"], m["error_mujoco"]["value"]
+        a, b, measured = m["reference"]["value"], m["test"]["value"], m["measured"]["value"]
+        ea, eb = m["error_reference"]["value"], m["error_test"]["value"]
         apart = abs(b - a) / abs(a) if a else math.inf
         tol = tolerance.get(m["quantity"]) or 0.0
         if apart > tol:
@@ -394,8 +396,8 @@ def _summary_lines(data) -> list[str]:
     p = data["provenance"]
     A, B = solver_names(data)
     runs = [] if steady["how"] == "modes only" else [
-        f"Reference ({A}): {_settings_line(s['lumped'])}",
-        f"Test ({B}): {_settings_line(s['mujoco'])}"]
+        f"Reference ({A}): {_settings_line(s['reference'])}",
+        f"Test ({B}): {_settings_line(s['test'])}"]
     integration = [] if steady["how"] == "modes only" else [
         "Integration error per solver, from the same run at twice the step or half it "
         f"(check steps {', '.join(steps)}): Richardson's estimate for gearcheck's fourth-order solvers, "
@@ -406,6 +408,7 @@ def _summary_lines(data) -> list[str]:
         f"Train: {data['train']['name']} — {data['train']['description']} ({data['train']['source']})",
         f"Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
         f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})",
+        f"Sides: {A}, the {data['sides']['reference']} (reference, a); {B}, the {data['sides']['test']} (test, b)",
         *runs,
         f"gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "
         f"NumPy {p['numpy_version']}, Python {p['python']}, {p['machine']}; train {p['train_file']} "
@@ -518,18 +521,19 @@ NULLABLE_STRING, NULLABLE_NUMBER = {"type": ["string", "null"]}, {"type": ["numb
 
 
 def report_schema() -> dict:
-    """The JSON Schema (draft 2020-12) of ``report.json``, schema ``gearcheck.crosscheck`` version 1, as
+    """The JSON Schema (draft 2020-12) of ``report.json``, schema ``gearcheck.crosscheck`` version 2, as
     :func:`to_dict` writes it."""
     return {
         "$schema": DRAFT,
         "title": f"gearcheck cross-check report ({SCHEMA} version {SCHEMA_VERSION})",
         "description": "report.json of `gearcheck crosscheck`. Numbers with a unit are {value, unit} objects; "
-                       "ratios have unit '1'. 'lumped' and 'mujoco' name the reference and the test side, whatever "
-                       "their solvers ('solvers'). Only 'volatile' changes between runs of the same inputs.",
+                       "ratios have unit '1'. 'reference' and 'test' key the two sides' values; 'solvers' names them "
+                       "and 'sides' says what each is (reference lumped model, MuJoCo twin, user model, recording). "
+                       "Only 'volatile' changes between runs of the same inputs.",
         "type": "object",
         "properties": _report_properties(),
         "required": ["schema", "schema_version", "train", "calibration", "provenance", "settings", "verdict",
-                     "steady_state", "modes", "modes_tolerance", "solvers", "diagnosis", "quantities",
+                     "steady_state", "modes", "modes_tolerance", "solvers", "sides", "diagnosis", "quantities",
                      "measurements", "notes", "references", "volatile"],
         "additionalProperties": False,
         "$defs": {"value": _value(), "measurement": _measurement_schema(), "candidate": _candidate_schema()},
@@ -547,8 +551,8 @@ def _report_properties() -> dict:
                                        "null for a train file's own parameters"},
         "provenance": _object({
             "gearcheck_version": STRING, "git_revision": NULLABLE_STRING, "mujoco_version": STRING,
-            "numpy_version": STRING, "python": STRING, "machine": STRING, "lumped_solver": {"type": "object"},
-            "mujoco_solver": {"type": "object"}, "train_file": STRING, "train_sha256": STRING}),
+            "numpy_version": STRING, "python": STRING, "machine": STRING, "reference_solver": {"type": "object"},
+            "test_solver": {"type": "object"}, "train_file": STRING, "train_sha256": STRING}),
         "settings": _settings_schema(),
         "verdict": _verdict_schema(),
         "steady_state": _object({"start": seconds, "detected": BOOLEAN,
@@ -557,10 +561,11 @@ def _report_properties() -> dict:
                                  "settling_time": _value("s", nullable=True)}),
         "modes": _array(_object({
             "mode": {"type": "integer"}, "type": STRING, "multiplicity": {"type": "integer"},
-            "lumped": _value("Hz"), "mujoco": _value("Hz"), "mujoco_type": STRING, "rel_error": _value(RATIO),
+            "reference": _value("Hz"), "test": _value("Hz"), "test_type": STRING, "rel_error": _value(RATIO),
             "status": {"enum": ["fail", "pass"]}})),
         "modes_tolerance": _value(RATIO),
         "solvers": _object({"reference": STRING, "test": STRING}),
+        "sides": _object({"reference": STRING, "test": STRING}),
         "diagnosis": _diagnosis_schema(),
         "quantities": _array(_quantity_schema()),
         "measurements": _array({"$ref": "#/$defs/measurement"}),
@@ -578,7 +583,7 @@ def _settings_schema() -> dict:
     seconds = _value("s")
     properties = {
         "duration": seconds, "simulated": seconds, "input_speed": _value("rpm"),
-        "output_torque": _value("N·m"), "lumped": {"type": "object"}, "mujoco": {"type": "object"},
+        "output_torque": _value("N·m"), "reference": {"type": "object"}, "test": {"type": "object"},
         "common_sample_rate": _value("Hz"), "steady_cycle": seconds,
         "integration_check_steps": _value("s", {"type": "array", "items": NULLABLE_NUMBER}),
         "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
@@ -609,7 +614,9 @@ def _diagnosis_schema() -> dict:
         "train": STRING, "agrees": BOOLEAN, "reduced_to": {"type": ["integer", "null"]},
         "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
         "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
-        "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"})}),
+        "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"}),
+        "rigid_modes": _object({k: {"type": "integer"} for k in ("evidence", "reference")}),
+        "pairs": {"type": "integer"}}),
         {"type": "null"}], "description": "a user's model: the term of the reference that best explains "
                                           "its modes; null otherwise"}
 
@@ -621,19 +628,19 @@ def _quantity_schema() -> dict:
     return _object({
         "name": STRING, "kind": STRING, "unit": STRING, "description": STRING,
         "status": {"enum": list(STATUSES)}, "tolerance_nrmse": ratio_or_null,
-        "lumped": stats, "mujoco": stats,
+        "reference": stats, "test": stats,
         "errors": _object({"rel_rms": ratio_or_null, "rel_peak_to_peak": ratio_or_null, "rel_peak": ratio_or_null,
                            "nrmse": ratio_or_null, "nrmse_ac": ratio_or_null, "correlation": ratio_or_null,
                            "lag": _value("s")}),
-        "integration_error": _object({"lumped": ratio_or_null, "mujoco": ratio_or_null}),
+        "integration_error": _object({"reference": ratio_or_null, "test": ratio_or_null}),
         "spectrum": _array(_object({
-            "line": STRING, "frequency": _value("Hz"), "lumped": {"$ref": "#/$defs/value"},
-            "mujoco": {"$ref": "#/$defs/value"}, "rel_error": ratio_or_null,
+            "line": STRING, "frequency": _value("Hz"), "reference": {"$ref": "#/$defs/value"},
+            "test": {"$ref": "#/$defs/value"}, "rel_error": ratio_or_null,
             "nrmse_part": ratio_or_null, "status": {"enum": ["fail", "pass", "negligible"]},
         }), "spectral lines; status advisory: fail when |rel_error| exceeds the quantity's NRMSE tolerance and "
             f"nrmse_part is at least {LINE_SHARE:g} of it"),
         "measured": _array({"$ref": "#/$defs/measurement"}),
-    }, description="one compared signal: 'lumped' is the reference (a), 'mujoco' the test (b) whatever solvers")
+    }, description="one compared signal: 'reference' is the reference side (a), 'test' the test side (b)")
 
 
 def _measurement_schema() -> dict:
@@ -642,9 +649,9 @@ def _measurement_schema() -> dict:
     return _object({
         "quantity": STRING, "metric": {"enum": list(MEASUREMENT.fields["metric"].choices)}, "source": STRING,
         "sensor_band": _value("Hz", {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}, True),
-        "measured": {"$ref": "#/$defs/value"}, "lumped": {"$ref": "#/$defs/value"},
-        "mujoco": {"$ref": "#/$defs/value"}, "published_model": _value(nullable=True),
-        "error_lumped": ratio, "error_mujoco": ratio, "error_published_model": _value(RATIO, nullable=True),
+        "measured": {"$ref": "#/$defs/value"}, "reference": {"$ref": "#/$defs/value"},
+        "test": {"$ref": "#/$defs/value"}, "published_model": _value(nullable=True),
+        "error_reference": ratio, "error_test": ratio, "error_published_model": _value(RATIO, nullable=True),
     }, description="a measured value beside both solvers' statistic of it; errors (model - measured)/|measured|")
 
 
@@ -653,6 +660,6 @@ def _candidate_schema() -> dict:
     return _object({
         "term": STRING, "kind": {"enum": list(KINDS)}, "score": NUMBER,
         "parts": {"type": "object", "additionalProperties": NUMBER}, "row": STRING, "coordinate": STRING,
-        "member": STRING, "factor": NUMBER, "coordinates": _array(STRING),
-        "equivalents": _array({"$ref": "#/$defs/candidate"}),
-    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference")
+        "member": STRING, "factor": NUMBER, "stiffness": NUMBER, "coordinates": _array(STRING),
+        "equivalents": _array({"$ref": "#/$defs/candidate"}), "pair": _array({"$ref": "#/$defs/candidate"}),
+    }, required=["term", "kind", "score", "parts"], description="a one-term change of the reference (or a pair)")

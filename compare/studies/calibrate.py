@@ -30,7 +30,7 @@ from scipy.optimize import least_squares
 from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.measure import MIN_CYCLES, measure
 from gearcheck.lumped.assembly import build_model
-from gearcheck.train.kinematics import kinematics
+from gearcheck.train.kinematics import kinematics, require_mesh_cycle
 from gearcheck.train.loader import load_text, load_train
 from gearcheck.lumped.modal import settling_time
 from gearcheck.train.spec import beside, named_file
@@ -172,6 +172,7 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
     if not entries:
         raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or measurements=")
     base_spec = load_text(text, source)
+    require_mesh_cycle(base_spec, "a calibration (its time runs)")
     base_rpm = rad_s_to_rpm(base_spec.operating.input_speed)
     rpm = _speeds(entries, base_rpm)
     used = [fit_speeds is None or any(abs(r - f) <= SPEED_MATCH * f for f in fit_speeds) for r in rpm]

@@ -113,7 +113,8 @@ def phasing_rule(spec) -> tuple[int, int] | None:
     simple = all(spec.members[p].kind == "planet" and len(spec.members[p].gears) == 1 for p in stage.planets)
     if not stage.equally_spaced or len(suns) != 1 or len(suns[0].gears) != 1 or not simple:
         return None
-    return len(stage.planets), next(iter(suns[0].gears.values())).teeth
+    teeth = next(iter(suns[0].gears.values())).teeth
+    return None if teeth is None else (len(stage.planets), teeth)  # an idealised sun has no teeth to phase
 
 
 def excites(harmonic: int, kind: str, planets: int, sun_teeth: int) -> bool | None:
@@ -126,11 +127,15 @@ def excites(harmonic: int, kind: str, planets: int, sun_teeth: int) -> bool | No
 
 
 def _mesh_lines(spec, harmonics: int) -> list[dict]:
-    """Each distinct mesh frequency per rpm of the input, with the meshes that have it, times 1..harmonics."""
-    kin = kinematics(spec)
+    """Each distinct mesh frequency per rpm of the input, with the meshes that have it, times 1..harmonics (a train
+    at rest: its lines turning; an idealised mesh has no mesh cycle, so no line)."""
+    turning = spec if spec.operating.input_speed else spec.with_operating(input_speed=np.pi / 30.0)
+    kin = kinematics(turning)
     per_rpm: dict[float, list[str]] = {}
-    rpm = spec.operating.input_speed * 30.0 / np.pi
+    rpm = turning.operating.input_speed * 30.0 / np.pi
     for mesh_id, f in kin.mesh_frequency.items():
+        if f == 0.0:
+            continue
         key = round(f / rpm, 12)
         per_rpm.setdefault(key, []).append(mesh_id)
     return [{"meshes": sorted(ids), "harmonic": h, "hz_per_rpm": slope * h}

@@ -31,6 +31,7 @@ from gearcheck.lumped.fourier_response import (
     fourier_series_response,
     harmonic_balance_response,
 )
+from gearcheck.train.kinematics import require_mesh_cycle
 from gearcheck.train.loader import load_text, load_train
 from gearcheck.train.spec import ROTATION
 from gearcheck.lumped.response_sensitivity import (
@@ -113,6 +114,8 @@ def field_sensitivity(text: str, source: str, parameter: str, orders=None, metho
     ``step``, the whole response with ``check_step``; ``grids`` go to
     :func:`~gearcheck.lumped.forced_response.parametric_problem`."""
     _check(method)
+    spec = load_text(text, source)
+    require_mesh_cycle(spec if speed is None else spec.with_operating(input_speed=1.0), "a response sensitivity")
     field = FitParameter.parse(parameter, "parameter")
     value = field.get(tomllib.loads(text))
     contacts: dict = {}
@@ -203,24 +206,41 @@ def coordinate_unit(coordinate: str) -> str:
 
 
 def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, coordinate: str, orders=None,
-                    method: str = METHODS[1], progress=None, **grids):
+                    method: str = METHODS[1], progress=None, values=None, **grids):
     """d|Q_h|/d ln p of ``coordinate`` (a model coordinate, ``rv.carrier.theta``) for each parameter at each input
     speed (the paper's Figs. 5-10 over the mesh frequency), with the paper's Eq. (15) beside it for the
-    Fourier-series method.  The pins' contact pattern is that of the first speed at every speed (it moves only
-    with the rotating-frame terms); ``grids`` default to :data:`MAP_GRIDS`.  A pandas DataFrame, one row per
-    speed, parameter and harmonic (:data:`HARMONIC_NOTATION`), amplitudes and their derivatives in
-    ``amplitude_unit`` (:func:`coordinate_unit`)."""
+    Fourier-series method; with ``values``, of the one parameter set to each of those values (the file's unit) at
+    each speed (the paper's Figs. 6, 8 and 10: the sensitivity against the parameter at a constant speed).  Over
+    speeds the pins' contact pattern is that of the first speed at every speed (it moves only with the
+    rotating-frame terms); over values each value has its own.  ``grids`` default to :data:`MAP_GRIDS`.  A pandas
+    DataFrame, one row per speed, parameter, value and harmonic (:data:`HARMONIC_NOTATION`), amplitudes and their
+    derivatives in ``amplitude_unit`` (:func:`coordinate_unit`), ``d_amplitude_d_p`` per unit of the number;
+    ``negligible`` where d|Q_h|/d ln p or |Q_h| itself is round-off, below :data:`NULL` of the point's largest
+    harmonic (a harmonic the planets' phasing cancels; a
+    response that does not depend on the number: an RV reducer's in-phase planets never load the sun's
+    translations, so nothing depends on its support or its mass)."""
     import pandas as pd
 
     grids = grids or MAP_GRIDS
     _check(method)
     fields = [FitParameter.parse(p, "parameters") for p in parameters]
     document = tomllib.loads(text)
-    values = [f.get(document) for f in fields]
+    if values is None:
+        points = [(rpm, None, [(f, f.get(document)) for f in fields]) for rpm in speeds_rpm]
+    else:
+        if len(fields) != 1:
+            raise GearcheckError(f"parameters={parameters}: the sensitivity over values takes one parameter")
+        for v in values:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v == 0:
+                raise GearcheckError(f"values: {v!r} is no value of {fields[0].path} to differentiate at (a finite, "
+                                     "non-zero number in the file's unit)")
+        points = [(rpm, fields[0], [(fields[0], float(v))]) for rpm in speeds_rpm for v in values]
     contacts: dict = {}
     rows = []
-    for k, rpm in enumerate(speeds_rpm):
-        model = _model(text, source, None, None, rpm)
+    for k, (rpm, moved, at) in enumerate(points):
+        if moved is not None:
+            contacts = {}  # each value's own contact pattern
+        model = _model(text, source, moved, at[0][1], rpm)
         labels = model.dofs.labels()
         if coordinate not in labels:
             raise GearcheckError(f"coordinate={coordinate!r}: not a coordinate of {model.spec.name}"
@@ -229,19 +249,23 @@ def sensitivity_map(text: str, source: str, parameters: list[str], speeds_rpm, c
         base = parametric_problem(model, contacts=contacts, **grids)
         orders = lattice(base, orders)
         f_mesh = float(model.excitation.frequency.min())
-        for field, value in zip(fields, values):
+        for field, value in at:
             h = STEP * value
             plus, minus = (_problem(text, source, field, value + s, rpm, contacts, grids) for s in (h, -h))
             full, truncated = _closed_form(base, _derivative(base, plus, minus, h), orders, method)
+            level = NULL * float(np.abs(full.response.amplitudes[:, index]).max())  # round-off of d|Q|/d ln p
             for j, hk in enumerate(full.response.harmonics):
                 rows.append({"speed_rpm": float(rpm), "mesh_frequency_hz": f_mesh, "parameter": field.path,
-                             "harmonic": str(tuple(int(x) for x in hk)),
+                             "value": value, "harmonic": str(tuple(int(x) for x in hk)),
                              "frequency_hz": float(full.response.frequencies[j]) / (2 * np.pi),
                              "amplitude": float(np.abs(full.response.amplitudes[j, index])),
                              "amplitude_unit": coordinate_unit(coordinate),
+                             "d_amplitude_d_p": float(full.d_modulus[j, index]),
                              "d_amplitude_d_ln_p": float(full.d_modulus[j, index]) * value,
                              "eq15_d_amplitude_d_ln_p": None if truncated is None
-                             else float(truncated[j, index]) * value})
+                             else float(truncated[j, index]) * value,
+                             "negligible": float(np.abs(full.response.amplitudes[j, index])) <= level
+                             or abs(float(full.d_modulus[j, index]) * value) <= level})
         if progress is not None:
-            progress((k + 1) / len(speeds_rpm))
+            progress((k + 1) / len(points))
     return pd.DataFrame(rows)

@@ -40,7 +40,7 @@ from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError, did_you_mean, one_line
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
 from gearcheck.shared.trust import granted
-from gearcheck.shared.units import checked_rpm
+from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
 from gearcheck.train.files import report_folders, train_list
 
 
@@ -275,7 +275,8 @@ def cmd_show(args) -> int:
               f"{st['carrier_radius_m'] * 1e3:.6g} mm")
         for name, g in st["gears"].items():
             helix = f"  beta={g['helix_angle_deg']:+.6g} deg" if g["helix_angle_deg"] else ""
-            print(f"    {name:<16} z={g['teeth']:<4d} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
+            teeth = "—" if g["teeth"] is None else g["teeth"]  # an idealised gear's
+            print(f"    {name:<16} z={teeth:<4} r_pitch={g['pitch_radius_m'] * 1e3:.6g} mm  "
                   f"r_base={g['base_radius_m'] * 1e3:.6g} mm  r_tip={g['tip_radius_m'] * 1e3:.6g} mm{helix}")
         if "cycloid" in st:
             c = st["cycloid"]
@@ -291,7 +292,8 @@ def cmd_show(args) -> int:
     print("  meshes:")
     for m in info["meshes"]:
         face = f"+{m['face_contact_ratio']:.4f}" if m["face_contact_ratio"] else ""
-        print(f"    {m['mesh']:<24} eps={m['contact_ratio']:.4f}{face}  "
+        eps = "—" if m["contact_ratio"] is None else f"{m['contact_ratio']:.4f}"  # an idealised mesh has none
+        print(f"    {m['mesh']:<24} eps={eps}{face}  "
               f"alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
               f"f_mesh={m['mesh_frequency_hz']:.6g} Hz  phase={m['phase_cycles']:.4f}  "
               f"k={m['mean_stiffness_n_per_m']:.4g} N/m ({m['stiffness_model']})  c={m['damping_n_s_per_m']:.4g} N·s/m")
@@ -441,7 +443,20 @@ def cmd_sensitivity(args) -> int:
         checked_rpm(rpm, "--speeds: every speed")
     index = _coordinate(spec, coordinate)
     with OutputDirectory(args.out) as place:
-        if args.speeds:
+        if args.values:
+            speeds = args.speeds or [rad_s_to_rpm(spec.operating.input_speed)]
+            bar = ProgressBar(f"sensitivity over {args.parameter[0]}")
+            frame = sensitivity.sensitivity_map(text, source, args.parameter, speeds, coordinate, args.orders, method,
+                                                progress=bar, values=args.values)
+            bar.close()
+            frame.to_csv(place.path / "sensitivity_values.csv", index=False, float_format="%.10g")
+            write_file(place.path / "sensitivity_values.png", plots.sensitivity_values(
+                frame, coordinate, f"{spec.name}: sensitivity of {coordinate} to {args.parameter[0]}"))
+            written = ["sensitivity_values.csv", "sensitivity_values.png"]
+            if frame["negligible"].all():
+                print(f"{args.parameter[0]}: the response of {coordinate} does not depend on it at these values and "
+                      "speeds (every derivative is round-off: negligible)")
+        elif args.speeds:
             bar = ProgressBar(f"sensitivity map {spec.name}")
             frame = sensitivity.sensitivity_map(text, source, args.parameter, args.speeds, coordinate,
                                                 args.orders, method, progress=bar)
@@ -947,6 +962,9 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="harmonics kept per clock (mesh, then an RV reducer's eccentrics), default 3 2"),
         arg("--speeds", type=SPEED_RANGE, metavar="A:B:N",
             help="a map over input speeds (rpm) instead of the train's speed"),
+        arg("--values", type=float, nargs="+", metavar="V",
+            help="the sensitivity against the one --parameter set to each value (the file's unit), at the train's "
+                 "speed or each of --speeds (Yang, Chen & Wang 2018, Figs. 6, 8, 10)"),
         arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "pins": Command(

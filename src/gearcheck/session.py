@@ -32,6 +32,7 @@ from gearcheck.shared.progress import shows_progress
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import checked_rpm, rpm_to_rad_s
+from gearcheck.train.kinematics import require_mesh_cycle
 from gearcheck.train.loader import load_train
 from gearcheck.train.spec import TrainSpec
 
@@ -86,6 +87,7 @@ class Train:
         """A time run at the session's operating point.  See :func:`gearcheck.simulate`; ``y0``: the lumped
         model's start (q, q_dot) over its coordinates (``lumped.model.dofs.labels()``) instead of the static
         one, e.g. the end of another run (a sweep that follows one branch of a nonlinear response)."""
+        require_mesh_cycle(self.spec, "a time run")
         settings, side = RunSettings(duration, dt, output_dt, settle), self.side(solver, method)
         if y0 is None:
             return side.run(settings, progress)
@@ -119,6 +121,7 @@ class Train:
         methods = {"harmonic balance": harmonic_balance_response, "Fourier series": fourier_series_response}
         if method not in methods:
             raise GearcheckError(f"method {method!r}: one of {', '.join(methods)}")
+        require_mesh_cycle(self.spec, "a forced response")
         problem = parametric_problem(self.lumped.model)
         return methods[method](problem, lattice(problem, orders))
 
@@ -126,11 +129,13 @@ class Train:
         """The static transmission error of every mesh over one mesh cycle, unloaded and under the train's load
         (:func:`gearcheck.lumped.transmission_error.static_transmission_error`; ``slices``: face-width slices
         of a helical mesh)."""
+        require_mesh_cycle(self.spec, "the static transmission error")
         return static_transmission_error(self.spec, slices=slices)
 
     def relief_sweep(self, amounts, slices: int | None = None) -> dict:
         """The loaded static transmission error's peak-to-peak of the first planet's relieved meshes at each tip
         relief amount of ``amounts`` (m) (:func:`gearcheck.lumped.transmission_error.relief_sweep`)."""
+        require_mesh_cycle(self.spec, "a relief sweep")
         return relief_sweep(self.spec, amounts, slices=slices)
 
     @shows_progress
@@ -144,6 +149,8 @@ class Train:
 
         if speeds is None and self.speed is not None:
             speeds = [self.speed]
+        # at speeds of its own a sweep's train turns; its stages still need teeth
+        require_mesh_cycle(self.spec if speeds is None else self.spec.with_operating(input_speed=1.0), "a sweep")
         return sweep(self.source, speeds=speeds, fields=fields, distributions=distributions, samples=samples,
                      seed=seed, solvers=solver, duration=duration, harmonics=harmonics,
                      integration_check=integration_check, refine=refine, workers=workers, scheduler=scheduler,
@@ -156,6 +163,7 @@ class Train:
         from gearcheck.compare.presentation.animate import animate, animate_mode
 
         if mode is None:
+            require_mesh_cycle(self.spec, "an animation of the running twin (--mode animates a mode)")
             return animate(self.mujoco.model, path, **options)
         return animate_mode(self.mujoco.model, path, mode, solver, self.modes(solver), **options)
 
@@ -187,4 +195,5 @@ class Train:
         magnified ``magnify`` times, until the window closes (needs a display)."""
         from gearcheck.compare.presentation.live_view import live_view
 
+        require_mesh_cycle(self.spec, "the viewer's running twin")
         live_view(self.mujoco.model, slow_motion=slow_motion, magnify=magnify)

@@ -230,6 +230,9 @@ def train_signals(spec) -> list[Signal]:
                 signals.append(Signal(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
                                       f"{mid} acceleration along {axis} ({frame} frame)", gated))
         signals.append(Signal(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", gated))
+        if member.axial:
+            signals.append(Signal(f"{mid}.az", "acceleration", "m/s^2", f"{mid} acceleration along the stage axis",
+                                  gated))
     for mesh in spec.meshes:
         signals += [Signal(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force"),
                     Signal(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error"),
@@ -252,22 +255,26 @@ def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflecti
                  pin_force=None) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
-    acc_carrier: (n_t, n_members, 3) inertial acceleration of each member's centre along its carrier's
-    axes, and its angular acceleration; carrier_angle: (n_t, n_members) angle of those axes
-    (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force
-    (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and bearings are the
-    run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
+    acc_carrier: (n_t, n_members, 4) inertial acceleration of each member's centre along its carrier's axes, its
+    angular acceleration and its acceleration along the stage axis (read for members that slide); carrier_angle:
+    (n_t, n_members) angle of those axes (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes``
+    order; bearing_force (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and
+    bearings are the run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
     :func:`disc_names` order (an RV reducer's)."""
     signals = train_signals(spec)
     values = np.empty((len(t), len(signals)))
-    for j in range(len(spec.members)):  # member by member: small temporaries
+    col = 0
+    for j, member in enumerate(spec.members.values()):  # member by member: small temporaries
         a = acc_carrier[:, j, :]
         c, s = np.cos(carrier_angle[:, j]), np.sin(carrier_angle[:, j])
-        values[:, 5 * j] = c * a[:, 0] - s * a[:, 1]
-        values[:, 5 * j + 1] = s * a[:, 0] + c * a[:, 1]
-        values[:, 5 * j + 2:5 * j + 5] = a
-    col = _fill(values, 5 * len(spec.members),
-                [mesh_force, mesh_deflection, mesh_force / np.asarray(static_mesh_force), mesh_stiffness])
+        values[:, col] = c * a[:, 0] - s * a[:, 1]
+        values[:, col + 1] = s * a[:, 0] + c * a[:, 1]
+        values[:, col + 2:col + 5] = a[:, :3]
+        col += 5
+        if member.axial:
+            values[:, col] = a[:, 3]
+            col += 1
+    col = _fill(values, col, [mesh_force, mesh_deflection, mesh_force / np.asarray(static_mesh_force), mesh_stiffness])
     col = _fill(values, col, [bearing_force])
     if disc_names(spec):
         _fill(values, col, [pin_force.max(axis=-1), (pin_force > 0).sum(axis=-1)])

@@ -28,6 +28,7 @@ class Side(ABC):
     """A model of the train ``spec`` as the cross-check sees it."""
 
     solver: str  # how reports name it: "lumped", "mujoco", "as-published", ...
+    kind: str = "model"  # what it is, as every report says: "reference lumped model", "MuJoCo twin", "user model", ...
     spec: object  # the TrainSpec it models
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES its equations come from
     rerunnable: bool = True  # run() integrates anew at the settings asked (False: a recording, as it is)

@@ -7,6 +7,10 @@ dedenda and profile shifts stay in normal modules (x m_n) and the profile shift'
 thickness and operating pressure angle goes with tan(alpha_n) (ISO 21771, clauses 4-5).  With
 beta = 0 every formula is the spur one.
 
+An idealised gear (``teeth`` None) is what published modal models describe: a base radius and a pressure
+angle, no teeth, module or tooth geometry.  Its pitch, tip and root circles are its operating pitch circle
+r_b / cos(alpha_t), a plain cylinder; it has no base pitch (nan) and no contact ratio.
+
 Internal gears (rings) use positive teeth counts with ``internal=True``; a positive
 profile shift of a ring moves its teeth outward (larger tip radius, larger operating
 centre distance), so that for an internal pair
@@ -38,12 +42,12 @@ class Gear:
     """One gear's tooth geometry; lengths in m, angles in rad."""
 
     name: str
-    teeth: int
-    module: float
+    teeth: int | None  # None: an idealised gear (base radius and pressure angle only)
+    module: float | None
     pressure_angle: float
-    face_width: float
-    addendum: float
-    dedendum: float
+    face_width: float  # 0 when an idealised gear gives none
+    addendum: float | None
+    dedendum: float | None
     profile_shift: float
     internal: bool
     base_radius: float
@@ -57,9 +61,9 @@ class Gear:
     relief_power: int = 1  # 1 linear, 2 parabolic
 
     @property
-    def normal_module(self) -> float:
-        """m_n = m_t cos(beta): the unit of addenda, dedenda and profile shifts."""
-        return self.module * math.cos(self.helix_angle)
+    def normal_module(self) -> float | None:
+        """m_n = m_t cos(beta): the unit of addenda, dedenda and profile shifts (None for an idealised gear)."""
+        return None if self.idealised else self.module * math.cos(self.helix_angle)
 
     @property
     def normal_pressure_angle(self) -> float:
@@ -81,12 +85,21 @@ class Gear:
         return (self.helix_angle > 0) - (self.helix_angle < 0)
 
     @property
+    def idealised(self) -> bool:
+        """No teeth: a base radius and a pressure angle, as published modal models give a gear."""
+        return self.teeth is None
+
+    @property
     def pitch_radius(self) -> float:
+        if self.idealised:
+            return self.base_radius / math.cos(self.pressure_angle)
         return 0.5 * self.module * self.teeth
 
     @property
     def tip_radius(self) -> float:
         """Addendum circle; for a ring the inner (tooth tip) circle."""
+        if self.idealised:
+            return self.pitch_radius
         m, x = self.normal_module, self.profile_shift
         if self.internal:
             return self.pitch_radius - m * (self.addendum - x)
@@ -94,6 +107,8 @@ class Gear:
 
     @property
     def root_radius(self) -> float:
+        if self.idealised:
+            return self.pitch_radius
         m, x = self.normal_module, self.profile_shift
         if self.internal:
             return self.pitch_radius + m * (self.dedendum + x)
@@ -101,7 +116,8 @@ class Gear:
 
     @property
     def base_pitch(self) -> float:
-        return 2.0 * math.pi * self.base_radius / self.teeth
+        """2 pi r_b / z; nan for an idealised gear."""
+        return math.nan if self.idealised else 2.0 * math.pi * self.base_radius / self.teeth
 
 
 @dataclass(frozen=True)
@@ -167,6 +183,22 @@ def mesh_geometry(central: Gear, planet: Gear) -> MeshGeometry:
         face_contact_ratio=width * abs(math.sin(central.helix_angle)) / (math.pi * central.normal_module),
         face_width=width,
     )
+
+
+def idealised_mesh_geometry(central: Gear, planet: Gear) -> MeshGeometry:
+    """The operating geometry of a pair of idealised gears: the line of action tangent to both base circles at the
+    central gear's (transverse) pressure angle, a' = (r_bc +- r_bp) / cos a ('-' for a ring); no contact ratio or
+    base pitch (nan).  A ValueError when a ring's base circle does not enclose the planet's."""
+    alpha = central.pressure_angle
+    a_ref = central.base_radius - planet.base_radius if central.internal else central.base_radius + planet.base_radius
+    if a_ref <= 0.0:
+        raise ValueError(f"a ring's base radius ({central.base_radius * 1e3:.6g} mm) must exceed its planet's "
+                         f"({planet.base_radius * 1e3:.6g} mm)")
+    return MeshGeometry(
+        pressure_angle=alpha, centre_distance=a_ref / math.cos(alpha), contact_ratio=math.nan, base_pitch=math.nan,
+        central_pitch_radius=central.base_radius / math.cos(alpha),
+        planet_pitch_radius=planet.base_radius / math.cos(alpha), base_helix_angle=central.base_helix_angle,
+        face_width=min(central.face_width, planet.face_width))
 
 
 def reference_tooth_thickness(gear: Gear) -> float:
@@ -237,18 +269,27 @@ def gear_problem(gear: Gear) -> tuple[str, str] | None:
     return None
 
 
+def helix_problem(central: Gear, planet: Gear) -> str | None:
+    """Why the pair's helices cannot mesh, or None: an internal pair's helices run the same way, an external
+    pair's opposite (idealised gears too: the helix sets the line of action's axial part)."""
+    same_hand = central.internal
+    if central.helix_angle != (planet.helix_angle if same_hand else -planet.helix_angle):
+        return (f"helix angle {math.degrees(central.helix_angle):.6g} deg cannot mesh with "
+                f"{planet.name}'s {math.degrees(planet.helix_angle):.6g} deg: an "
+                f"{'internal' if same_hand else 'external'} pair needs equal helix angles of "
+                f"{'the same' if same_hand else 'opposite'} hand (positive = right hand)")
+    return None
+
+
 def mesh_problem(central: Gear, planet: Gear, geometry: MeshGeometry) -> tuple[str, str, str] | None:
     """(which gear: "central" or "planet", the field to blame, message) of the first thing that stops the pair
     meshing as involutes, or None: helices that do not match, base pitches that differ (an explicit base radius
     can make them: the meshes would turn at different frequencies), tips meeting the mate below its base circle
     (involute interference), tips hitting the mate's root circle, a contact ratio below ``MIN_CONTACT_RATIO``
     (transverse and face together for a helical pair)."""
-    same_hand = central.internal  # an internal pair's helices run the same way, an external pair's opposite
-    if central.helix_angle != (planet.helix_angle if same_hand else -planet.helix_angle):
-        return "central", "teeth", (f"helix angle {math.degrees(central.helix_angle):.6g} deg cannot mesh with "
-                                    f"{planet.name}'s {math.degrees(planet.helix_angle):.6g} deg: an "
-                                    f"{'internal' if same_hand else 'external'} pair needs equal helix angles of "
-                                    f"{'the same' if same_hand else 'opposite'} hand (positive = right hand)")
+    helix = helix_problem(central, planet)
+    if helix:
+        return "central", "teeth", helix
     if abs(central.base_pitch - planet.base_pitch) > BASE_PITCH_TOLERANCE * planet.base_pitch:
         return "central", "base_radius_mm", (
             f"base pitch {central.base_pitch * 1e3:.6g} mm, planet gear {planet.name}'s "

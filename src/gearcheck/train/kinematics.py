@@ -7,6 +7,11 @@
   torsional statics solve with the load torque on the output;
 * mesh frequencies z_C |w_C - w_carrier| / 2 pi and mesh phases (Parker & Lin 2004).
 
+The speeds follow from the lines of action (base radii and pitch points), never from tooth counts, so an idealised
+stage (no teeth) turns like a toothed one with the same base radii.  An idealised mesh has no mesh cycle: its
+frequency and phase are 0 (its stiffness is constant).  At input speed 0 (modal work) every member is at rest and
+the ratio is that of the train turning.
+
 These are properties of the train description, shared by both models.
 """
 
@@ -66,8 +71,10 @@ def kinematics(spec) -> Kinematics:
     free = [i for i in range(n) if i not in fixed]
 
     # --- speeds: rows @ w = 0 with w_input given, held = 0
+    w_in = spec.operating.input_speed
+    w_ref = w_in or 1.0  # at rest (modal work), the ratio of the train turning at 1 rad/s
     w = np.zeros(n)
-    w[index[spec.input]] = spec.operating.input_speed
+    w[index[spec.input]] = w_ref
     A = rows[:, free]
     rhs = -rows @ w
     sol, *_ = np.linalg.lstsq(A, rhs, rcond=None)
@@ -80,10 +87,11 @@ def kinematics(spec) -> Kinematics:
     if not _consistent(A, rhs):
         raise _locked(spec, rows, labels, free, rhs, index)
     w[free] = sol
-    speeds = {mid: float(w[i]) for mid, i in index.items()}
-    w_out = speeds[spec.output]
-    if abs(w_out) < 1e-12 * abs(spec.operating.input_speed):
+    w_out = float(w[index[spec.output]])
+    if abs(w_out) < 1e-12 * abs(w_ref):
         raise TrainFileError(spec.path, "train.output", f"{spec.output} does not turn when the input turns")
+    ratio = w_ref / w_out
+    speeds = {mid: float(w[i]) * (w_in / w_ref) + 0.0 for mid, i in index.items()}  # + 0.0: at rest no -0
     for mesh in spec.meshes:
         v = abs(speeds[mesh.central] - speeds[f"{mesh.stage}.carrier"]) * mesh.geometry.central_pitch_radius
         if v > MAX_PITCH_LINE_SPEED:
@@ -107,7 +115,7 @@ def kinematics(spec) -> Kinematics:
     for mesh in spec.meshes:
         carrier = f"{mesh.stage}.carrier"
         rel = speeds[mesh.central] - speeds[carrier]
-        z = mesh.central_gear.teeth
+        z = mesh.central_gear.teeth or 0  # an idealised mesh: no mesh cycle
         freq[mesh.id] = z * abs(rel) / (2 * math.pi)
         psi = spec.members[mesh.planet].angle
         phase[mesh.id] = (math.copysign(1.0, rel) * z * psi / (2 * math.pi) + _sun_ring_offset(spec, mesh)) % 1.0
@@ -115,9 +123,23 @@ def kinematics(spec) -> Kinematics:
     for part in spec.parts:  # the other parts' periodic contacts (an RV reducer's pins)
         freq.update(part.frequencies(speeds))
 
-    ratio = spec.operating.input_speed / w_out
     t_in = -t_out / ratio if load > 0 else 0.0
     return Kinematics(speeds, flanks, freq, phase, ratio, t_in, t_out if load > 0 else 0.0)
+
+
+def require_mesh_cycle(spec, what: str) -> None:
+    """Refuse ``what`` (a time run, a cross-check, ...) on a train without a mesh cycle to run over: one at rest
+    (input speed 0: modal work only) or with an idealised stage (no teeth: no mesh frequency, phase or tooth
+    pairs), naming the field."""
+    if spec.operating.input_speed == 0.0:
+        raise TrainFileError(spec.path, "operating.input_speed_rpm", f"0: {what} needs the train turning (at rest "
+                                                                     "only modes, campbell and mac apply; give a "
+                                                                     "speed)")
+    for i, stage in enumerate(spec.stages):
+        if stage.idealised:
+            raise TrainFileError(spec.path, f"stages[{i}].planet.teeth", f"missing: {what} needs the teeth of "
+                                                                        f"idealised stage {stage.name} (its mesh "
+                                                                        "cycle); its modes need none")
 
 
 def _sun_ring_offset(spec, mesh) -> float:
@@ -133,7 +155,7 @@ def _sun_ring_offset(spec, mesh) -> float:
     gamma_rs = 0 for odd and 1/2 for even planet tooth counts (measured at the pitch
     points).  Compound planets: 0 (the angle between their two gears is a design choice).
     """
-    if not mesh.internal:
+    if not mesh.internal or mesh.central_gear.idealised:
         return 0.0
     suns = [m for m in spec.meshes if m.planet == mesh.planet and not m.internal]
     if len(suns) != 1 or suns[0].planet_gear != mesh.planet_gear:

@@ -36,6 +36,7 @@ class MeshStiffness:
 
     name = ""
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
+    needs_teeth = True  # built from tooth geometry (contact ratio, profiles): refused for an idealised mesh
     parameters = Table({"mean": Positive("mean mesh stiffness over a mesh cycle", "N/m", REQUIRED, bound("stiffness"))})
 
     def __init__(self, params: dict, mesh):
@@ -80,6 +81,7 @@ class ConstantStiffness(MeshStiffness):
 
     name = "constant"
     breaks = ()
+    needs_teeth = False
 
     def __call__(self, xi):
         return np.full_like(np.asarray(xi, dtype=float), self.mean)

@@ -296,7 +296,8 @@ def _scale(value, factor: float):
 # --------------------------------------------------------------------------------------
 
 GEOMETRY = {
-    "teeth": Integer("number of teeth (ring: internal teeth)", minimum=1, maximum=int(bound("teeth"))),
+    "teeth": Integer("number of teeth (ring: internal teeth); omit, giving `base_radius_mm`, for an idealised gear "
+                     "(see *Idealised stages*)", None, minimum=1, maximum=int(bound("teeth"))),
     "module_mm": Number("normal module m_n (a spur gear's module); defaults to the stage's module", "mm", None,
                         MIN_MODULE_MM, False, bound("module", MM)),
     "pressure_angle_deg": Number("normal pressure angle; defaults to the stage's", "deg", None, 0.0, True, 45.0),
@@ -308,8 +309,8 @@ GEOMETRY = {
     "dedendum_coefficient": NonNegative("dedendum h_f* in modules; defaults to the stage's", "-", None, 3.0),
     "profile_shift": Number("profile shift coefficient x (ring: positive moves the teeth outward)", "-", 0.0,
                             -3.0, False, 3.0),
-    "base_radius_mm": Positive("base radius; derived from module, teeth and pressure angle unless given", "mm", None,
-                               bound("length", MM)),
+    "base_radius_mm": Positive("base radius; derived from module, teeth and pressure angle unless given (an "
+                               "idealised gear's only size)", "mm", None, bound("length", MM)),
     "eccentricity_um": NonNegative("eccentricity (run-out) of the gear's pitch circle", "µm", 0.0,
                                    bound("displacement", UM)),
     "eccentricity_phase_deg": Number("angle of the eccentricity at t = 0, in the member's own frame", "deg", 0.0,
@@ -441,7 +442,8 @@ PLANET_GEAR = Table({k: v for k, v in GEOMETRY.items()}, "one gear of a compound
 PLANET = Table(
     {
         **{k: v for k, v in GEOMETRY.items() if k != "teeth"},
-        "teeth": Integer("teeth of a simple planet (omit when `gears` is given)", None, 1, maximum=int(bound("teeth"))),
+        "teeth": Integer("teeth of a simple planet (omit when `gears` is given, or for an idealised planet)", None, 1,
+                         maximum=int(bound("teeth"))),
         **BODY,
         "bearing": PLANET_BEARING,
         "gears": Table({}, "compound planet: named gears, e.g. [stages.planet.gears.f]", None,
@@ -579,8 +581,9 @@ RIPPLE = Table(
 
 OPERATING = Table(
     {
-        "input_speed_rpm": Positive("nominal input speed (positive = counter-clockwise seen from +z)", "rpm",
-                                    REQUIRED, bound("speed", RAD_S_PER_RPM)),
+        "input_speed_rpm": NonNegative("nominal input speed (positive = counter-clockwise seen from +z); 0 for "
+                                       "modal work only (modes, campbell, mac): a time run needs the train turning",
+                                       "rpm", REQUIRED, bound("speed", RAD_S_PER_RPM)),
         "output_torque": NonNegative("load torque on the output member, opposing its rotation (default 0, or "
                                      "from `input_torque`)", "N·m", None, bound("torque")),
         "input_torque": NonNegative("torque the input delivers, instead of `output_torque`: the load is this times "

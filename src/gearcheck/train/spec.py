@@ -21,7 +21,8 @@ import numpy as np
 from gearcheck.train.expression import Expression
 from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, min_curvature_radius, palmgren_stiffness
 from gearcheck.train.files import read_text, read_toml
-from gearcheck.train.geometry import Gear, MeshGeometry, gear_problem, mesh_geometry, mesh_problem
+from gearcheck.train.geometry import (Gear, MeshGeometry, gear_problem, helix_problem, idealised_mesh_geometry,
+                                      mesh_geometry, mesh_problem)
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.schema import Context, parse_measurements
@@ -304,6 +305,7 @@ class Stage:
     planets: tuple[str, ...]
     carrier: str
     helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
+    idealised: bool = False  # no teeth: base radii and a pressure angle (see _idealised_gear)
 
 
 @dataclass(frozen=True)
@@ -422,6 +424,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
                           op["input_torque"], op["torque_expression"])
 
+    _note_idealised(stages)
     _note_undamped(members)
     return TrainSpec(
         name=train["name"], description=train["description"], source=train["source"], path=source,
@@ -432,6 +435,16 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
         user_model=_user_model(train["user_model"], source, fail),
     )
+
+
+def _note_idealised(stages: list[Stage]) -> None:
+    """A note naming the idealised stages and what they skip and lack."""
+    for i, stage in enumerate(stages):
+        if stage.idealised:
+            warnings.warn(f"stages[{i}] ({stage.name}) is idealised (base radii, no teeth): the involute and assembly "
+                          "checks are skipped, the speeds follow from the base radii, and its meshes have no mesh "
+                          "cycle (constant stiffness, no mesh frequency or phase: modes only)", TrainNote,
+                          stacklevel=2)
 
 
 def _note_undamped(members: dict) -> None:
@@ -568,6 +581,8 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
         return value
 
     teeth = raw["teeth"]
+    if teeth is None:
+        return _idealised_gear(name, raw, stage, internal, path, fail)
     if teeth < MIN_TEETH:
         raise fail(f"{path}.teeth", f"an involute gear needs at least {MIN_TEETH} teeth, got {teeth}")
     beta = raw["helix_angle"]
@@ -597,6 +612,32 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
         relief_amount=relief["amount"], relief_length=relief["length"],
         relief_power=2 if relief["shape"] == "parabolic" else 1,
     )
+
+
+TOOTH_FIELDS = ("module_mm", "addendum_coefficient", "dedendum_coefficient", "tip_relief")  # an idealised gear has none
+
+
+def _idealised_gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:
+    """A gear as published modal models give it (Lin & Parker 1999): a base radius, a pressure angle (and a helix
+    angle), no teeth, module or tooth geometry."""
+    if raw["base_radius"] is None:
+        raise fail(f"{path}.teeth", "missing required field (an idealised gear gives base_radius_mm instead)")
+    for key in TOOTH_FIELDS:
+        if raw.get(key.removesuffix("_mm")) is not None:
+            raise fail(f"{path}.{key}", "an idealised gear (no teeth) has no tooth geometry: give teeth, or remove it")
+    if raw["profile_shift"]:
+        raise fail(f"{path}.profile_shift", "an idealised gear (no teeth) has no tooth geometry: give teeth, or "
+                                            "remove it")
+    beta = raw["helix_angle"]
+    if beta is None:
+        beta = -stage["helix_angle"] if not internal and name.startswith("sun") else stage["helix_angle"]
+    normal_alpha = raw["pressure_angle"] if raw["pressure_angle"] is not None else stage["pressure_angle"]
+    alpha = normal_alpha if beta == 0.0 else math.atan(math.tan(normal_alpha) / math.cos(beta))
+    face = raw["face_width"] if raw["face_width"] is not None else stage["face_width"]
+    return Gear(name=name, teeth=None, module=None, pressure_angle=alpha, face_width=face or 0.0, addendum=None,
+                dedendum=None, profile_shift=0.0, internal=internal, base_radius=raw["base_radius"],
+                eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"], helix_angle=beta,
+                installation_error=raw["installation_error"], installation_error_phase=raw["installation_error_phase"])
 
 
 def _body(raw: dict, radius: float, path: str, fail, gear: Gear | None = None) -> tuple[float, float]:
@@ -656,11 +697,13 @@ def _build_stage(st: dict, path: str, fail):
     name, n = st["name"], st["planets"]
     planet_gears = _planet_gears(st, path, fail)
     centrals = _central_gears(st, planet_gears, path, fail)
+    idealised = _check_idealised(st, centrals, planet_gears, path, fail)
     rv = _check_rv_layout(st, centrals, path, fail)
     geoms = _mesh_geometries(centrals, planet_gears, path, fail)
     carrier_radius = _centre_distance(centrals, planet_gears, geoms, path, fail)
     angles, equally = _planet_angles(st, n, path, fail)
-    _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
+    if not idealised:  # an idealised stage's planets may sit anywhere: there are no teeth to assemble
+        _check_assembly(centrals, planet_gears, angles, equally, n, path, fail)
     _check_carrier_radius(st["carrier_radius"], carrier_radius, path, fail)
     _check_collision(planet_gears, angles, carrier_radius, path, fail)
     members = _stage_members(st, centrals, planet_gears, angles, carrier_radius, rv, path, fail)
@@ -675,8 +718,26 @@ def _build_stage(st: dict, path: str, fail):
     if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
         members = {mid: replace(m, axial=True) for mid, m in members.items()}
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
-                  f"{name}.carrier", helical)
+                  f"{name}.carrier", helical, idealised)
     return members, stage, meshes, cycloids
+
+
+def _check_idealised(st: dict, centrals: dict, planet_gears: dict, path: str, fail) -> bool:
+    """Whether the stage is idealised (no gear has teeth; see :func:`_idealised_gear`); a stage of toothed and
+    idealised gears is refused, naming the first idealised one."""
+    gears = [(planet_gears[n], q) for n, q in _planet_paths(planet_gears, path).items()] + \
+        [(g, f"{path}.{key}") for key, (g, _, _) in centrals.items()]
+    idealised = [p for g, p in gears if g.idealised]
+    if not idealised:
+        return False
+    if len(idealised) < len(gears):
+        raise fail(f"{idealised[0]}.teeth", "missing: the stage's other gears have teeth (an idealised stage gives "
+                                            "none: base radii and a pressure angle only)")
+    if st["module"] is not None:
+        raise fail(f"{path}.module_mm", "an idealised stage (no teeth) has no module: remove it, or give teeth")
+    if st["crank"] is not None or st["cycloid"] is not None:
+        raise fail(f"{path}.crank", "an RV reducer's stage needs teeth (its pins and lobes are counted)")
+    return True
 
 
 def _planet_gears(st: dict, path: str, fail) -> dict[str, Gear]:
@@ -686,8 +747,6 @@ def _planet_gears(st: dict, path: str, fail) -> dict[str, Gear]:
         if planet_raw["teeth"] is not None:
             raise fail(f"{path}.planet.teeth", "give teeth on each of planet.gears, not on the planet")
         return {g: _gear(g, raw, st, False, f"{path}.planet.gears.{g}", fail) for g, raw in planet_raw["gears"].items()}
-    if planet_raw["teeth"] is None:
-        raise fail(f"{path}.planet.teeth", "missing required field (or give planet.gears)")
     return {"planet": _gear("planet", planet_raw, st, False, f"{path}.planet", fail)}
 
 
@@ -745,12 +804,21 @@ def _mesh_geometries(centrals: dict, planet_gears: dict, path: str, fail) -> dic
     planet_paths = _planet_paths(planet_gears, path)
     for gear, gpath in [(planet_gears[n], p) for n, p in planet_paths.items()] + \
             [(g, f"{path}.{key}") for key, (g, _, _) in centrals.items()]:
-        problem = gear_problem(gear)
+        problem = None if gear.idealised else gear_problem(gear)
         if problem:
             raise fail(f"{gpath}.{problem[0]}", problem[1])
     geoms = {}
     for key, (gear, pg, _) in centrals.items():
         planet = planet_gears[pg]
+        if gear.idealised:
+            problem = helix_problem(gear, planet)
+            if problem:
+                raise fail(f"{path}.{key}.helix_angle_deg", f"meshing {key} with the planet: {problem}")
+            try:
+                geoms[key] = idealised_mesh_geometry(gear, planet)
+            except ValueError as exc:
+                raise fail(f"{path}.{key}.base_radius_mm", str(exc)) from None
+            continue
         if gear.internal and gear.teeth <= planet.teeth:
             raise fail(f"{path}.{key}.teeth", f"a ring needs more teeth than its planet gear ({planet.teeth}), "
                                               f"got {gear.teeth}")
@@ -774,6 +842,11 @@ def _centre_distance(centrals: dict, planet_gears: dict, geoms: dict, path: str,
         a = geoms[key].centre_distance
         if abs(a - a0) > CENTRE_DISTANCE_TOLERANCE:
             g, pg, _ = centrals[key]
+            if g.idealised:
+                raise fail(f"{path}.{key}.base_radius_mm", f"{key} meets the planet at centre distance {a * 1e3:.4f} "
+                                                           f"mm but {first} at {a0 * 1e3:.4f} mm: the base radii "
+                                                           "must close (r_b,sun + r_b,planet = r_b,ring - "
+                                                           "r_b,planet at one pressure angle)")
             hint = ""
             if g.internal and not centrals[first][0].internal and len(planet_gears) == 1:
                 zs, zp = centrals[first][0].teeth, planet_gears[pg].teeth
@@ -834,9 +907,12 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
     checked (a central gear's [mesh] over the stage's)."""
     name = st["name"]
     layers = [(st["mesh"], f"{path}.mesh")] + [(c[2]["mesh"], f"{path}.{k}.mesh") for k, c in centrals.items()]
+    idealised = any(gear.idealised for gear, _, _ in centrals.values())
     for layer, lpath in layers:
         if layer and layer["stiffness"] is not None:
             _check_stiffness(layer["stiffness"], f"{lpath}.stiffness", fail)
+        if layer and idealised:
+            _check_idealised_mesh(layer, lpath, fail)
     meshes = []
     for key, (gear, pg, raw) in centrals.items():
         mesh = _merge_mesh(st["mesh"], raw["mesh"])
@@ -847,7 +923,9 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
         if damping["ratio"] is not None and damping["coefficient"] is not None:
             raise fail(f"{mpath}.damping", "give ratio or coefficient, not both")
         ste = tuple((s["harmonic"], s["amplitude"], s["phase"]) for s in mesh["ste"])
-        _check_small(mesh["backlash"] or 0.0, MAX_BACKLASH, gear.module, f"{mpath}.backlash_um", "backlash", fail)
+        if not gear.idealised:  # an idealised gear has no module to measure backlash by
+            _check_small(mesh["backlash"] or 0.0, MAX_BACKLASH, gear.module, f"{mpath}.backlash_um", "backlash",
+                         fail)
         if mesh["backlash"] and (gear.relief_amount or planet_gears[pg].relief_amount):
             raise fail(f"{mpath}.backlash_um", "a mesh with tip relief is modelled on its drive flanks only: give "
                                                "it no backlash")
@@ -862,6 +940,18 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
                 backlash=mesh["backlash"] or 0.0, ste=ste, planet_index=k,
             ))
     return meshes
+
+
+def _check_idealised_mesh(mesh: dict, path: str, fail) -> None:
+    """A [mesh] table of an idealised stage (no teeth): a stiffness model that needs no tooth geometry, and no
+    transmission error (harmonics of a mesh cycle it does not have)."""
+    model = MODELS[mesh["stiffness"]["model"]] if mesh["stiffness"] is not None else None
+    if model is not None and model.needs_teeth:
+        toothless = ", ".join(name for name, m in MODELS.items() if not m.needs_teeth)
+        raise fail(f"{path}.stiffness.model", f"{model.name!r} needs tooth geometry; an idealised mesh (no teeth) "
+                                              f"needs {toothless}")
+    if mesh["ste"]:
+        raise fail(f"{path}.ste", "an idealised mesh (no teeth) has no mesh cycle for transmission error harmonics")
 
 
 def _cycloid_stage(st: dict, members: dict, angles, carrier_radius: float, path: str, fail) -> CycloidStage:

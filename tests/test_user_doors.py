@@ -353,3 +353,16 @@ def test_massless_refusals_name_coordinate_and_matrix():
                          np.diag(np.r_[np.zeros(node), 0.5]))
     with pytest.raises(gearcheck.GearcheckError, match="stiffness: K.t. varies on the massless coordinate shaft.mid"):
         LinearSide(replace(model, stiffness=stiffness), SPEC)
+
+
+def test_reduced_against_the_twin():
+    """The reduction needs only the reference's modes and mass (K = M Phi Omega^2 Phi^T M), so the MuJoCo twin
+    reduces alike: the ring-eliminated reference pairs with the twin held there, frequencies to the twin's own
+    agreement with the lumped model (1e-6, tests/test_mode_pairing.py)."""
+    from gearcheck.mbd_models.side import MujocoSide
+
+    twin, side = MujocoSide(SPEC), LinearSide(ring_eliminated(), SPEC)
+    _, modes, sentence = reduced_reference(twin, side, (twin.modes(), side.modes()))
+    np.testing.assert_allclose(modes.frequencies, side.modes().frequencies, rtol=1e-6)
+    assert "stage1.ring.x, .y, .theta held" in sentence
+    assert pair_modes(TRAIN, twin, side).findings == []

@@ -77,44 +77,29 @@ def ring_eliminated_driven() -> LinearModel:
                        meshes=[replace(m, row=m.row[KEEP]) for m in model.meshes])
 
 
-def _with_node(model: LinearModel, motor: bool, damped: bool = False) -> LinearModel:
-    """The input shaft (stiffness k_s from the sun to ground in the reference) split by a massless midpoint into
-    two springs 2 k_s, and, with ``motor``, ending on a motor of MOTOR_RATIO times the sun's inertia instead of
-    ground."""
-    k_s = SPEC.operating.input_shaft_stiffness
+def drivetrain(node: bool, motor: bool, damped: bool = False) -> LinearModel:
+    """The reference's M and K with its input shaft (k_s from the sun to ground) rebuilt: with ``node``, split by a
+    massless midpoint ``shaft.mid`` into two springs 2 k_s (``damped``: a damper on it); with ``motor``, ending on
+    ``motor.theta``, MOTOR_RATIO times the sun's inertia, instead of ground."""
+    model, k_s = _mk(name="drivetrain"), SPEC.operating.input_shaft_stiffness
     n = model.n
-    names = [*model.coordinates, "shaft.mid"] + (["motor.theta"] if motor else [])
+    names = [*model.coordinates] + (["shaft.mid"] if node else []) + (["motor.theta"] if motor else [])
     N = len(names)
-    M, K = np.zeros((N, N)), np.zeros((N, N))
+    M, K, C = np.zeros((N, N)), np.zeros((N, N)), np.zeros((N, N))
     M[:n, :n], K[:n, :n] = model.M, model.K_mean
     K[SUN, SUN] -= k_s
-    for a, b in ((SUN, n), (n, n + 1 if motor else None)):
+    chain = [SUN] + ([n] if node else []) + ([N - 1] if motor else [None])
+    for a, b in zip(chain, chain[1:]):
         row = np.zeros(N)
         row[a] = 1.0
         if b is not None:
             row[b] = -1.0
-        K += 2.0 * k_s * np.outer(row, row)
+        K += (len(chain) - 1) * k_s * np.outer(row, row)  # springs in series: k_s in all
     if motor:
-        M[n + 1, n + 1] = MOTOR_RATIO * model.M[SUN, SUN]
-    C = None
+        M[N - 1, N - 1] = MOTOR_RATIO * model.M[SUN, SUN]
     if damped:
-        C = np.zeros((N, N))
         C[n, n] = 1.0
-    return LinearModel(model.name, names, M, K, C=C, physical={c: {c: 1.0} for c in model.coordinates})
-
-
-def _motor(model: LinearModel) -> LinearModel:
-    """The input shaft k_s ending on a motor of MOTOR_RATIO times the sun's inertia instead of ground."""
-    k_s = SPEC.operating.input_shaft_stiffness
-    n = model.n
-    M, K = np.zeros((n + 1, n + 1)), np.zeros((n + 1, n + 1))
-    M[:n, :n], K[:n, :n] = model.M, model.K_mean
-    M[n, n] = MOTOR_RATIO * model.M[SUN, SUN]
-    row = np.zeros(n + 1)
-    row[SUN], row[n] = 1.0, -1.0
-    K[SUN, SUN] -= k_s
-    K += k_s * np.outer(row, row)
-    return LinearModel("motor", [*model.coordinates, "motor.theta"], M, K,
+    return LinearModel(model.name, names, M, K, C=C if damped else None,
                        physical={c: {c: 1.0} for c in model.coordinates})
 
 
@@ -139,10 +124,10 @@ CONTENTS = {
                            "reduction: 'fixed': choose held or condensed"),
     # its modes are the held reference's, but its forced response is not the train's, whose ring is supported
     "ring eliminated, meshes": (lambda: ring_eliminated_driven(), FAIL, None),
-    "extra coordinate (motor)": (lambda: _motor(_mk()), PASS, None),
-    "massless coordinate (shaft node)": (lambda: _with_node(_mk(), motor=False), PASS, None),
-    "massless node and motor": (lambda: _with_node(_mk(), motor=True), PASS, None),
-    "damping on a massless node": (lambda: _with_node(_mk(), motor=False, damped=True), INVALID,
+    "extra coordinate (motor)": (lambda: drivetrain(node=False, motor=True), PASS, None),
+    "massless coordinate (shaft node)": (lambda: drivetrain(node=True, motor=False), PASS, None),
+    "massless node and motor": (lambda: drivetrain(node=True, motor=True), PASS, None),
+    "damping on a massless node": (lambda: drivetrain(node=True, motor=False, damped=True), INVALID,
                                    "C: acts on the massless coordinate shaft.mid"),
 }
 RECORDED = ("M, K 10 % stiff", "meshes, damping, forcing", "ring eliminated (held)", "ring eliminated, 10 % stiff")
@@ -270,7 +255,7 @@ def test_massless_node_is_the_series_spring():
 def test_massless_shaft_node_in_the_train_is_the_reference():
     """The input shaft split by a massless midpoint into two springs 2 k_s is the reference's shaft k_s: its modes
     to round-off, and the note names the node."""
-    side = LinearSide(_with_node(_mk(), motor=False), SPEC)
+    side = LinearSide(drivetrain(node=True, motor=False), SPEC)
     fa, fb = LumpedSide(SPEC).modes().frequencies, side.modes().frequencies
     np.testing.assert_allclose(fb, fa, rtol=0, atol=1e-13 * fa.max())
     assert any("(shaft.mid) statically condensed out" in note for note in side.notes)
@@ -280,12 +265,12 @@ def test_extra_motor_modes_set_aside():
     """A motor of MOTOR_RATIO times the sun's inertia on the input shaft: its mode (the drivetrain turning as a
     whole) is set aside and named; the train's modes are the reference's, which grounds the shaft, to within
     the inertia ratio; their shapes pair one to one."""
-    side = LinearSide(_motor(_mk()), SPEC)
+    side = LinearSide(drivetrain(node=False, motor=True), SPEC)
     reference = LumpedSide(SPEC)
     fa, fb = reference.modes().frequencies, side.modes().frequencies
     assert len(fb) == len(fa)
     np.testing.assert_allclose(fb, fa, rtol=10 / MOTOR_RATIO)
-    assert side.notes == [f"motor has 1 coordinate mapped to no coordinate of {TRAIN} (motor.theta), kept in its "
+    assert side.notes == [f"drivetrain has 1 coordinate mapped to no coordinate of {TRAIN} (motor.theta), kept in its "
                           "dynamics; 1 of its modes have more than 50% of their kinetic energy there: 0 Hz, without "
                           "counterpart in the reference: set aside, not compared."]
     pairing = pair_modes(TRAIN, reference, side)
@@ -343,7 +328,7 @@ def test_diagnosis_uses_the_declared_reduction(how):
 
 def test_massless_refusals_name_coordinate_and_matrix():
     """Where the condensation would not be exact, one line names the coordinate and the matrix."""
-    model = _with_node(_mk(), motor=False)
+    model = drivetrain(node=True, motor=False)
     node = model.n - 1
     G = np.zeros((model.n, model.n))
     G[0, node], G[node, 0] = 1.0, -1.0

@@ -4,15 +4,26 @@ A user's model (written in Python, or exported from MATLAB as a file of matrices
 
     M q'' + (C + G + sum_m c_m a_m a_m^T) q' + (K(t) + K_omega + sum_m k_m(t) a_m a_m^T) q = F(t)
 
-over its own coordinates q: M its mass matrix, C its damping, G its gyroscopic matrix at the operating
-speed (skew), K(t) its stiffness (mean K, optionally periodic over a mesh cycle), K_omega its
-speed-dependent stiffness (centripetal softening, circulatory terms), F(t) its forcing (mean F), and
+over its own coordinates q: M its mass matrix, C its damping, G its gyroscopic matrix (skew), K(t) its
+stiffness (mean K, optionally periodic over a mesh cycle), K_omega its speed-dependent stiffness
+(centripetal softening, circulatory terms), F(t) its forcing (mean F), and
 each mesh m a deflection row a_m (the mesh's compression along its line of action) with a periodic
 stiffness k_m(t) and a damping c_m -- the usual structure of a gear model (Lin & Parker 1999; Kahraman
 1994).  ``physical`` says what its coordinates are in the train's: each of gearcheck's physical
 coordinates (``stage1.sun.x``, ``stage1.planet1.tangential``, ``stage1.ring.theta``, ...) as a
-combination of the model's coordinates; coordinates the model does not have are held.  Through that
-map the model reports the train's named signals, computed from its own motion and its own meshes.
+combination of the model's coordinates.  Through that map the model reports the train's named signals,
+computed from its own motion and its own meshes.
+
+G and K_omega are given at the train's operating speed (``G``, ``K_omega``) or, as rotordynamics codes
+hand them out, per unit speed (``G_per_speed`` per rad/s, ``K_omega_per_speed2`` per (rad/s)^2, of the speed
+of ``speed_of``: ``"input"`` or a member id such as ``"stage1.carrier"``); :meth:`LinearModel.frame_terms`
+gives both at any speed, G scaling with it and K_omega with its square (Cooley & Parker 2012).
+
+Train coordinates the model lacks (a reduced model: a ring eliminated, translations left out) are, in the
+reference it is compared with, held at zero (``reduction="held"``) or statically condensed out
+(``"condensed"``, Guyan 1965).  Coordinates of the model that map to no train coordinate (a motor, a
+coupling, a generator) are extra coordinates: kept in its dynamics, and the modes they dominate set aside
+in comparisons (:mod:`gearcheck.lumped.side`).
 
 :meth:`LinearModel.check` validates it as the loader validates a train file: one line per error,
 naming the source, the field and the value.
@@ -28,12 +39,15 @@ from functools import cached_property
 import numpy as np
 
 from gearcheck.shared.errors import TrainFileError, did_you_mean
+from gearcheck.train.kinematics import kinematics
 
 SYMMETRY_TOLERANCE = 1e-9  # relative asymmetry of M, K, C accepted as round-off
 MEAN_TOLERANCE = 1e-6  # relative difference accepted between a given mean and the mean of the samples
 UNIT_SLIP = 100.0  # a mass or inertia this many times off the train's own is taken for a unit slip
 START = ("static", "rest")
 INTERPOLATIONS = ("linear", "hold")
+REDUCTIONS = ("held", "condensed")  # what the reference does with the train coordinates a model lacks
+SPEED_FORMS = (("G", "G_per_speed"), ("K_omega", "K_omega_per_speed2"))  # (at the operating speed, per unit speed)
 
 
 @dataclass(frozen=True)
@@ -132,11 +146,14 @@ class Mesh:
 class LinearModel:
     """M q'' + (C + G + mesh damping) q' + (K(t) + K_omega + mesh stiffness) q = F(t) over ``coordinates``.
 
+    G, K_omega: at the train's operating speed; or G_per_speed (per rad/s), K_omega_per_speed2 (per
+    (rad/s)^2) of the speed of ``speed_of`` ("input" or a member id), one form of each.
     stiffness: K(t) (a :class:`Periodic` of matrices whose mean is K), or None (K constant).
     forcing: F(t) (a :class:`Periodic` whose mean is F, or any callable of t), or None (F constant).
     physical: train coordinate label -> {model coordinate: coefficient}; None: the model's coordinates are
     the train's own labels.  start: "static" (from K_mean q = F) or "rest" (q = q' = 0).
-    descriptions: coordinate -> what it is (reports).
+    reduction: "held" or "condensed", what the reference does with the train coordinates the model lacks.
+    descriptions: coordinate -> what it is (reports).  notes: what was done to the model (reports show them).
     """
 
     name: str
@@ -146,14 +163,21 @@ class LinearModel:
     C: np.ndarray | None = None
     G: np.ndarray | None = None
     K_omega: np.ndarray | None = None
+    G_per_speed: np.ndarray | None = None
+    K_omega_per_speed2: np.ndarray | None = None
+    speed_of: str = "input"
     F: np.ndarray | None = None
     stiffness: Periodic | None = None
     forcing: Periodic | Callable | None = None
     meshes: list[Mesh] = field(default_factory=list)
     physical: dict[str, dict[str, float]] | None = None
     start: str = "static"
+    reduction: str = "held"
     descriptions: dict[str, str] = field(default_factory=dict)
     source: str = ""  # the file or factory it came from: error messages name it
+    notes: list[str] = field(default_factory=list)
+    operating_speed: float | None = None  # rad/s, the input speed G and K_omega are at (set by check with a train)
+    speed_ratio: float = 1.0  # the speed of speed_of over the input speed (set by check with a train)
 
     @property
     def n(self) -> int:
@@ -180,9 +204,14 @@ class LinearModel:
         return self.matrix("K") + self._mesh_sum([m.k_mean for m in self.meshes])
 
     @property
+    def frame(self) -> tuple[np.ndarray, np.ndarray]:
+        """(G, K_omega) at the operating speed (:meth:`frame_terms`)."""
+        return self.frame_terms(self.operating_speed)
+
+    @property
     def damping(self) -> np.ndarray:
         """Everything that multiplies q': C + G + the meshes' damping."""
-        return self.matrix("C") + self.matrix("G") + self._mesh_sum([m.damping for m in self.meshes])
+        return self.matrix("C") + self.frame[0] + self._mesh_sum([m.damping for m in self.meshes])
 
     def K_peak(self) -> np.ndarray:
         """A stiffness no less than K(t) + K_omega's symmetric part at any time (the stable step's bound)."""
@@ -191,8 +220,49 @@ class LinearModel:
             over = self.stiffness.over_period()
             worst = max(range(len(over)), key=lambda i: np.linalg.eigvalsh(0.5 * (over[i] + over[i].T))[-1])
             K = over[worst]
-        K_omega = self.matrix("K_omega")
+        K_omega = self.frame[1]
         return K + 0.5 * (K_omega + K_omega.T) + self._mesh_sum([m.k_max for m in self.meshes])
+
+    @property
+    def massless(self) -> list[int]:
+        """Indices of the coordinates without mass: their row and column of M exactly zero."""
+        M = np.asarray(self.M, dtype=float)
+        return [i for i in range(self.n) if not M[i].any() and not M[:, i].any()]
+
+    @property
+    def extra(self) -> list[str]:
+        """The coordinates that map to no train coordinate (a motor, a coupling, a generator) in a model that maps
+        some; none in a model that maps none (one compared by its own signals, as the published 4-DOF models)."""
+        used = {c for combination in self.physical_map().values() for c in combination}
+        return [c for c in self.coordinates if c not in used] if used else []
+
+    def frame_terms(self, input_speed: float) -> tuple[np.ndarray, np.ndarray]:
+        """(G, K_omega) with the train's input at ``input_speed`` (rad/s): G_per_speed Omega and
+        K_omega_per_speed2 Omega^2 (Omega the speed of ``speed_of``), or G and K_omega scaled from the operating
+        speed they are given at, G with the speed and K_omega with its square (Cooley & Parker 2012)."""
+        if input_speed is None:
+            if self.G_per_speed is not None or self.K_omega_per_speed2 is not None:
+                raise self._error("G_per_speed", "per unit speed: needs the train's operating speed (check(spec))")
+            return self.matrix("G"), self.matrix("K_omega")
+        omega = self.speed_ratio * input_speed
+        if self.G_per_speed is not None:
+            G = omega * self.matrix("G_per_speed")
+        else:
+            G = self._scaled("G", input_speed, 1)
+        if self.K_omega_per_speed2 is not None:
+            K_omega = omega * omega * self.matrix("K_omega_per_speed2")
+        else:
+            K_omega = self._scaled("K_omega", input_speed, 2)
+        return G, K_omega
+
+    def _scaled(self, name: str, input_speed: float, power: int) -> np.ndarray:
+        A = self.matrix(name)
+        if not A.any() or input_speed == self.operating_speed:
+            return A
+        if not self.operating_speed:
+            raise self._error(name, f"given at the operating speed, which is {self.operating_speed}: give it per unit "
+                              f"speed ({dict(SPEED_FORMS)[name]})")
+        return (input_speed / self.operating_speed) ** power * A
 
     def F_at(self, t: float) -> np.ndarray:
         return self.matrix("F") if self.forcing is None else np.asarray(self.forcing(t), dtype=float)
@@ -209,16 +279,24 @@ class LinearModel:
         if n == 0 or len(set(self.coordinates)) != n:
             raise self._error("coordinates", f"{n} names with {n - len(set(self.coordinates))} repeated: need at "
                               "least one, each once")
-        for name in ("M", "K", "C", "G", "K_omega", "F"):
+        for name in ("M", "K", "C", "G", "K_omega", "G_per_speed", "K_omega_per_speed2", "F"):
             self._check_array(name, (n,) if name == "F" else (n, n), required=name in ("M", "K"))
+        for at_speed, per_speed in SPEED_FORMS:
+            if getattr(self, at_speed) is not None and getattr(self, per_speed) is not None:
+                raise self._error(per_speed, f"given with {at_speed}: give {at_speed} at the operating speed or "
+                                  f"{per_speed} per unit speed, not both")
         M = self.matrix("M")
         for name in ("M", "K", "C"):
             self._check_symmetric(name, +1)
         self._check_symmetric("G", -1)
-        lowest = np.linalg.eigvalsh(M)[0]
+        self._check_symmetric("G_per_speed", -1)
+        massive = [i for i in range(n) if i not in self.massless]
+        if not massive:
+            raise self._error("M", "all zero: the model needs mass or inertia")
+        lowest = np.linalg.eigvalsh(M[np.ix_(massive, massive)])[0]
         if lowest <= 0:
             raise self._error("M", f"not positive definite (eigenvalue {lowest:.4g}): every coordinate needs mass "
-                              "or inertia")
+                              "or inertia, or none (a row and column of exact zeros: condensed)")
         if self.stiffness is not None:
             self._check_periodic("stiffness", self.stiffness, (n, n), "K")
         if isinstance(self.forcing, Periodic):
@@ -227,9 +305,26 @@ class LinearModel:
             self._check_mesh(j, mesh)
         if self.start not in START:
             raise self._error("start", f"{self.start!r}: choose {' or '.join(START)}")
+        if self.reduction not in REDUCTIONS:
+            raise self._error("reduction", f"{self.reduction!r}: choose {' or '.join(REDUCTIONS)}")
         if spec is not None:
             self._check_map(spec, labels)
+            self._set_speed(spec)
         return self
+
+    def _set_speed(self, spec) -> None:
+        """The operating speed G and K_omega are at, and the speed ``speed_of`` names over the input's."""
+        self.operating_speed = spec.operating.input_speed
+        if self.speed_of != "input":
+            carriers = [m for m in spec.members if m.endswith(".carrier")]
+            member = carriers[0] if self.speed_of == "carrier" and len(carriers) == 1 else self.speed_of
+            if member not in spec.members:
+                raise self._error("speed_of", f"{self.speed_of!r}: 'input' or a member of {spec.name} "
+                                  f"({', '.join(spec.members)})")
+            if not self.operating_speed:
+                raise self._error("speed_of", f"{self.speed_of!r}: {spec.name} does not turn (input speed 0), so no "
+                                  "ratio of speeds: give the per-unit-speed forms per rad/s of the input")
+            self.speed_ratio = kinematics(spec).speeds[member] / self.operating_speed
 
     def _error(self, field_name: str, message: str) -> TrainFileError:
         return TrainFileError(self.source or self.name, field_name, message)
@@ -331,6 +426,8 @@ class LinearModel:
             member = spec.members[member_id]
             expected, what = (member.inertia, "inertia (kg m^2)") if dof == "theta" else (member.mass, "mass (kg)")
             i = self.coordinates.index(coordinate)
+            if i in self.massless:  # condensed out, not a unit slip
+                continue
             ratio = self.M[i, i] / expected
             if not 1.0 / UNIT_SLIP <= ratio <= UNIT_SLIP:
                 raise self._error(f"M[{coordinate}]", f"{self.M[i, i]:.6g} but {member_id}'s {what} is {expected:.6g} "

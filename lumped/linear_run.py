@@ -2,7 +2,8 @@
 
 * :func:`linear_modes` -- K_mean x = omega^2 M x (typed like the reference's modes when the model's
   coordinates are the train's), and :func:`linear_modes_at_speed`, the gyroscopic problem with G and
-  K_omega (Cooley & Parker 2012);
+  K_omega (Cooley & Parker 2012); :func:`set_aside` parts the modes that the model's extra coordinates (a
+  motor, a coupling: mapped to no train coordinate) dominate from the train's;
 * :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest), the
   stiffness, meshes and forcing evaluated at each stage's time;
 * :func:`linear_result` -- what the run reports: every coordinate and its acceleration, and, through
@@ -14,6 +15,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -22,7 +24,7 @@ from gearcheck.lumped.modal import central_coordinates
 from gearcheck.lumped.time_solver import rk4_step
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import DivergenceError
-from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
+from gearcheck.shared.modal import ModalResult, modal_result, multiplicities, speed_modal_result
 from gearcheck.shared.results import TimeResult, coordinate_signals, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
@@ -30,6 +32,7 @@ from gearcheck.shared.units import rad_s_to_rpm
 from gearcheck.train.spec import AXIAL
 
 CHUNK = 2000  # steps between progress reports
+EXTRA_DOMINATED = 0.5  # a mode with more of its kinetic energy in the extra coordinates is theirs, not the train's
 
 
 def _typing(model, train) -> tuple:
@@ -49,13 +52,32 @@ def linear_modes(model, train=None) -> ModalResult:
 
 
 def linear_modes_at_speed(model, train, input_speed: float) -> ModalResult:
-    """The gyroscopic modes at ``input_speed`` (rad/s): G and K_omega scaled from the train's own speed (G with
-    the speed, K_omega with its square)."""
-    r = input_speed / train.spec.operating.input_speed
-    K_omega = model.matrix("K_omega")
-    return speed_modal_result(train.spec.name, model.name, model.M, r * model.matrix("G"),
-                              model.K_mean + r * r * 0.5 * (K_omega + K_omega.T), model.coordinates,
+    """The gyroscopic modes at ``input_speed`` (rad/s), G and K_omega at that speed
+    (:meth:`~gearcheck.lumped.linear_model.LinearModel.frame_terms`)."""
+    G, K_omega = model.frame_terms(input_speed)
+    return speed_modal_result(train.spec.name, model.name, model.M, G, model.K_mean + 0.5 * (K_omega + K_omega.T),
+                              model.coordinates,
                               *_typing(model, train), rad_s_to_rpm(input_speed))
+
+
+def set_aside(model, modal: ModalResult) -> tuple[ModalResult, list[float]]:
+    """(the modes of ``modal`` that are the train's, the frequencies in Hz of those set aside): a mode with more
+    than ``EXTRA_DOMINATED`` of its kinetic energy phi^H M_ee phi / phi^H M phi in the model's extra coordinates
+    (:attr:`~gearcheck.lumped.linear_model.LinearModel.extra`) has no counterpart in the train."""
+    extra = [model.coordinates.index(c) for c in model.extra]
+    if not extra:
+        return modal, []
+    phi, M = modal.shapes, model.M
+    total = np.real(np.einsum("ip,ij,jp->p", phi.conj(), M, phi))
+    part = np.real(np.einsum("ip,ij,jp->p", phi[extra].conj(), M[np.ix_(extra, extra)], phi[extra]))
+    aside = part > EXTRA_DOMINATED * total
+    keep = np.flatnonzero(~aside)
+    kept = replace(modal, frequencies=modal.frequencies[keep], shapes=modal.shapes[:, keep],
+                   types=[modal.types[i] for i in keep], multiplicity=multiplicities(modal.frequencies[keep]),
+                   fractions=None if modal.fractions is None else modal.fractions[keep],
+                   growth=None if modal.growth is None else modal.growth[keep],
+                   stability=None if modal.stability is None else [modal.stability[i] for i in keep])
+    return kept, [float(f) for f in modal.frequencies[aside]]
 
 
 def step_limits(model) -> stepping.StepLimits:
@@ -79,7 +101,7 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
     steps, every = settings.check_work(dt, 3 * model.n, f"model {model.name}")
     M_inv = np.linalg.inv(model.M)
     D = model.damping
-    K_omega = model.matrix("K_omega")
+    K_omega = model.frame[1]
     A = model.mesh_rows
     t = np.arange(steps + 1) * dt
     stage_t = t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt  # where every fixed-step solver samples its drive
@@ -130,7 +152,7 @@ def _start(model) -> tuple[np.ndarray, np.ndarray]:
     zero = np.zeros(model.n)
     if model.start == "rest":
         return zero, zero
-    K_omega = model.matrix("K_omega")
+    K_omega = model.frame[1]
     q, *_ = np.linalg.lstsq(model.K_mean + K_omega, model.matrix("F"), rcond=None)
     return q, zero
 

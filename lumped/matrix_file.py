@@ -8,9 +8,16 @@ name                   shape                   meaning
 =====================  ======================  =====================================================
 coordinates            n strings               the model's coordinates; without ``physical``, the
                                                train's own labels (``stage1.sun.theta``, ...)
-M, K                   n x n                   mass, mean stiffness (without the meshes below)
-C, G, K_omega          n x n (optional)        damping, gyroscopic (at the operating speed),
-                                               speed-dependent stiffness
+M, K                   n x n                   mass, mean stiffness (without the meshes below); a
+                                               coordinate whose row and column of M are exact zeros
+                                               is massless and condensed out (Guyan 1965)
+C                      n x n (optional)        damping
+G, K_omega             n x n (optional)        gyroscopic, speed-dependent stiffness, at the train's
+                                               operating speed
+G_per_speed            n x n (optional)        G per rad/s of the speed_of speed (instead of G)
+K_omega_per_speed2     n x n (optional)        K_omega per (rad/s)^2 of it (instead of K_omega)
+speed_of               string (optional)       whose speed the per-speed forms are per: "input"
+                                               (default), "carrier" (a single stage) or a member id
 F                      n (optional)            mean force
 period                 scalar                  s, of every periodic quantity (a mesh cycle)
 K_samples              N x n x n (.npz),       K(t) at t = i period / N (mean must be K)
@@ -28,7 +35,12 @@ mesh_interpolation     string (optional)       between the stiffness samples: "l
 mesh_error             m x N (optional)        m, each mesh's static transmission error over the period:
                                                its force is k (row . q - e) + c (row . q' - e')
 physical_labels        k strings               train coordinates the model has ...
-physical               k x n                   ... as combinations of its coordinates
+physical               k x n                   ... as combinations of its coordinates; a coordinate
+                                               in no combination is extra (a motor, a coupling):
+                                               kept, and the modes it dominates set aside
+reduction              string (optional)       the train coordinates the model lacks, in the
+                                               reference compared with it: "held" (default) or
+                                               "condensed" (Guyan 1965)
 name                   string (optional)       how reports name the model (default: the file's stem)
 start                  string (optional)       "static" (default) or "rest"
 units                  string (optional)       "SI" (the only units accepted)
@@ -48,9 +60,10 @@ from gearcheck.shared.errors import TrainFileError, shown
 from gearcheck.train.files import read_arrays
 
 SUFFIXES = (".mat", ".npz")
-KNOWN = {"coordinates", "M", "K", "C", "G", "K_omega", "F", "period", "K_samples", "K_cos", "K_sin", "orders",
-         "F_samples", "mesh_ids", "mesh_rows", "mesh_stiffness", "mesh_period", "mesh_damping", "mesh_interpolation",
-         "mesh_error", "physical_labels", "physical", "name", "start", "units"}
+KNOWN = {"coordinates", "M", "K", "C", "G", "K_omega", "G_per_speed", "K_omega_per_speed2", "speed_of", "F", "period",
+         "K_samples", "K_cos", "K_sin", "orders", "F_samples", "mesh_ids", "mesh_rows", "mesh_stiffness", "mesh_period",
+         "mesh_damping", "mesh_interpolation", "mesh_error", "physical_labels", "physical", "name", "start",
+         "reduction", "units"}
 
 
 def read_matrix_file(path) -> LinearModel:
@@ -92,9 +105,11 @@ def read_matrix_file(path) -> LinearModel:
         physical = {label: {c: float(x) for c, x in zip(coordinates, row) if x != 0} for label, row in zip(labels, T)}
     return LinearModel(get.string("name", path.stem), coordinates, get.array("M", required=True),
                        get.array("K", required=True), C=get.array("C"), G=get.array("G"),
-                       K_omega=get.array("K_omega"), F=get.array("F"), stiffness=stiffness, forcing=forcing,
+                       K_omega=get.array("K_omega"), G_per_speed=get.array("G_per_speed"),
+                       K_omega_per_speed2=get.array("K_omega_per_speed2"), speed_of=get.string("speed_of", "input"),
+                       F=get.array("F"), stiffness=stiffness, forcing=forcing,
                        meshes=_meshes(get, source, n, period), physical=physical,
-                       start=get.string("start", "static"), source=source)
+                       start=get.string("start", "static"), reduction=get.string("reduction", "held"), source=source)
 
 
 class _Reader:

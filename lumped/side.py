@@ -15,8 +15,10 @@ from functools import cached_property
 import numpy as np
 
 from gearcheck.lumped.assembly import LumpedModel, build_model
+from gearcheck.lumped.condensation import condense_massless
 from gearcheck.lumped.linear_model import LinearModel
-from gearcheck.lumped.linear_run import linear_modes, linear_modes_at_speed, simulate_linear, step_limits, unmapped
+from gearcheck.lumped.linear_run import EXTRA_DOMINATED, linear_modes, linear_modes_at_speed, set_aside, simulate_linear
+from gearcheck.lumped.linear_run import step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed, settling_time
 from gearcheck.lumped.periodic_steady_state import periodic_steady_state
@@ -92,25 +94,44 @@ class LumpedSide(Side):
 
 class LinearSide(Side):
     """A model given as matrices (:class:`~gearcheck.lumped.linear_model.LinearModel`: a user's, or a
-    published one) for the train ``spec``; validated against the train's coordinates when built."""
+    published one) for the train ``spec``; validated against the train's coordinates when built, its massless
+    coordinates condensed out (:func:`~gearcheck.lumped.condensation.condense_massless`).  Its modes are the
+    train's: those its extra coordinates dominate are set aside (:func:`~gearcheck.lumped.linear_run.set_aside`)
+    and named in its notes."""
 
     kind = "user model"
 
     def __init__(self, model: LinearModel, spec, references: tuple[str, ...] = ()):
         self.spec = spec
         self.train = build_model(spec)  # the train's coordinates and kinematics, which the model maps into
-        self.linear = model.check(spec, self.train.dofs.labels())
+        self.linear = condense_massless(model.check(spec, self.train.dofs.labels()))
         self.solver = model.name
         self.references = references
         self.driven = bool(self.linear.meshes) or self.linear.stiffness is not None or self.linear.forcing is not None
 
-    def modes(self) -> ModalResult:
-        modal = linear_modes(self.linear, self.train)
+    @cached_property
+    def _rest(self) -> tuple[ModalResult, list[float]]:
+        modal, aside = set_aside(self.linear, linear_modes(self.linear, self.train))
         modal.train = self.spec.name
-        return modal
+        return modal, aside
+
+    def modes(self) -> ModalResult:
+        return self._rest[0]
 
     def modes_at_speed(self, input_speed: float) -> ModalResult:
-        return linear_modes_at_speed(self.linear, self.train, input_speed)
+        return set_aside(self.linear, linear_modes_at_speed(self.linear, self.train, input_speed))[0]
+
+    @property
+    def notes(self) -> list[str]:
+        """What was done to the model (its massless coordinates condensed) and which of its modes are set aside."""
+        aside, extra = self._rest[1], self.linear.extra
+        if not extra:
+            return list(self.linear.notes)
+        return [*self.linear.notes, f"{self.solver} has {len(extra)} coordinate{'s' if len(extra) > 1 else ''} mapped "
+                f"to no coordinate of {self.spec.name} ({', '.join(extra)}), kept in its dynamics; {len(aside)} of its "
+                f"modes have more than {EXTRA_DOMINATED:.0%} of their kinetic energy there"
+                f"{': ' + ', '.join(f'{f:.6g} Hz' for f in aside) if aside else ''}, without counterpart in the "
+                "reference: set aside, not compared."]
 
     def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray | None, np.ndarray]:
         """(the train coordinates the model has, its mass matrix over them when they determine its own
@@ -118,10 +139,11 @@ class LinearSide(Side):
         labels = self.train.dofs.labels()
         T, mapped = self.linear.to_physical(labels)
         T = T[mapped]
+        own = [i for i, c in enumerate(self.linear.coordinates) if c not in self.linear.extra]
         mass = None
-        if T.shape[0] == T.shape[1] and np.linalg.matrix_rank(T) == T.shape[0]:
-            T_inv = np.linalg.inv(T)
-            mass = T_inv.T @ self.linear.M @ T_inv
+        if len(own) == T.shape[0] and np.linalg.matrix_rank(T[:, own]) == T.shape[0]:
+            T_inv = np.linalg.inv(T[:, own])
+            mass = T_inv.T @ self.linear.M[np.ix_(own, own)] @ T_inv
         return [label for label, m in zip(labels, mapped) if m], mass, T @ modal.shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:

@@ -138,8 +138,11 @@ def test_factory_on_the_command_line(tmp_path, capsys):
     report = (tmp_path / "report.md").read_text()
     assert "does not report" in report and "stage1.sun.ax.world" in report
     assert "Diagnosis: No single-term mistake: agrees with the reference reduced to its 6 coordinates" in report
+    assert "the reference is compared with stage1.sun.x, .y, stage1.ring.x, .y" in report
+    capsys.readouterr()
     status = main(["mac", "demo-3p", "--model", TORSIONAL, "--out", str(tmp_path / "mac")])
     assert (tmp_path / "mac" / "mac.png").is_file()
+    assert status == 0 and "torsional has 9 of the 18 coordinates of demo-3p" in capsys.readouterr().out
 
 
 def test_published_models_through_the_same_door():

@@ -3,7 +3,8 @@
 Any pair of :class:`~gearcheck.shared.side.Side` objects, read by a comparison plan
 (:mod:`gearcheck.compare.engine.plan`):
 
-1. natural frequencies of both, mode by mode;
+1. natural frequencies of both, mode by mode (a reduced test model's against the reference reduced alike,
+   :mod:`gearcheck.compare.engine.reduction`);
 2. time runs of both (each from its own static state, or from rest), each twice: at its step h and,
    for the integration error, at 2 h (at h / 2 where 2 h would be unstable);
 3. every signal the reference gates and the test has, put on one grid: anti-aliased resampling at
@@ -56,6 +57,7 @@ from gearcheck.compare.engine.line_projection import harmonics
 from gearcheck.compare.engine.metrics import modal_metrics, spectral_amplitude, spectral_metrics, statistics
 from gearcheck.compare.engine.metrics import waveform_metrics
 from gearcheck.compare.engine.mode_pairing import pair_modes
+from gearcheck.compare.engine.reduction import reduced_reference
 from gearcheck.compare.engine.tolerances import Tolerances
 from gearcheck.shared.errors import SolverError, UnsupportedError, did_you_mean
 from gearcheck.shared.selection import chosen
@@ -219,21 +221,28 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     progress: callable(fraction) over the runs.
     """
     clock = Clock()
+    modal_reference = reference
     with clock.step(f"{_label(reference, 0)}_modes_s"):
         modes_a = reference.modes()
     with clock.step(f"{_label(test, 1)}_modes_s"):
         modes_b = test.modes() if test.has_modes else None
-    modal_rows = [] if modes_b is None else _modal_rows(spec, reference, test, modes_a, modes_b)
+    reduction = None
+    if modes_b is not None:  # a reduced model's modes against the reference reduced alike
+        modal_reference, modes_a, reduction = reduced_reference(reference, test, (modes_a, modes_b))
+    modal_rows = [] if modes_b is None else _modal_rows(spec, modal_reference, test, modes_a, modes_b)
+    if reduction and test.driven:
+        reduction = f"{reduction[:-1]}; its time histories are compared with the full reference's."
+    told = [*test.notes] + ([reduction] if reduction else [])  # what was done to the test and the reference
     modal_tolerance = tolerances.lookup("modes", "frequency", "rel_error")
     assert modal_tolerance is not None  # the defaults hold it, and a tolerances file only overrides them
     references = list(dict.fromkeys(list(spec.references) + list(reference.references) + list(test.references)))
     if not test.driven:
         return _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_tolerance, (modes_a, modes_b),
-                           clock, references)
+                           clock, references, told)
 
     asked = settings[0].duration
     adjustable = [s.dt is None for s in settings]
-    duration, notes = asked, _Notes()
+    duration, notes = asked, _Notes(told)
     steps = first_steps((reference, test), settings)
     refinements, extended, best = 0, False, None
     needed = plan.needed_duration() if plan.detect_steady else None
@@ -317,10 +326,10 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
 
 
 def _modal_only(spec, reference, test, plan, tolerances, modal_rows, modal_tolerance, modal_results, clock,
-                references) -> CrosscheckResult:
+                references, told) -> CrosscheckResult:
     """The cross-check of a side that nothing drives (``Side.driven`` False): its modes against the reference's,
-    the time-domain part skipped with the reason and what to add."""
-    notes = _Notes()
+    the time-domain part skipped with the reason and what to add; ``told``: the notes already made."""
+    notes = _Notes(told)
     notes.append(f"{display_name(test.solver)} has nothing that drives it: no mesh rows, no time-varying stiffness, "
                  "no time-varying force. Its runs would sit at their static state, so only its modes are compared; "
                  "give its meshes as mesh rows (or its stiffness and forcing as functions of time) for the "

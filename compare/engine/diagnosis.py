@@ -57,6 +57,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.linalg as sla
 
+from gearcheck.compare.engine.reduction import reduction_basis
 from gearcheck.lumped.assembly import DofMap, LumpedModel
 from gearcheck.train.spec import AXIAL, ROTATION
 from gearcheck.lumped.modal import modes, modes_at_speed
@@ -763,23 +764,27 @@ def diagnose(model: LumpedModel, evidence: Evidence, top: int = 3) -> Diagnosis:
 def diagnose_side(model: LumpedModel, side, modal=None, top: int = 3) -> Diagnosis:
     """The diagnosis of a user's model as the cross-check holds it (a :class:`~gearcheck.shared.side.Side`)
     against the reference ``model``: its frequencies, its shapes and its frequencies at the operating speed where
-    it has them.  A model given as
-    matrices over the train's members is compared with the reference reduced to its coordinates
-    (:func:`constrained`), so a torsional model is held to the reference with its translations tied as its
-    map ties them.  ``modal``: the side's modes when already computed."""
+    it has them.  A model given as matrices over the train's members (its extra coordinates aside) is compared
+    with the reference reduced to its coordinates as it declares, held or condensed
+    (:func:`~gearcheck.compare.engine.reduction.reduction_basis`, then :func:`constrained`), so a torsional
+    model is held to the reference with its translations tied as its map ties them.  ``modal``: the side's modes
+    when already computed."""
     modal = side.modes() if modal is None else modal
     try:
         at_speed = side.modes_at_speed(model.spec.operating.input_speed).frequencies
     except UnsupportedError:
         at_speed = None
     linear = side.linear
-    if linear is not None and all("." in c and c.rsplit(".", 1)[0] in model.spec.members for c in linear.coordinates):
-        T, _ = linear.to_physical(model.dofs.labels())
-        reduced = constrained(model, linear.coordinates, T)
-        diagnosis = diagnose(reduced, Evidence(linear.coordinates, modal.frequencies, modal.shapes, linear.M,
-                                               at_speed), top)
-        if len(linear.coordinates) < model.n:
-            diagnosis.reduced_to = len(linear.coordinates)
+    own = [] if linear is None else [i for i, c in enumerate(linear.coordinates) if c not in linear.extra]
+    coordinates = [linear.coordinates[i] for i in own]
+    if own and all("." in c and c.rsplit(".", 1)[0] in model.spec.members for c in coordinates):
+        T, mapped = linear.to_physical(model.dofs.labels())
+        basis = reduction_basis(model.K_mean, T[:, own], mapped, linear.reduction)
+        reduced = constrained(model, coordinates, basis)
+        diagnosis = diagnose(reduced, Evidence(coordinates, modal.frequencies, modal.shapes[own],
+                                               linear.M[np.ix_(own, own)], at_speed), top)
+        if len(coordinates) < model.n:
+            diagnosis.reduced_to = len(coordinates)
         return diagnosis
     try:
         labels, mass, shapes = side.physical_modes(modal)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from gearcheck.compare.engine.reduction import reduced_reference
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import frequency_groups, modal_assurance
 
@@ -37,6 +38,7 @@ class ModePairing:
     mac: np.ndarray
     paired: np.ndarray  # per reference mode: its share in its own frequency group's test modes
     findings: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # what was done to the test model and the reference, in words
 
     def plot(self):
         """The MAC matrix as a :class:`matplotlib.figure.Figure` (no pyplot)."""
@@ -48,17 +50,20 @@ class ModePairing:
         return {"train": self.train, "reference": self.reference, "test": self.test,
                 "frequencies_reference_hz": self.frequencies_reference.tolist(),
                 "frequencies_test_hz": self.frequencies_test.tolist(), "mac": self.mac.tolist(),
-                "paired": self.paired.tolist(), "worst_paired": float(self.paired.min()), "findings": self.findings}
+                "paired": self.paired.tolist(), "worst_paired": float(self.paired.min()), "findings": self.findings,
+                "notes": self.notes}
 
 
 def pair_modes(train: str, reference, test, modes: tuple | None = None) -> ModePairing:
     """Pair the modes of two sides (objects with ``solver``, ``modes()`` and ``physical_modes(modal)``).
 
-    A test model with fewer coordinates (a torsional model against the translational-torsional reference)
-    is compared on the coordinates it has, with the reference's mass over them; each reference mode's own
+    A test model with fewer coordinates (a ring eliminated, a torsional model) is compared with the reference
+    reduced to them (:func:`~gearcheck.compare.engine.reduction.reduced_reference`: held or condensed, as the
+    model declares), on the coordinates it has, with the reference's mass over them; each reference mode's own
     partners are the test modes of the frequency group nearest to it.  ``modes``: the two sides' modes when
     already computed."""
     modes_a, modes_b = modes if modes is not None else (reference.modes(), test.modes())
+    reference, modes_a, reduction = reduced_reference(reference, test, (modes_a, modes_b))
     labels_a, M, shapes_a = reference.physical_modes(modes_a)
     labels_b, _, shapes_b = test.physical_modes(modes_b)
     missing = [label for label in labels_b if label not in labels_a]
@@ -91,4 +96,5 @@ def pair_modes(train: str, reference, test, modes: tuple | None = None) -> ModeP
     for j in np.where(mac.max(axis=0) < NO_MATCH)[0]:
         findings.append(f"spurious: {test.solver} mode {j + 1} ({fb[j]:.6g} Hz) has no {reference.solver} "
                         f"partner (best MAC {mac[:, j].max():.3f})")
-    return ModePairing(train, reference.solver, test.solver, fa, fb, mac, paired, findings)
+    notes = [*getattr(test, "notes", ())] + ([reduction] if reduction else [])
+    return ModePairing(train, reference.solver, test.solver, fa, fb, mac, paired, findings, notes)

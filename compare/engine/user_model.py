@@ -110,6 +110,9 @@ class AdoptedSide(Side):
                 value = getattr(side, name)
                 setattr(self, name, self._guarded(name, value) if callable(value) else value)
         self.references = tuple(self.references)
+        if isinstance(self.notes, str) or not all(isinstance(x, str) for x in self.notes):
+            raise GearcheckError(f"model={given}: its notes {shown(self.notes)} are not a list of sentences")
+        self.notes = tuple(self.notes)
         if not isinstance(self.kind, str) or not self.kind.strip():
             raise GearcheckError(f"model={given}: its kind {shown(self.kind)} is no words for what it is (a string)")
         if isinstance(self.order, bool) or self.order not in (1, 2, 3, 4, 5, 6, 7, 8):

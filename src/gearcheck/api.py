@@ -105,13 +105,15 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
 
 def mode_pairing(train, model=None, against: str = "lumped") -> ModePairing:
     """The lumped model's and the MuJoCo twin's mode shapes paired by the modal assurance criterion; with
-    ``model`` (as :func:`crosscheck` takes it), that model's against ``against``.
+    ``model`` (as :func:`crosscheck` takes it), that model's against ``against``: a model with fewer
+    coordinates against the reference reduced to them (held or condensed, as it declares).
 
     Returns
     -------
     ModePairing
         ``mac`` (reference modes x twin modes), ``paired`` (each mode's share in its frequency group's twin
-        modes: 1 is the same shape), ``findings`` (swapped, missing, spurious modes), ``to_dict()``; ``plot()``.
+        modes: 1 is the same shape), ``findings`` (swapped, missing, spurious modes), ``notes`` (what was
+        reduced, condensed or set aside, in sentences), ``to_dict()``; ``plot()``.
     """
     return Train(train).mac(model, against)
 

@@ -380,6 +380,8 @@ def cmd_mac(args) -> int:
         write_file(place.path / "mac.json", json.dumps(pairing.to_dict(), indent=2) + "\n")
     print(f"{pairing.train}: {len(pairing.paired)} modes; each {pairing.reference} mode lies in its frequency group's "
           f"{pairing.test} modes to {1.0 - pairing.paired.min():.1e} (worst)")
+    for line in pairing.notes:
+        print(f"  {line}")
     for line in pairing.findings:
         print(f"  {line}")
     print(f"  wrote {args.out / 'mac.png'} and {args.out / 'mac.json'}")

@@ -36,6 +36,7 @@ class Side(ABC):
     driven: bool = True  # its runs have something that moves them (False: matrices with no mesh rows, no varying
     #                      stiffness and no varying force: its runs would sit still, and only its modes compare)
     linear = None  # its matrices (a LinearModel) when it is a model given as matrices
+    notes: tuple[str, ...] = ()  # what was done to it (coordinates condensed, modes set aside), as reports say it
     order = 1  # the order its runs converge at; 1 (not known) makes the change on doubling the step a bound
 
     @abstractmethod

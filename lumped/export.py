@@ -119,10 +119,17 @@ def write_matrix_file(model: LinearModel, path) -> None:
     path = Path(path)
     matlab = path.suffix == ".mat"
     data = {"coordinates": np.array(model.coordinates, dtype=object if matlab else str), "M": model.M, "K": model.K,
-            "name": model.name, "start": model.start, "units": "SI"}
-    for name in ("C", "G", "K_omega", "F"):
+            "name": model.name, "start": model.start, "reduction": model.reduction, "units": "SI"}
+    for name in ("C", "G", "K_omega", "G_per_speed", "K_omega_per_speed2", "F"):
         if getattr(model, name) is not None:
             data[name] = getattr(model, name)
+    if model.G_per_speed is not None or model.K_omega_per_speed2 is not None:
+        data["speed_of"] = model.speed_of
+    if model.physical is not None:
+        labels = list(model.physical)
+        data["physical_labels"] = np.array(labels, dtype=object if matlab else str)
+        data["physical"] = np.array([[model.physical[label].get(c, 0.0) for c in model.coordinates]
+                                     for label in labels])
     periods = set()
     if model.forcing is not None:
         period, F = _forcing_samples(model)

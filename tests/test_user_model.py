@@ -367,3 +367,29 @@ def test_periodic_rate_is_the_derivative():
     expected = (-0.5 * w * np.sin(w * at) * np.sin(x[0]) / x[0]
                 + 0.75 * w * np.cos(3 * w * at) * np.sin(x[1]) / x[1])
     np.testing.assert_allclose(sampled(at), expected, rtol=0, atol=1e-12 * w)
+
+
+@pytest.mark.parametrize("suffix", [".mat", ".npz"])
+def test_a_model_file_keeps_every_field_it_was_given(tmp_path, suffix):
+    """What a model carries survives the file: per-unit-speed G and K_omega with their speed, the map to the
+    train's coordinates, the declared reduction (a torsional model: its rotations, u = r theta for the sun)."""
+    spec = gearcheck.load("demo-3p")
+    ref = reference_linear_model(spec)
+    keep = [i for i, c in enumerate(ref.coordinates) if c.endswith(".theta")]
+    names = [ref.coordinates[i] for i in keep]
+    r = 0.033
+    physical = {c: {c: 1.0} for c in names}
+    physical["stage1.sun.theta"] = {"stage1.sun.theta": 1.0 / r}
+    T = np.eye(len(keep))
+    T[names.index("stage1.sun.theta"), names.index("stage1.sun.theta")] = 1.0 / r
+    M, K = (T.T @ ref.matrix(x)[np.ix_(keep, keep)] @ T for x in ("M", "K"))
+    G = T.T @ ref.matrix("G")[np.ix_(keep, keep)] @ T
+    model = LinearModel("torsional", names, M, K, G_per_speed=G / spec.operating.input_speed,
+                        K_omega_per_speed2=np.zeros_like(K), physical=physical, reduction="condensed")
+    path = tmp_path / f"model{suffix}"
+    write_matrix_file(model, path)
+    back = read_matrix_file(path)
+    for name in ("M", "K", "G_per_speed", "K_omega_per_speed2"):
+        np.testing.assert_array_equal(back.matrix(name), model.matrix(name))
+    assert back.G is None and back.speed_of == "input" and back.reduction == "condensed"
+    assert back.physical == physical and back.coordinates == names

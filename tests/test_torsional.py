@@ -19,7 +19,7 @@ import gearcheck
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.modal import modes
 from gearcheck.shared.errors import TrainFileError, TrainNote
-from gearcheck.train.variants import chained_text, edited, edited_text
+from gearcheck.train.variants import chained_text, edited, edited_text, helical_stage
 
 STAGE = (r"^planets = 3", "planets = 3\ntorsional = true")  # demo-3p's stage, every member torsional
 PLANETS = (r"^\[stages.planet\]", "[stages.planet]\ntorsional = true")
@@ -89,15 +89,22 @@ def test_stiff_supports_converge_to_it_as_one_over_k():
     assert np.allclose(errors[0] / errors[1], 10.0, rtol=0.02)
 
 
-@pytest.mark.parametrize("pairs, rotations_only", [((STAGE,), True), ((PLANETS,), False), ((CARRIER,), False)],
-                         ids=["every member", "planets", "carrier"])
-def test_both_solvers_agree_on_the_free_coordinates(pairs, rotations_only):
+@pytest.mark.parametrize("pairs, rotations_only, helical", [
+    ((STAGE,), True, False), ((PLANETS,), False, False), ((CARRIER,), False, False), ((STAGE,), True, True),
+    ((PLANETS,), False, True)], ids=["every member", "planets", "carrier", "helical", "helical planets"])
+def test_both_solvers_agree_on_the_free_coordinates(pairs, rotations_only, helical):
     """Lumped and twin agree; a mode per free coordinate (6 rotations when every member is torsional; a planet on
-    its pin loses its two translations, a central member its two)."""
-    spec = train(*pairs)
+    its pin loses its two translations, a central member its two, and in a helical stage its axial one too: a
+    planet's rides the carrier's)."""
+    if helical:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TrainNote)
+            spec = helical_stage(extra=pairs)
+    else:
+        spec = train(*pairs)
     lumped, twin = gearcheck.modes(spec, solver="lumped"), gearcheck.modes(spec, solver="mujoco")
     free = sum(len(m.coordinates) for m in spec.members.values())
-    assert free == sum(len(m.dofs) for m in spec.members.values()) - 2 * sum(m.torsional for m in spec.members.values())
+    assert free == sum(len(m.dofs) - (len(m.dofs) - 1) * m.torsional for m in spec.members.values())
     assert lumped.frequencies.size == twin.frequencies.size == free
     assert free == len(spec.members) if rotations_only else free > len(spec.members)
     assert np.allclose(twin.frequencies, lumped.frequencies, rtol=1e-9)

@@ -84,6 +84,11 @@ class LumpedModel:
         return len(self.dofs)
 
     @property
+    def physical_dofs(self) -> DofMap:
+        """The train's physical coordinates: :attr:`dofs`, or those its coordinates are tied to (``expansion``)."""
+        return self.dofs if self.train_dofs is None else self.train_dofs
+
+    @property
     def K_frame(self) -> np.ndarray:
         """Every stiffness-like term of the rotating frame."""
         return self.K_centripetal + self.K_circulatory

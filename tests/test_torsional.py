@@ -10,6 +10,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,10 +18,13 @@ import scipy.linalg as sla
 
 import gearcheck
 from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.modal import modes
+from gearcheck.lumped.side import LinearSide
 from gearcheck.shared.errors import TrainFileError, TrainNote
 from gearcheck.train.variants import chained_text, edited, edited_text, helical_stage
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 STAGE = (r"^planets = 3", "planets = 3\ntorsional = true")  # demo-3p's stage, every member torsional
 PLANETS = (r"^\[stages.planet\]", "[stages.planet]\ntorsional = true")
 CARRIER = (r"^\[stages.carrier\]", "[stages.carrier]\ntorsional = true")
@@ -125,6 +129,27 @@ def test_crosscheck_passes(pairs):
     lumped, twin = result.results
     for run in (lumped, twin):
         assert np.all(run["stage1.sun.ax.world"] == 0.0) and np.all(run["stage1.carrier.ay.carrier"] == 0.0)
+
+
+def test_a_users_torsional_model_is_the_torsional_train(tmp_path):
+    """examples/torsional_user_model.py, a user's torsional derivation from Lin & Parker (1999), is the torsional
+    train's reference itself (M and mean K to round-off, no projection), and the reference exported as a file of
+    matrices passes the cross-check as a user's model, its map over the torsional train's coordinates."""
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        from torsional_user_model import torsional_model
+    finally:
+        sys.path.remove(str(EXAMPLES))
+    spec = train(STAGE)
+    reference, user = build_model(spec), LinearSide(torsional_model(spec), spec).linear
+    assert user.coordinates == reference.dofs.labels()
+    np.testing.assert_allclose(user.M, reference.M, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(user.K_mean, reference.K_mean, rtol=1e-12, atol=1e-12 * np.abs(reference.K_mean).max())
+    path = tmp_path / "torsional.mat"
+    write_matrix_file(reference_linear_model(spec), path)
+    result = gearcheck.crosscheck(spec, model=str(path), duration=0.05)
+    assert result.verdict == "PASS", result.failures
+    assert max(m["rel_error"] for m in result.modal) < 1e-12
 
 
 def test_ignored_supports_are_noted():

@@ -35,7 +35,7 @@ from contextlib import contextmanager
 import mujoco
 import numpy as np
 
-from gearcheck.mbd_models.mjcf_text import ROTATION
+from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes
 from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
@@ -260,7 +260,7 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
         P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier
         for mid, member in mb.spec.members.items():
             if member.frame == "axis" and not member.torsional:
-                ix, iy = mb.dadr[mid]["x"], mb.dadr[mid]["y"]
+                ix, iy = (mb.dadr[mid][a] for a in member_axes(member))
                 omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
                 P[ix, iy], P[iy, ix] = -omega, omega
 

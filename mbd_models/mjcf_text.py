@@ -38,16 +38,22 @@ ROTATION = "rz"  # the hinge of the member's rotation theta
 AXIAL = "z"  # the slide along the stage axis
 
 
-def member_axes(member) -> tuple[str, ...]:
-    """The names of a member's joints of its two translations (:data:`AXES`; its rotation is ``rz``): none for a
-    torsional member, which sits on its parent (the world, or its carrier's pin) with its hinge alone."""
-    return () if member.torsional else AXES[member.frame]
+def _joint_names(member) -> dict[str, str]:
+    """Each of the member's :attr:`~gearcheck.train.spec.Member.dofs` -> the suffix of the joint that realises it."""
+    return dict(zip(member.dofs, AXES[member.frame] + (ROTATION, AXIAL)))
 
 
 def member_joints(member) -> tuple[str, ...]:
     """The suffixes of all of a member's joints, one per free coordinate in the order of its
-    :attr:`~gearcheck.train.spec.Member.coordinates`."""
-    return member_axes(member) + (ROTATION,) + ((AXIAL,) if member.axial and not member.torsional else ())
+    :attr:`~gearcheck.train.spec.Member.coordinates`: a torsional member has its hinge alone, and sits on its
+    parent (the world, or its carrier's pin)."""
+    names = _joint_names(member)
+    return tuple(names[d] for d in member.coordinates)
+
+
+def member_axes(member) -> tuple[str, ...]:
+    """The suffixes of a member's joints of its two translations (:data:`AXES`; none for a torsional member)."""
+    return tuple(j for j in member_joints(member) if j in AXES[member.frame])
 
 
 def num(x) -> str:

@@ -69,6 +69,7 @@ from gearcheck.mbd_models import compiled
 from gearcheck.mbd_models.elements import base as elements
 from gearcheck.mbd_models.forces import ForceReader
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
+from gearcheck.mbd_models.mjcf_text import ROTATION
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
@@ -561,7 +562,7 @@ def _body_clock(mb: MbdModel):
     for mesh in spec.meshes:
         carrier = spec.stage_of(mesh.planet).carrier
         rel = kin.speeds[mesh.central] - kin.speeds[carrier]
-        rows.append((mb.qadr[mesh.central]["rz"], mb.qadr[carrier]["rz"],
+        rows.append((mb.qadr[mesh.central][ROTATION], mb.qadr[carrier][ROTATION],
                      math.copysign(1.0, rel) * (mesh.central_gear.teeth or 0) / (2 * math.pi)))
     return tuple(np.array(x) for x in zip(*rows))
 

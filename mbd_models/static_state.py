@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 
 from gearcheck.mbd_models.forces import ForceReader
+from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes
 from gearcheck.shared.errors import SolverError
 
 # --------------------------------------------------------------------------- damping correction
@@ -73,11 +74,11 @@ def nominal_speeds(mb) -> np.ndarray:
     spec, kin = mb.spec, mb.kin
     qvel = np.zeros(mb.model.nv)
     for mid, member in spec.members.items():
-        ir = mb.dadr[mid]["rz"]
+        ir = mb.dadr[mid][ROTATION]
         omega = kin.speeds[f"{member.stage}.carrier"]
         if member.eccentric is not None:
             orbit = kin.speeds[member.eccentric.crank]
-            qvel[mb.dadr[mid]["orbit"]], qvel[ir] = orbit, kin.speeds[mid] - orbit
+            qvel[mb.dadr[mid][member_axes(member)[0]]], qvel[ir] = orbit, kin.speeds[mid] - orbit
         else:
             qvel[ir] = kin.speeds[mid] - (omega if member.orbits else 0.0)
     return qvel
@@ -95,7 +96,7 @@ def _nominal(mb, q: np.ndarray):
     for mid, member in spec.members.items():
         if member.frame != "axis" or member.torsional:
             continue
-        ix, iy = mb.dadr[mid]["x"], mb.dadr[mid]["y"]
+        ix, iy = (mb.dadr[mid][a] for a in member_axes(member))
         omega = kin.speeds[f"{member.stage}.carrier"]
         qvel[ix], qvel[iy] = -omega * q[iy], omega * q[ix]
         target[ix], target[iy] = -omega**2 * q[ix], -omega**2 * q[iy]

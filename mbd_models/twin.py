@@ -63,7 +63,7 @@ from gearcheck.mbd_models.elements import ELEMENTS
 from gearcheck.mbd_models.elements.base import group_order
 from gearcheck.mbd_models.elements.mesh import mesh_joints
 from gearcheck.mbd_models.mjcf_builder import document, header
-from gearcheck.mbd_models.mjcf_text import ROTATION, LateValues, member_axes
+from gearcheck.mbd_models.mjcf_text import AXES, ROTATION, LateValues, member_axes
 from gearcheck.mbd_models.static_state import static_state
 from gearcheck.shared import stepping
 
@@ -315,8 +315,9 @@ def _indices(spec, kin, exc, model) -> MbdModel:
     wraps = np.array(x_wraps + y_wraps, dtype=int)
     c0x, c0y = model.wrap_prm[x_wraps].copy(), model.wrap_prm[y_wraps].copy()
     base = np.stack([np.concatenate([c0x, c0y]), np.concatenate([-c0y, c0x])], axis=1)
-    slide_qadr = np.array([qadr[mid]["x"] for mid in slide_x] + [qadr[mid]["y"] for mid in slide_y], dtype=int)
-    slide_dof = np.array([dadr[mid]["x"] for mid in slide_x] + [dadr[mid]["y"] for mid in slide_y], dtype=int)
+    x, y = AXES["axis"]
+    slide_qadr = np.array([qadr[mid][x] for mid in slide_x] + [qadr[mid][y] for mid in slide_y], dtype=int)
+    slide_dof = np.array([dadr[mid][x] for mid in slide_x] + [dadr[mid][y] for mid in slide_y], dtype=int)
     carrier_qadr = np.array(carrier + carrier, dtype=int)
     turning = TurningCoefficients(wraps, base, carrier_qadr, np.array(tendon + tendon, dtype=int), slide_qadr,
                                   slide_dof)

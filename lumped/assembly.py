@@ -35,7 +35,8 @@ terms of the rotating frame:
 Each member's coordinates are its :attr:`~gearcheck.train.spec.Member.dofs`; every part of the train
 (:attr:`~gearcheck.train.spec.TrainSpec.parts`) is built by the element of its kind
 (:mod:`gearcheck.lumped.elements`).  A new kind of part is a new element; nothing here is specific to a part
-or a stage layout.
+or a stage layout.  A train with torsional members is assembled over all of these coordinates and then reduced to
+its free ones (:func:`gearcheck.lumped.constraints.torsional`).
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ import numpy as np
 
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, DofMap, Row
+from gearcheck.lumped.constraints import torsional
 from gearcheck.lumped.elements.bearing import pin_rows
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import Kinematics, kinematics
@@ -74,10 +76,17 @@ class LumpedModel:
     excitation: Excitation
     rotating_frame_terms: bool = True
     turning: list = field(default_factory=list)  # elements whose rows move with time (elements.base.Turning)
+    expansion: np.ndarray | None = None  # T: the train's coordinates are T q where some are tied (constraints)
+    train_dofs: DofMap | None = None  # the train's coordinates, where they are not the model's (``expansion``)
 
     @property
     def n(self) -> int:
         return len(self.dofs)
+
+    @property
+    def physical_dofs(self) -> DofMap:
+        """The train's physical coordinates: :attr:`dofs`, or those its coordinates are tied to (``expansion``)."""
+        return self.dofs if self.train_dofs is None else self.train_dofs
 
     @property
     def K_frame(self) -> np.ndarray:
@@ -184,6 +193,7 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     for p in parts:
         if p.place:
             model = p.place(model)
+    model = torsional(model)
     return model if rotating_frame_terms else model.without_rotating_frame_terms()
 
 

@@ -40,7 +40,7 @@ def _typing(model, train) -> tuple:
     central members' own; (None, None) when it has none (then modes are rigid or elastic)."""
     if train is None:
         return None, None
-    known = set(train.dofs.labels())
+    known = set(train.physical_dofs.labels())
     translation, rotation = central_coordinates(train.spec, [c if c in known else "" for c in model.coordinates])
     return (translation, rotation) if translation or rotation else (None, None)
 
@@ -176,24 +176,24 @@ def linear_result(model, train, t, q, v, qdd, q0, info) -> TimeResult:
 def _train_signals(model, train, t, q, v, qdd, q0):
     """The train's signals the model has: a member's angular acceleration when its rotation is one of the
     model's coordinates, its translational accelerations when both its translations are, and its meshes'."""
-    labels = train.dofs.labels()
+    labels = train.physical_dofs.labels()
     T, mapped = model.to_physical(labels)
     has = dict(zip(labels, mapped))
-    acc, angle = member_motion(train.spec, train.kin, train.dofs, t, q @ T.T, v @ T.T, qdd @ T.T)
+    acc, angle = member_motion(train.spec, train.kin, train.physical_dofs, t, q @ T.T, v @ T.T, qdd @ T.T)
     by_name = {s.name: s for s in train_signals(train.spec)}
     signals, columns = [], []
-    for j, mid in enumerate(train.spec.members):
-        u, w, th = (labels[i] for i in train.dofs.of_member(mid)[:3])
-        if has[u] and has[w]:
+    for j, (mid, member) in enumerate(train.spec.members.items()):
+        u, w, th = (f"{mid}.{d}" for d in member.dofs[:3])
+        if has.get(u) and has.get(w):
             c, s = np.cos(angle[:, j]), np.sin(angle[:, j])
             world = (c * acc[:, j, 0] - s * acc[:, j, 1], s * acc[:, j, 0] + c * acc[:, j, 1])
             for axis, x_world, x_carrier in zip("xy", world, acc[:, j, :2].T):
                 signals += [by_name[f"{mid}.a{axis}.world"], by_name[f"{mid}.a{axis}.carrier"]]
                 columns += [x_world, x_carrier]
-        if has[th]:
+        if has.get(th):
             signals.append(by_name[f"{mid}.alpha"])
             columns.append(acc[:, j, 2])
-        if train.spec.members[mid].axial and has[f"{mid}.{AXIAL}"]:
+        if member.axial and has.get(f"{mid}.{AXIAL}"):
             signals.append(by_name[f"{mid}.az"])
             columns.append(acc[:, j, 3])
     static = {}

@@ -104,7 +104,7 @@ class LinearSide(Side):
     def __init__(self, model: LinearModel, spec, references: tuple[str, ...] = ()):
         self.spec = spec
         self.train = build_model(spec)  # the train's coordinates and kinematics, which the model maps into
-        self.linear = condense_massless(model.check(spec, self.train.dofs.labels()))
+        self.linear = condense_massless(model.check(spec, self.train.physical_dofs.labels()))
         self.solver = model.name
         self.references = references
         self.driven = bool(self.linear.meshes) or self.linear.stiffness is not None or self.linear.forcing is not None
@@ -136,7 +136,7 @@ class LinearSide(Side):
     def physical_modes(self, modal: ModalResult) -> tuple[list[str], np.ndarray | None, np.ndarray]:
         """(the train coordinates the model has, its mass matrix over them when they determine its own
         coordinates, else None; the shapes of ``modal`` over them)."""
-        labels = self.train.dofs.labels()
+        labels = self.train.physical_dofs.labels()
         T, mapped = self.linear.to_physical(labels)
         T = T[mapped]
         own = [i for i, c in enumerate(self.linear.coordinates) if c not in self.linear.extra]

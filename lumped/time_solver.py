@@ -391,7 +391,8 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     delta, force = sys.mesh_force(q, v, k, e, de, pairs)
     k = sys.contact_stiffness(q, k, e, pairs)
     spec, dofs = model.spec, model.dofs
-    acc, angle = member_motion(spec, model.kin, dofs, t, q, v, qdd, model.rotating_frame_terms)
+    q_t, v_t, qdd_t = (q, v, qdd) if model.expansion is None else (x @ model.expansion.T for x in (q, v, qdd))
+    acc, angle = member_motion(spec, model.kin, model.physical_dofs, t, q_t, v_t, qdd_t, model.rotating_frame_terms)
     rows = {r.name: r for r in model.rows if r.kind == "bearing"}
     bearings = [rows[name] for name in bearing_names(spec)]
     a = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)

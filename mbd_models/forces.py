@@ -12,6 +12,11 @@ evaluated by ``mj_passive`` on the same state, take them apart:
 * the bearing probe, with every tendon removed, gives the joints' own springs and dampers: a bearing force
   (of a planet, or of an RV reducer's crankshaft on its carrier) is minus its slides' joint forces.
 
+A torsional planet (no slides: it rides its pin) has a hinge alone for its two meshes, and the planets' joints no
+longer tell the meshes apart (nor do all the joints: the load sharing among torsional planets moves no joint).
+Then the mesh probe holds one mesh tendon at a time, whose force is f_j = J_j . (J_j^T f_j) / |J_j|^2, and g is
+read from the runner's damping correction (:class:`~gearcheck.mbd_models.static_state.DampingCorrection`).
+
 Nothing here restates a force law: the dead band, the spring and the damper are MuJoCo's.
 """
 
@@ -22,15 +27,16 @@ import copy
 import mujoco
 import numpy as np
 
+from gearcheck.mbd_models.mjcf_text import member_axes
 from gearcheck.shared.errors import SolverError
 
 
 class ForceReader:
     """Reads mesh and bearing forces from MuJoCo's generalized forces for one compiled twin and its data."""
 
-    def __init__(self, mb, d: mujoco.MjData):
+    def __init__(self, mb, d: mujoco.MjData, correction=None):
         m = mb.model
-        self.model, self.d = m, d
+        self.mb, self.model, self.d, self.correction = mb, m, d, correction
         self.n_mesh = len(mb.mesh_tendon)
         self.probe = copy.copy(m)
         self.probe.jnt_stiffness[:] = 0.0
@@ -41,42 +47,61 @@ class ForceReader:
         self.joints_only.tendon_stiffness[:] = 0.0
         self.joints_only.tendon_damping[:] = 0.0
         planets = [mid for mid, member in mb.spec.members.items() if member.is_planet]
-        self.dofs = np.array([dof for mid in planets for dof in mb.dadr[mid]], dtype=int)
-        self.slides = np.array([dof for mid, member in mb.spec.members.items() if member.orbits and member.bearing
-                                for dof in mb.dadr[mid][:2]], dtype=int)
+        self.dofs = np.array([dof for mid in planets for dof in mb.dadr[mid].values()], dtype=int)
+        self.slides = np.array([mb.dadr[mid][a] for mid, member in mb.spec.members.items()
+                                if member.orbits and member.bearing for a in member_axes(member)], dtype=int)
         J_P = mb.mesh_jacobian()[:, self.dofs]
-        if np.linalg.matrix_rank(J_P) < self.n_mesh:
+        self.one_by_one = any(mb.spec.members[mid].torsional for mid in planets)
+        if not self.one_by_one and np.linalg.matrix_rank(J_P) < self.n_mesh:
             raise SolverError(f"{mb.spec.name}: the mesh forces cannot be told apart at the planets' joints "
                               "(a planet meshes with more than three central gears)")
-        self.P = np.linalg.pinv(J_P.T)
+        self.P = None if self.one_by_one else np.linalg.pinv(J_P.T)
         # views kept once: the hot path only copies into them
         self._sum = np.empty(m.nv)
         self._spring, self._damper, self._applied = d.qfrc_spring, d.qfrc_damper, d.qfrc_applied
         n = self.n_mesh
         self._stiffness, self._probe_stiffness = m.tendon_stiffness[:n], self.probe.tendon_stiffness[:n]
         self._lengths, self._probe_lengths = m.tendon_lengthspring[:n], self.probe.tendon_lengthspring[:n]
+        self._damping, self._probe_damping = m.tendon_damping[:n], self.probe.tendon_damping[:n]
 
     @property
     def width(self) -> int:
-        return 2 * len(self.dofs) + len(self.slides)
+        return 2 * (self.n_mesh if self.one_by_one else len(self.dofs)) + len(self.slides)
 
     def sample(self, out: np.ndarray) -> None:
         """After ``mj_forward``: write the planet joints' (mesh-only, applied) generalized forces and the bearing
         slides' joint forces into ``out`` (one row of :attr:`width`), for :meth:`forces`.  Leaves the data's
         passive forces those of a probe (nothing that the RK4 stages read)."""
         n, dofs, total = len(self.dofs), self.dofs, self._sum
-        self._probe_stiffness[:] = self._stiffness
-        self._probe_lengths[:] = self._lengths
-        mujoco.mj_passive(self.probe, self.d)
-        np.add(self._spring, self._damper, out=total)
-        out[:n] = total[dofs]
-        out[n:2 * n] = self._applied[dofs]
+        if self.one_by_one:
+            n = self._each(out)
+        else:
+            self._probe_stiffness[:] = self._stiffness
+            self._probe_lengths[:] = self._lengths
+            mujoco.mj_passive(self.probe, self.d)
+            np.add(self._spring, self._damper, out=total)
+            out[:n] = total[dofs]
+            out[n:2 * n] = self._applied[dofs]
         mujoco.mj_passive(self.joints_only, self.d)
         np.add(self._spring, self._damper, out=total)
         out[2 * n:] = total[self.slides]
 
+    def _each(self, out: np.ndarray) -> int:
+        """Each mesh tendon's force alone in the probe, and the damping correction's g, into ``out``; returns
+        n_mesh."""
+        n, J, total = self.n_mesh, self.mb.mesh_jacobian(), self._sum
+        for j in range(n):
+            self._probe_stiffness[:], self._probe_damping[:] = 0.0, 0.0
+            self._probe_stiffness[j], self._probe_damping[j] = self._stiffness[j], self._damping[j]
+            self._probe_lengths[j] = self._lengths[j]
+            mujoco.mj_passive(self.probe, self.d)
+            np.add(self._spring, self._damper, out=total)
+            out[j] = J[j] @ total / (J[j] @ J[j])
+        out[n:2 * n] = 0.0 if self.correction is None else self.correction.g
+        return n
+
     def forces(self, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(mesh forces (n, n_mesh), bearing forces (n, n_bearing)) from rows written by :meth:`sample`."""
-        n = len(self.dofs)
+        n = self.n_mesh if self.one_by_one else len(self.dofs)
         mesh, applied, bearing = samples[:, :n], samples[:, n:2 * n], samples[:, 2 * n:]
-        return -(mesh + applied) @ self.P.T, -bearing
+        return -(mesh + applied) @ (np.eye(n) if self.P is None else self.P.T), -bearing

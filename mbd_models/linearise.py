@@ -35,6 +35,7 @@ from contextlib import contextmanager
 import mujoco
 import numpy as np
 
+from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes
 from gearcheck.mbd_models.static_state import nominal_speeds
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
@@ -189,7 +190,7 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
         else:
             axes = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0])}
         moves = [(f"{mid}.{name}", axis @ jp) for name, axis in axes.items()] + [(f"{mid}.theta", jr[2])]
-        if _axial_dof(mb, mid) is not None:
+        if member.axial:
             moves.append((f"{mid}.z", jp[2]))
         for label, row in moves:
             labels.append(label)
@@ -203,7 +204,8 @@ def _central(mb) -> tuple[list[int], list[int]]:
     its x, y and rotation in place of its polar joints (:func:`_disc_axes`)."""
     central = [mid for mid, member in mb.spec.members.items() if not member.orbits]
     axial = [dof for mid in central if (dof := _axial_dof(mb, mid)) is not None]
-    return [i for mid in central for i in mb.dadr[mid][:2]], [mb.dadr[mid][2] for mid in central] + axial
+    return ([i for mid in central for a, i in mb.dadr[mid].items() if a != ROTATION],
+            [mb.dadr[mid][ROTATION] for mid in central] + axial)
 
 
 def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -219,11 +221,12 @@ def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np
             continue
         e, psi = member.eccentric.eccentricity, member.eccentric.phase
         rate = speed_ratio * (mb.kin.speeds[member.eccentric.crank] - mb.kin.speeds[f"{member.stage}.carrier"])
-        i = np.ix_(mb.dadr[mid], mb.dadr[mid])
+        dofs = list(mb.dadr[mid].values())  # orbit, radial, own hinge
+        i = np.ix_(dofs, dofs)
         for out, scale, angle in ((S, 1.0, psi), (dS, rate, psi + 0.5 * np.pi), (ddS, rate**2, psi + np.pi)):
             c, s = np.cos(angle), np.sin(angle)  # d/dpsi (cos, sin) = (cos, sin) of psi + pi/2
             out[i] = scale * np.array([[-s / e, c / e, 0.0], [c, s, 0.0], [s / e, -c / e, 0.0]])
-        S[mb.dadr[mid][2], mb.dadr[mid][2]] = 1.0
+        S[mb.dadr[mid][ROTATION], mb.dadr[mid][ROTATION]] = 1.0
     return S, dS, ddS
 
 
@@ -256,8 +259,8 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
             c.undamp()
         P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier
         for mid, member in mb.spec.members.items():
-            if member.frame == "axis":
-                ix, iy, _ = mb.dadr[mid]
+            if member.frame == "axis" and not member.torsional:
+                ix, iy = (mb.dadr[mid][a] for a in member_axes(member))
                 omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
                 P[ix, iy], P[iy, ix] = -omega, omega
 
@@ -297,8 +300,9 @@ def _disc_curvature(mb, force: np.ndarray) -> np.ndarray:
     for mid, member in mb.spec.members.items():
         if member.eccentric is not None:
             e, psi = member.eccentric.eccentricity, member.eccentric.phase
-            orbit, radial, own = force[list(mb.dadr[mid])]
+            dofs = list(mb.dadr[mid].values())
+            orbit, radial, own = force[dofs]
             axes = np.array([[np.cos(psi), np.sin(psi)], [-np.sin(psi), np.cos(psi)]])  # rows e_r, e_t
             curvature = np.array([[0.0, (orbit - own) / e**2], [(orbit - own) / e**2, -radial / e]])
-            K[np.ix_(mb.dadr[mid][:2], mb.dadr[mid][:2])] = axes.T @ curvature @ axes
+            K[np.ix_(dofs[:2], dofs[:2])] = axes.T @ curvature @ axes
     return K

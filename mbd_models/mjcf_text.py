@@ -38,14 +38,22 @@ ROTATION = "rz"  # the hinge of the member's rotation theta
 AXIAL = "z"  # the slide along the stage axis
 
 
-def member_axes(member) -> tuple[str, str]:
-    """The names of a member's first two joints (:data:`AXES`; its rotation is ``rz``)."""
-    return AXES[member.frame]
+def _joint_names(member) -> dict[str, str]:
+    """Each of the member's :attr:`~gearcheck.train.spec.Member.dofs` -> the suffix of the joint that realises it."""
+    return dict(zip(member.dofs, AXES[member.frame] + (ROTATION, AXIAL)))
 
 
 def member_joints(member) -> tuple[str, ...]:
-    """The suffixes of all of a member's joints, one per degree of freedom in the order of its ``dofs``."""
-    return member_axes(member) + (ROTATION,) + ((AXIAL,) if member.axial else ())
+    """The suffixes of all of a member's joints, one per free coordinate in the order of its
+    :attr:`~gearcheck.train.spec.Member.coordinates`: a torsional member has its hinge alone, and sits on its
+    parent (the world, or its carrier's pin)."""
+    names = _joint_names(member)
+    return tuple(names[d] for d in member.coordinates)
+
+
+def member_axes(member) -> tuple[str, ...]:
+    """The suffixes of a member's joints of its two translations (:data:`AXES`; none for a torsional member)."""
+    return tuple(j for j in member_joints(member) if j in AXES[member.frame])
 
 
 def num(x) -> str:
@@ -177,10 +185,9 @@ def fixed(name: str, coefs: list[tuple[str, float]], stiffness: float, damping: 
 def _joints(member, springs: dict, axes, indent: str) -> list[str]:
     """The body's joints, (suffix, type, axis) each, with the springs its parts put on them, and its axial slide
     when it slides axially."""
-    if member.axial:
-        axes = axes + [(AXIAL, "slide", (0, 0, 1))]
+    axes = axes + [(AXIAL, "slide", (0, 0, 1))]
     return [f"{indent}  {joint(f'{member.label}_{name}', kind, axis, *springs.get((member.id, name), (0.0, 0.0)))}"
-            for name, kind, axis in axes]
+            for name, kind, axis in axes if name in member_joints(member)]
 
 
 def central_body(member, springs: dict, z_stage: float, indent: str, visuals: list[str],

@@ -69,6 +69,7 @@ from gearcheck.mbd_models import compiled
 from gearcheck.mbd_models.elements import base as elements
 from gearcheck.mbd_models.forces import ForceReader
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
+from gearcheck.mbd_models.mjcf_text import ROTATION
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
@@ -162,8 +163,8 @@ class _Stepper:
         self.mb, self.m, self.d, self.h = mb, m, d, h
         self.n_mesh = len(mb.mesh_tendon)
         self.drive = _Drive(mb)
-        self.reader = ForceReader(mb, d)
         self.correction = DampingCorrection(mb, d)
+        self.reader = ForceReader(mb, d, self.correction)
         self.lo_hi = np.stack([-mb.half_backlash, mb.half_backlash], axis=1)
         self.clock = _body_clock(mb) if bodies else None
         self.contacts = _ToothContacts(mb) if mb.excitation.relieved.size else None
@@ -426,6 +427,8 @@ def compiled_unsupported(mb: MbdModel, stiffness_clock: str = "nominal") -> str 
     """Why the compiled step loop cannot run ``mb`` (None: it can)."""
     if stiffness_clock != "nominal":
         return "the 'bodies' stiffness clock evaluates the stiffness models from the bodies' angles in Python"
+    if any(m.torsional and m.orbits for m in mb.spec.members.values()):
+        return "a torsional planet's mesh forces are read one mesh at a time in Python (ForceReader)"
     return compiled.unavailable()
 
 
@@ -559,7 +562,7 @@ def _body_clock(mb: MbdModel):
     for mesh in spec.meshes:
         carrier = spec.stage_of(mesh.planet).carrier
         rel = kin.speeds[mesh.central] - kin.speeds[carrier]
-        rows.append((mb.qadr[mesh.central][2], mb.qadr[carrier][2],
+        rows.append((mb.qadr[mesh.central][ROTATION], mb.qadr[carrier][ROTATION],
                      math.copysign(1.0, rel) * (mesh.central_gear.teeth or 0) / (2 * math.pi)))
     return tuple(np.array(x) for x in zip(*rows))
 

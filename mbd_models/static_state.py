@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 
 from gearcheck.mbd_models.forces import ForceReader
+from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes
 from gearcheck.shared.errors import SolverError
 
 # --------------------------------------------------------------------------- damping correction
@@ -36,6 +37,7 @@ class DampingCorrection:
         self.c_wrap = np.zeros((len(mb.mesh_tendon), len(tc.wraps)))  # mesh damping per turning wrap
         self.c_wrap[tc.tendon, np.arange(len(tc.wraps))] = self.c[tc.tendon]
         self.half = len(tc.wraps) // 2
+        self.g = np.zeros(len(mb.mesh_tendon))  # the last applied
 
     def apply(self, de) -> None:
         tc, d, n = self.mb.turning, self.d, self.half
@@ -46,6 +48,7 @@ class DampingCorrection:
         if de is not None:
             g += self.c * de
         d.qfrc_applied[:] = g @ self.J
+        self.g = g
 
 
 # --------------------------------------------------------------------------- static state
@@ -71,11 +74,11 @@ def nominal_speeds(mb) -> np.ndarray:
     spec, kin = mb.spec, mb.kin
     qvel = np.zeros(mb.model.nv)
     for mid, member in spec.members.items():
-        ix, _, ir = mb.dadr[mid]
+        ir = mb.dadr[mid][ROTATION]
         omega = kin.speeds[f"{member.stage}.carrier"]
         if member.eccentric is not None:
             orbit = kin.speeds[member.eccentric.crank]
-            qvel[ix], qvel[ir] = orbit, kin.speeds[mid] - orbit
+            qvel[mb.dadr[mid][member_axes(member)[0]]], qvel[ir] = orbit, kin.speeds[mid] - orbit
         else:
             qvel[ir] = kin.speeds[mid] - (omega if member.orbits else 0.0)
     return qvel
@@ -91,9 +94,9 @@ def _nominal(mb, q: np.ndarray):
     qvel = nominal_speeds(mb)
     target = np.zeros_like(q)
     for mid, member in spec.members.items():
-        if member.frame != "axis":
+        if member.frame != "axis" or member.torsional:
             continue
-        ix, iy, _ = mb.dadr[mid]
+        ix, iy = (mb.dadr[mid][a] for a in member_axes(member))
         omega = kin.speeds[f"{member.stage}.carrier"]
         qvel[ix], qvel[iy] = -omega * q[iy], omega * q[ix]
         target[ix], target[iy] = -omega**2 * q[ix], -omega**2 * q[iy]

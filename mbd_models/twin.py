@@ -63,7 +63,7 @@ from gearcheck.mbd_models.elements import ELEMENTS
 from gearcheck.mbd_models.elements.base import group_order
 from gearcheck.mbd_models.elements.mesh import mesh_joints
 from gearcheck.mbd_models.mjcf_builder import document, header
-from gearcheck.mbd_models.mjcf_text import LateValues, member_axes
+from gearcheck.mbd_models.mjcf_text import AXES, ROTATION, LateValues, member_axes
 from gearcheck.mbd_models.static_state import static_state
 from gearcheck.shared import stepping
 
@@ -116,8 +116,8 @@ class MbdModel:
     model: mujoco.MjModel
     limits: stepping.StepLimits  # of MuJoCo's linearisation, every mesh at its cycle-maximum stiffness
     body: dict[str, int]  # member id -> body id
-    qadr: dict[str, tuple[int, int, int]]  # member id -> qpos addresses (:func:`member_axes`, then rz)
-    dadr: dict[str, tuple[int, int, int]]  # member id -> dof addresses
+    qadr: dict[str, dict[str, int]]  # member id -> {joint suffix: qpos address} (:func:`member_axes`, then rz)
+    dadr: dict[str, dict[str, int]]  # member id -> {joint suffix: dof address}
     mesh_tendon: np.ndarray  # tendon id per spec.meshes entry (the first tendons of the model)
     mesh_damping: np.ndarray
     half_backlash: np.ndarray
@@ -178,9 +178,10 @@ def mesh_jacobian_row(spec: TrainSpec, kin: Kinematics, model: mujoco.MjModel, d
     planet_body = _id(model, mujoco.mjtObj.mjOBJ_BODY, planet.label)
     R = data.xmat[carrier].reshape(3, 3)
     # the stage axis: the carrier frame's origin less the carrier's own slide displacement
-    jx = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_x")
-    jy = _id(model, mujoco.mjtObj.mjOBJ_JOINT, carrier_label + "_y")
-    origin = data.xpos[carrier] - np.array([data.qpos[model.jnt_qposadr[jx]], data.qpos[model.jnt_qposadr[jy]], 0.0])
+    slides = [_id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{carrier_label}_{a}")
+              for a in member_axes(spec.members[stage.carrier])]  # none: a torsional carrier stays on the axis
+    shift = [data.qpos[model.jnt_qposadr[j]] for j in slides]
+    origin = data.xpos[carrier] - np.array(shift + [0.0] * (3 - len(shift)))
     point = origin + rows_combined((loa.pitch_point[0], loa.pitch_point[1], 0.0), R.T)
     direction = rows_combined((loa.direction[0], loa.direction[1], loa.axial), R.T)
     jac_c = np.zeros((3, model.nv))
@@ -286,9 +287,9 @@ def _indices(spec, kin, exc, model) -> MbdModel:
     body, qadr, dadr = {}, {}, {}
     for mid, member in spec.members.items():
         body[mid] = _id(model, B, member.label)
-        joints = [_id(model, J, f"{member.label}_{a}") for a in member_axes(member) + ("rz",)]
-        qadr[mid] = tuple(int(model.jnt_qposadr[j]) for j in joints)
-        dadr[mid] = tuple(int(model.jnt_dofadr[j]) for j in joints)
+        joints = {a: _id(model, J, f"{member.label}_{a}") for a in member_axes(member) + (ROTATION,)}
+        qadr[mid] = {a: int(model.jnt_qposadr[j]) for a, j in joints.items()}
+        dadr[mid] = {a: int(model.jnt_dofadr[j]) for a, j in joints.items()}
     mesh_tendon = np.array([_id(model, T, m.label) for m in spec.meshes], dtype=int)
     assert np.array_equal(mesh_tendon, np.arange(len(spec.meshes))), "mesh tendons must come first"
     actuator = {name: i for name in ("input_shaft", "input_shaft_damper", "input_torque", "output_load")
@@ -302,18 +303,21 @@ def _indices(spec, kin, exc, model) -> MbdModel:
         wrap_of = {int(model.wrap_objid[adr + i]): adr + i for i in range(n)}
         stage = spec.stage_of(mesh.planet)
         for mid in (mesh.central, stage.carrier):
+            if spec.members[mid].torsional:  # no world-frame slides
+                continue
             label = spec.members[mid].label
             x_wraps.append(wrap_of[_id(model, J, label + "_x")])
             y_wraps.append(wrap_of[_id(model, J, label + "_y")])
-            carrier.append(qadr[stage.carrier][2])
+            carrier.append(qadr[stage.carrier][ROTATION])
             tendon.append(t)
             slide_x.append(mid)
             slide_y.append(mid)
     wraps = np.array(x_wraps + y_wraps, dtype=int)
     c0x, c0y = model.wrap_prm[x_wraps].copy(), model.wrap_prm[y_wraps].copy()
     base = np.stack([np.concatenate([c0x, c0y]), np.concatenate([-c0y, c0x])], axis=1)
-    slide_qadr = np.array([qadr[mid][0] for mid in slide_x] + [qadr[mid][1] for mid in slide_y], dtype=int)
-    slide_dof = np.array([dadr[mid][0] for mid in slide_x] + [dadr[mid][1] for mid in slide_y], dtype=int)
+    x, y = AXES["axis"]
+    slide_qadr = np.array([qadr[mid][x] for mid in slide_x] + [qadr[mid][y] for mid in slide_y], dtype=int)
+    slide_dof = np.array([dadr[mid][x] for mid in slide_x] + [dadr[mid][y] for mid in slide_y], dtype=int)
     carrier_qadr = np.array(carrier + carrier, dtype=int)
     turning = TurningCoefficients(wraps, base, carrier_qadr, np.array(tendon + tendon, dtype=int), slide_qadr,
                                   slide_dof)

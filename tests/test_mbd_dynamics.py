@@ -80,7 +80,7 @@ def test_energy_conserved_free_spinning_undamped():
     qvel = st.qvel.copy()
     for mid, member in spec.members.items():
         if member.is_planet:
-            dr, dt_, _ = mb.dadr[mid]
+            dr, dt_ = mb.dadr[mid]["radial"], mb.dadr[mid]["tangential"]
             qvel[dr] += 0.01
             qvel[dt_] -= 0.01
     d = mujoco.MjData(mb.model)
@@ -270,8 +270,8 @@ def test_mesh_forces_are_mujocos_own():
     raw, tc = res.raw, mb.turning
     deflection = np.column_stack([raw[f"{m.label}_deflection"] for m in spec.meshes])
     carrier = spec.members[spec.stages[0].carrier].label
-    slides = {mb.qadr[mid][i]: f"{spec.members[mid].label}_{axis}_pos" for mid, m in spec.members.items()
-              if not m.is_planet for i, axis in enumerate("xy")}
+    slides = {mb.qadr[mid][axis]: f"{spec.members[mid].label}_{axis}_pos" for mid, m in spec.members.items()
+              if not m.is_planet for axis in "xy"}
     slide = np.column_stack([raw[slides[q]] for q in tc.slide_qadr])
     phi = np.repeat(raw[f"{carrier}_angle"][:, None], len(tc.wraps), axis=1)
     phidot = np.repeat(raw[f"{carrier}_angle_rate"][:, None], len(tc.wraps), axis=1)
@@ -299,7 +299,7 @@ def test_divergence_is_reported():
     mb = compile_train(spec)
     st = static_state(mb)
     qpos = st.qpos.copy()
-    qpos[mb.dadr["stage1.planet1"][0]] = np.nan
+    qpos[mb.dadr["stage1.planet1"]["radial"]] = np.nan
     with pytest.raises(DivergenceError, match="diverged at t ="):
         simulate_mujoco(mb, RunSettings(0.001), initial_state=(qpos, st.qvel))
 

@@ -90,8 +90,8 @@ def test_mesh_coefficients_follow_the_carrier():
     m = mb.model
     d = mujoco.MjData(m)
     d.qpos[:] = 0.0
-    d.qpos[mb.qadr["stage1.carrier"][2]] = 0.7
-    d.qpos[mb.qadr["stage1.sun"][2]] = 2.1  # a gear's own angle does not change its mesh coefficients
+    d.qpos[mb.qadr["stage1.carrier"]["rz"]] = 0.7
+    d.qpos[mb.qadr["stage1.sun"]["rz"]] = 2.1  # a gear's own angle does not change its mesh coefficients
     mujoco.mj_forward(m, d)
     mb.refresh(d.qpos)
     for mesh, t in zip(spec.meshes, mb.mesh_tendon):

@@ -91,7 +91,7 @@ def test_the_ratio_is_mujocos_own(twin):
     """The one motion that strains no spring of the twin (every pin touching, the input shaft let go) is the
     description's nominal motion: sun to carrier 185."""
     K = linearise.stiffness_matrix(twin, every_pin=True)
-    sun, carrier = twin.dadr["rv.sun"][2], twin.dadr["rv.carrier"][2]
+    sun, carrier = twin.dadr["rv.sun"]["rz"], twin.dadr["rv.carrier"]["rz"]
     K[sun, sun] -= twin.spec.operating.input_shaft_stiffness
     w, v = np.linalg.eigh(K)
     assert abs(w[0]) < 1e-12 * w[-1] < w[1] * 1e-3  # one mechanism

@@ -58,7 +58,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from gearcheck.compare.engine.reduction import reduction_basis
-from gearcheck.lumped.assembly import DofMap, LumpedModel
+from gearcheck.lumped.assembly import LumpedModel
+from gearcheck.lumped.constraints import constrained
 from gearcheck.train.spec import AXIAL, ROTATION
 from gearcheck.lumped.modal import modes, modes_at_speed
 from gearcheck.shared.errors import GearcheckError, UnsupportedError
@@ -694,22 +695,6 @@ def _best_pair(base: _Base, scorer: _Scorer, trials: list[_Trial], partial: np.n
         for t in pairs:
             _at_speed(base, t, speed)
     return min(pairs, key=lambda t: t.candidate.score), len(changed)
-
-
-def constrained(model: LumpedModel, coordinates: list[str], T: np.ndarray) -> LumpedModel:
-    """The reference over a user's ``coordinates``, the train's physical coordinates being T q (n x len(q)):
-    M, G and the rotating-frame stiffness as T^T (.) T, every row a as a T.  A coordinate map that selects
-    (T a column of the identity) holds the rest; one that combines (a planet's centre riding its pin,
-    tangential = r_c theta_c) constrains the reference as the user's model assumes, so that the evidence of a
-    reduced model is compared with the reference reduced alike (the Rayleigh-Ritz reduction)."""
-    dofs = DofMap()
-    for c in coordinates:
-        member, dof = c.rsplit(".", 1)
-        dofs.add(member, [dof])
-    return replace(model, dofs=dofs, M=T.T @ model.M @ T, G=T.T @ model.G @ T,
-                   K_centripetal=T.T @ model.K_centripetal @ T, K_circulatory=T.T @ model.K_circulatory @ T,
-                   rows=[replace(r, a=r.a @ T) for r in model.rows], mesh_rows=model.mesh_rows @ T,
-                   F_static=T.T @ model.F_static, b_input=T.T @ model.b_input, b_output=T.T @ model.b_output)
 
 
 def diagnose(model: LumpedModel, evidence: Evidence, top: int = 3) -> Diagnosis:

@@ -12,9 +12,8 @@ from gearcheck.mbd_models.mjcf_text import AXIAL, ROTATION, member_axes
 class Support(Element):
     def joint_springs(self, part, spec) -> dict:
         s, mid = part.support, part.member
-        x, y = member_axes(spec.members[mid])
-        springs = {(mid, x): (s.radial_stiffness, s.radial_damping), (mid, y): (s.radial_stiffness, s.radial_damping),
-                   (mid, ROTATION): (s.torsional_stiffness, s.torsional_damping)}
-        if part.axial:
+        springs = {(mid, axis): (s.radial_stiffness, s.radial_damping) for axis in member_axes(spec.members[mid])}
+        springs[mid, ROTATION] = (s.torsional_stiffness, s.torsional_damping)
+        if part.axial and not spec.members[mid].torsional:
             springs[mid, AXIAL] = (s.axial_stiffness, s.axial_damping)
         return springs

@@ -201,7 +201,8 @@ def units_of(path) -> dict:
 
 def bearing_names(spec) -> list[str]:
     """``MEMBER.bearing_radial`` and ``MEMBER.bearing_tangential`` of every member borne on a carrier pin (a
-    planet, an RV reducer's crankshaft), in member order."""
+    planet, an RV reducer's crankshaft), in member order; a torsional planet rides its pin rigidly and has none
+    (its bearing's force is a constraint force, not reported)."""
     planets = [mid for mid, m in spec.members.items() if m.orbits and m.bearing is not None]
     return [f"{mid}.bearing_{axis}" for mid in planets for axis in ("radial", "tangential")]
 
@@ -226,13 +227,14 @@ def train_signals(spec) -> list[Signal]:
     for mid, member in spec.members.items():
         gated = not member.orbits
         for frame in ("world", "carrier"):
-            for axis in "xy":
+            for axis in "xy":  # a torsional member's: held at zero, reported and not compared
                 signals.append(Signal(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
-                                      f"{mid} acceleration along {axis} ({frame} frame)", gated))
+                                      f"{mid} acceleration along {axis} ({frame} frame)",
+                                      gated and not member.torsional))
         signals.append(Signal(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", gated))
         if member.axial:
             signals.append(Signal(f"{mid}.az", "acceleration", "m/s^2", f"{mid} acceleration along the stage axis",
-                                  gated))
+                                  gated and not member.torsional))
     for mesh in spec.meshes:
         signals += [Signal(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force"),
                     Signal(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error"),

@@ -1,7 +1,7 @@
 """The train file's JSON Schema (draft 2020-12), generated from the declarative schema.
 
 :func:`train_schema` walks :data:`gearcheck.train.schema.TRAIN` (its :class:`~gearcheck.train.schema.Table`,
-``TableList``, ``ListOf``, ``Number``, ``Integer`` and ``Text`` objects) into JSON Schema, so an editor or a CI
+``TableList``, ``ListOf``, ``Number``, ``Integer``, ``Flag``, ``Text``) into JSON Schema, so an editor or a CI
 step can check a train file (parsed from TOML) before gearcheck reads it.  Keys keep the file's names and units
 (``module_mm``), units are stated in the descriptions, bounds and defaults are the file's, a closed table has
 ``additionalProperties: false``.  Tables the module names (``SUPPORT``, ``MESH``, ...) are shared
@@ -76,6 +76,8 @@ class _Walker:
                 out["enum"] = list(spec.choices)
             if spec.pattern is not None:
                 out["pattern"] = f"^(?:{spec.pattern})$"  # the loader matches the whole string
+        elif isinstance(spec, schema.Flag):
+            out["type"] = "boolean"
         elif isinstance(spec, schema.ListOf):
             out |= {"type": "array", "items": self.field(spec.item)}
             out |= {k: v for k, v in (("minItems", spec.min_length or None), ("maxItems", spec.max_length))

@@ -178,6 +178,21 @@ class Text:
 
 
 @dataclass(frozen=True)
+class Flag:
+    doc: str
+    default: Any = REQUIRED
+    unit: str = ""
+
+    def parse(self, value, path: str, ctx: Context) -> bool:
+        if not isinstance(value, bool):
+            raise ctx.fail(path, f"must be true or false, got {shown(value)}")
+        return value
+
+    def type_name(self) -> str:
+        return "boolean"
+
+
+@dataclass(frozen=True)
 class ListOf:
     item: Any
     doc: str
@@ -333,7 +348,12 @@ GEOMETRY = {
     ),
 }
 
+TORSIONAL = Flag("rotation only (Kahraman 1994's purely torsional level): a central member's translations are "
+                 "held at zero, a planet rides rigidly on its carrier's pin; its support's or bearing's translational "
+                 "stiffness and damping are ignored with a note (default: the stage's `torsional`)", None)
+
 BODY = {
+    "torsional": TORSIONAL,
     "mass": Number("mass; from `density` when not given", "kg", None, floor("mass"), False, bound("mass")),
     "inertia": Number("polar moment of inertia about the rotation axis", "kg·m²", None, floor("inertia"), False,
                       bound("inertia")),
@@ -554,6 +574,8 @@ STAGE = Table(
         "face_width_mm": Number("default face width", "mm", None, MIN_MODULE_MM, False, bound("length", MM)),
         "addendum_coefficient": NonNegative("default addendum coefficient h_a*", "-", 1.0, 3.0),
         "dedendum_coefficient": NonNegative("default dedendum coefficient h_f*", "-", 1.25, 3.0),
+        "torsional": Flag("every member of the stage rotation only (see the members' `torsional`), unless a member "
+                          "says otherwise", False),
         "mesh": MESH,
         "carrier": CARRIER,
         "planet": PLANET,

@@ -26,6 +26,7 @@ from gearcheck.train.geometry import (Gear, MeshGeometry, gear_problem, helix_pr
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.schema import Context, parse_measurements
+from gearcheck.train.torsional import check_torsional_couplings, torsional_members
 from gearcheck.shared.errors import GearcheckError, TrainFileError, TrainNote, did_you_mean, shown
 from gearcheck.shared.trust import inside_roots
 
@@ -90,6 +91,7 @@ class Member:
     axial: bool = False  # slides along its stage's axis (every member of a helical stage)
     reference_radius: float = 0.0  # where its rotation is read as a tangential motion (see below)
     eccentric: Eccentric | None = None  # on an eccentric (frame "eccentric"): the one that carries it
+    torsional: bool = False  # rotation only: translations held (on the axis) or riding the carrier's pin (planets)
 
     # reference_radius: a gear's pitch radius (a compound planet's first gear), a carrier's pin circle, a crankshaft's
     # eccentricity, a cycloid disc's rolling circle and a pin wheel's pin circle
@@ -115,6 +117,12 @@ class Member:
         (:data:`TRANSLATIONS`), the absolute rotation ``theta``, and ``z`` along the stage axis when it slides
         axially."""
         return TRANSLATIONS[self.frame] + (ROTATION,) + ((AXIAL,) if self.axial else ())
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        """The dofs the models keep as free coordinates: all of :attr:`dofs`, or the rotation alone for a torsional
+        member, whose translations are held (on the stage axis) or follow its carrier's pin (on a pin)."""
+        return (ROTATION,) if self.torsional else self.dofs
 
     @property
     def label(self) -> str:
@@ -399,6 +407,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
                                                     "central members (sun, ring, carrier, pin wheel)")
         if members[c["from"]].stage == members[c["to"]].stage:
             raise fail(f"couplings[{j}]", "a coupling joins members of different stages")
+        check_torsional_couplings(c, members, f"couplings[{j}]", fail)
         couplings.append(Coupling(c["name"], c["kind"], c["from"], c["to"], c["torsional_stiffness"],
                                   c["torsional_damping"], c["radial_stiffness"], c["radial_damping"]))
 
@@ -717,6 +726,7 @@ def _build_stage(st: dict, path: str, fail):
         raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
     if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
         members = {mid: replace(m, axial=True) for mid, m in members.items()}
+    members = torsional_members(st, centrals, members, rv, path, fail)
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
                   f"{name}.carrier", helical, idealised)
     return members, stage, meshes, cycloids

@@ -63,12 +63,13 @@ def wide_stage(n_planets: int, teeth: tuple[int, int, int] = (30, 24, 78), torqu
                   + (", torque-driven" if torque_driven else ""))
 
 
-def helical_stage(helix_deg: float = 15.0, axial_stiffness: float = 5.0e8, stiffness: str = "constant") -> TrainSpec:
+def helical_stage(helix_deg: float = 15.0, axial_stiffness: float = 5.0e8, stiffness: str = "constant",
+                  extra=()) -> TrainSpec:
     """demo-3p with helical gears (planets ``helix_deg``, positive = right hand; the sun the other hand), every
     member held axially by ``axial_stiffness`` (N/m, damping as its radial support's) and the mesh stiffness
-    model ``stiffness`` at demo-3p's mean."""
+    model ``stiffness`` at demo-3p's mean; ``extra`` (pattern, replacement) pairs applied after those."""
     axial = f"axial_stiffness = {axial_stiffness!r}, axial_damping = 500.0"
     pairs = [(r"^face_width_mm = 40.0$", f"face_width_mm = 40.0\nhelix_angle_deg = {helix_deg!r}"),
              (r'model = "rectangular"', f'model = "{stiffness}"'),
-             (r"^(support|bearing) = \{ (.*) \}$", rf"\1 = {{ \2, {axial} }}")]
+             (r"^(support|bearing) = \{ (.*) \}$", rf"\1 = {{ \2, {axial} }}"), *extra]
     return edited("demo-3p", pairs, f"helical {helix_deg:g} deg")

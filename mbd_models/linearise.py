@@ -174,7 +174,8 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
     """(labels, T): the train's physical coordinates as MuJoCo moves them, T (n, nv) mapping a small joint
     motion to them, read from MuJoCo's own Jacobians at rest: each member's centre moves along x, y (a
     planet or a crankshaft: along its radial and tangential axes), it turns about z, and in a helical stage it moves
-    along z.  The labels are ``member.x`` ... as the lumped model names its coordinates."""
+    along z.  The labels are ``member.x`` ... as the lumped model names its coordinates; a torsional member has
+    its rotation alone (its translations held or riding its pin), as the lumped model keeps it."""
     m = mb.model
     d = mujoco.MjData(m)
     _set_rest(mb, d, m.qpos0)
@@ -193,8 +194,9 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
         if member.axial:
             moves.append((f"{mid}.z", jp[2]))
         for label, row in moves:
-            labels.append(label)
-            rows.append(row)
+            if label.rsplit(".", 1)[1] in member.coordinates:  # a torsional member's translations are not its own
+                labels.append(label)
+                rows.append(row)
     return labels, np.array(rows)
 
 

@@ -335,7 +335,8 @@ def _shape_scale(mb: MbdModel, shape: np.ndarray) -> float:
         body = mb.body[mid]
         rim = float(max(m.geom_rbound[m.body_geomadr[body]:m.body_geomadr[body] + m.body_geomnum[body]], default=0))
         a, b = ("radial", "tangential") if member.orbits else ("x", "y")
-        biggest = max(biggest, math.hypot(phys[f"{mid}.{a}"], phys[f"{mid}.{b}"]) + rim * abs(phys[f"{mid}.theta"]))
+        shift = math.hypot(phys.get(f"{mid}.{a}", 0.0), phys.get(f"{mid}.{b}", 0.0))  # none of its own: torsional
+        biggest = max(biggest, shift + rim * abs(phys[f"{mid}.theta"]))
     return MODE_SIZE * m.stat.extent / biggest if biggest > 0 else 0.0
 
 

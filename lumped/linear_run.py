@@ -4,8 +4,9 @@
   coordinates are the train's), and :func:`linear_modes_at_speed`, the gyroscopic problem with G and
   K_omega (Cooley & Parker 2012); :func:`set_aside` parts the modes that the model's extra coordinates (a
   motor, a coupling: mapped to no train coordinate) dominate from the train's;
-* :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest), the
-  stiffness, meshes and forcing evaluated at each stage's time;
+* :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest, or any state), the
+  stiffness, meshes and forcing evaluated at each stage's time; :func:`periodic_start`, the state its RK4 map
+  returns to after the drive's period, solved exactly (the map is affine);
 * :func:`linear_result` -- what the run reports: every coordinate and its acceleration, and, through
   the model's map to the train's coordinates, the train's signals the model has (member accelerations
   in carrier and world axes from :func:`~gearcheck.lumped.member_motion.member_motion`, its meshes'
@@ -14,24 +15,29 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 
 import numpy as np
 
+from gearcheck.lumped.linear_model import Periodic
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.modal import central_coordinates
 from gearcheck.lumped.time_solver import rk4_step
 from gearcheck.shared import stepping
-from gearcheck.shared.errors import DivergenceError
+from gearcheck.shared.errors import DivergenceError, UnsupportedError
 from gearcheck.shared.modal import ModalResult, modal_result, multiplicities, speed_modal_result
 from gearcheck.shared.results import TimeResult, coordinate_signals, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
+from gearcheck.train.periods import whole_cycles
 from gearcheck.train.spec import AXIAL
 
 CHUNK = 2000  # steps between progress reports
+PERIOD_LIMIT = 64  # the longest common period sought, in multiples of the longest periodic part's
+SINGULAR = 1e-12  # I - Phi closer than this (1 / condition number) to singular has no unique periodic state
 EXTRA_DOMINATED = 0.5  # a mode with more of its kinetic energy in the extra coordinates is theirs, not the train's
 
 
@@ -91,41 +97,32 @@ def default_step(model) -> float:
     return stepping.default_step(step_limits(model), [1.0 / p for p in periods])
 
 
-def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> TimeResult:
-    """Fixed-step RK4 of the model; ``train`` (spec, kin, dofs of the train, or None) names its signals.
-    The step defaults to :func:`default_step`; a step beyond RK4's stability limit is refused."""
+def simulate_linear(model, settings: RunSettings, train=None, progress=None, y0=None) -> TimeResult:
+    """Fixed-step RK4 of the model from ``y0`` (q, q') or its own start; ``train`` (spec, kin, dofs of the train, or
+    None) names its signals.  The step defaults to :func:`default_step`; a step beyond RK4's stability limit is
+    refused."""
     started = time.perf_counter()
     limits = step_limits(model)
     dt = default_step(model) if settings.dt is None else settings.dt
     stepping.check_step(dt, limits, [], f"model {model.name}")
     steps, every = settings.check_work(dt, 3 * model.n, f"model {model.name}")
-    M_inv = np.linalg.inv(model.M)
-    D = model.damping
-    K_omega = model.frame[1]
-    A = model.mesh_rows
     t = np.arange(steps + 1) * dt
-    stage_t = t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt  # where every fixed-step solver samples its drive
-    errors = [m.transmission_error(stage_t) for m in model.meshes]
-    k_mesh = _along_last([m.k(stage_t) for m in model.meshes], stage_t.shape)
-    e_mesh = _along_last([e for e, _ in errors], stage_t.shape)
-    c_de = _along_last([m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
+    rates = _rates(model, t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt)
 
-    def acceleration(ti, s, q, v, k, e, damping_rate):
-        stiffness_force = (model.K_at(ti) + K_omega) @ q + A.T @ (k * (A @ q - e) - damping_rate)
-        return M_inv @ (model.F_at(ti) - D @ v - stiffness_force)
+    def acceleration(i, s, q, v):
+        return rates(i, s, q[:, None], v[:, None])[:, 0]
 
-    q0, v = _start(model)
+    q0, v = _start(model) if y0 is None else (np.array(y0[0], dtype=float), np.array(y0[1], dtype=float))
     q = q0
     n_out = steps // every + 1
     Q, V, Qdd = (np.empty((n_out, model.n)) for _ in range(3))
     for i in range(steps + 1):
         if i % every == 0:
             j = i // every
-            Q[j], V[j], Qdd[j] = q, v, acceleration(t[i], 0, q, v, k_mesh[i, 0], e_mesh[i, 0], c_de[i, 0])
+            Q[j], V[j], Qdd[j] = q, v, acceleration(i, 0, q, v)
         if i == steps:
             break
-        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(stage_t[i, s], s, q_, v_, k_mesh[i, s], e_mesh[i, s],
-                                                            c_de[i, s]), q, v, dt)
+        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(i, s, q_, v_), q, v, dt)
         if i % CHUNK == 0:
             if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
                 raise DivergenceError(float(t[i + 1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
@@ -138,7 +135,76 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None) -> 
     wall = time.perf_counter() - started
     info = RunInfo("linear-rk4", steps, 4, 4 * steps, wall,
                    {"method": f"{model.name}, rk4", "dt_s": dt, "steps": steps, "wall_time_s": wall})
-    return linear_result(model, train, t[::every], Q, V, Qdd, q0, info)
+    return linear_result(model, train, t[::every], Q, V, Qdd, _start(model)[0], info)
+
+
+def _rates(model, stage_t: np.ndarray):
+    """q'' = M^-1 (f(t) - D q' - (K(t) + K_omega + sum_m k_m(t) a_m a_m^T) q) at the stage times ``stage_t``
+    (steps x stages): ``rates(i, s, Q, V)`` for states as the columns of Q, V, the forcing f(t) = F(t) +
+    sum_m a_m (k_m e_m + c_m e_m') acting on the last column alone -- one column is a run; the unit states
+    beside a last zero one give a period's monodromy matrix and its particular response."""
+    M_inv = np.linalg.inv(model.M)
+    D = model.damping
+    K_omega = model.frame[1]
+    A = model.mesh_rows
+    errors = [m.transmission_error(stage_t) for m in model.meshes]
+    k_mesh = _along_last([m.k(stage_t) for m in model.meshes], stage_t.shape)
+    e_mesh = _along_last([e for e, _ in errors], stage_t.shape)
+    c_de = _along_last([m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
+
+    def rates(i, s, Q, V):
+        ti, k = stage_t[i, s], k_mesh[i, s]
+        force = -(D @ V) - (model.K_at(ti) + K_omega) @ Q - A.T @ (k[:, None] * (A @ Q))
+        force[:, -1] += model.F_at(ti) + A.T @ (k * e_mesh[i, s] + c_de[i, s])
+        return M_inv @ force
+
+    return rates
+
+
+def drive_period(model) -> float:
+    """The shortest time over which every time-varying part of ``model`` repeats (each mesh's stiffness and
+    transmission error, K(t), F(t)), at most :data:`PERIOD_LIMIT` times the longest of their periods;
+    UnsupportedError when nothing varies, a forcing has no period, or the periods have no such common one."""
+    periods = [m.stiffness.period for m in model.meshes if isinstance(m.stiffness, Periodic)]
+    periods += [m.error.period for m in model.meshes if m.error is not None]
+    periods += [model.stiffness.period] if model.stiffness is not None else []
+    if model.forcing is not None:
+        if getattr(model.forcing, "period", None) is None:
+            raise UnsupportedError(f"model {model.name}: its forcing is a function of time without a period")
+        periods.append(model.forcing.period)
+    if not periods:
+        raise UnsupportedError(f"model {model.name}: nothing in it varies with time")
+    base = max(periods)
+    for k in range(1, PERIOD_LIMIT + 1):
+        if whole_cycles(k * base / np.array(periods)):
+            return k * base
+    raise UnsupportedError(f"model {model.name}: its periods {', '.join(f'{p:.6g}' for p in sorted(set(periods)))} s "
+                           f"have no common period within {PERIOD_LIMIT} of the longest")
+
+
+def periodic_start(model, dt: float) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """(q, q', h, residual): the state the model's RK4 map at step h returns to after one drive period
+    (:func:`drive_period`, h = T / ceil(T / dt)), found exactly: the map is affine, y(T) = Phi y0 + p, so the
+    state solves (I - Phi) y0 = p, Phi and p from one pass over the period carrying the 2n unit states and the
+    particular one side by side (:func:`_rates`); ``residual`` |y(T) - y0| / |y0| of the fixed point.  A mode
+    that neither decays nor is forced away (a free rigid rotation, an undamped mode) leaves I - Phi singular:
+    UnsupportedError."""
+    T = drive_period(model)
+    steps = max(1, math.ceil(T / dt - 1e-9))
+    h, n = T / steps, model.n
+    rates = _rates(model, (np.arange(steps)[:, None] + np.array(stepping.STAGE_OFFSETS)) * h)
+    Q = np.hstack([np.eye(n), np.zeros((n, n + 1))])
+    V = np.hstack([np.zeros((n, n)), np.eye(n), np.zeros((n, 1))])
+    for i in range(steps):
+        Q, V = rk4_step(lambda s, q_, v_, i=i: rates(i, s, q_, v_), Q, V, h)
+    Phi, p = np.vstack([Q[:, :-1], V[:, :-1]]), np.concatenate([Q[:, -1], V[:, -1]])
+    gap = np.eye(2 * n) - Phi
+    if np.linalg.cond(gap) > 1.0 / SINGULAR:
+        raise UnsupportedError(f"model {model.name}: a mode neither decays nor is driven over the period (a free "
+                               "rotation, an undamped mode): no unique periodic state")
+    y0 = np.linalg.solve(gap, p)
+    residual = float(np.linalg.norm(Phi @ y0 + p - y0) / max(np.linalg.norm(y0), 1e-300))
+    return y0[:n], y0[n:], h, residual
 
 
 def _along_last(values: list, shape: tuple) -> np.ndarray:

@@ -18,7 +18,7 @@ from gearcheck.lumped.assembly import LumpedModel, build_model
 from gearcheck.lumped.condensation import condense_massless
 from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import EXTRA_DOMINATED, linear_modes, linear_modes_at_speed, set_aside, simulate_linear
-from gearcheck.lumped.linear_run import step_limits, unmapped
+from gearcheck.lumped.linear_run import default_step as linear_default_step, periodic_start, step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.lumped.modal import modes, modes_at_speed, settling_time
 from gearcheck.lumped.periodic_steady_state import periodic_steady_state
@@ -145,6 +145,18 @@ class LinearSide(Side):
             T_inv = np.linalg.inv(T[:, own])
             mass = T_inv.T @ self.linear.M[np.ix_(own, own)] @ T_inv
         return [label for label, m in zip(labels, mapped) if m], mass, T @ modal.shapes
+
+    def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
+        """Its run and check from its periodic steady state (:func:`~gearcheck.lumped.linear_run.periodic_start`:
+        the fixed point of its RK4 map over the drive's period, exact for a linear model)."""
+        dt = linear_default_step(self.linear) if settings.dt is None else settings.dt
+        q, v, h, residual = periodic_start(self.linear, dt)
+        run = simulate_linear(self.linear, replace(settings, dt=h), self.train, progress, y0=(q, v))
+        check = simulate_linear(self.linear, replace(settings, dt=check_step(h), output_dt=None), self.train,
+                                y0=(q, v))
+        run.train = check.train = self.spec.name
+        return run, check, (f"{self.solver}: the fixed point of its RK4 map over the drive's period, solved as the "
+                            f"linear system it is, residual {residual:.1e}")
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         result = simulate_linear(self.linear, settings, self.train, progress)

@@ -20,17 +20,19 @@ import gearcheck
 TEST = (148.95, 387.88, 681.47)  # Table 3, experiment (Hz)
 PAPER = (154.56, 396.09, 697.16)  # Table 3, the paper's model
 MEASUREMENTS = Path(gearcheck.__file__).parent / "train" / "presets" / "data" / "rv-reducer-table3.toml"
-PLATE = "stages[0].carrier.inertia=0.106:100"  # the output's inertia, the plate on top of the file's 0.106 kg m^2
-MOTOR = "stages[0].sun.inertia=4.44e-4:4.44e-3"  # the sun's, a motor and coupling of up to 9 times J_s on top
+PLATE_PATH, MOTOR_PATH = "stages[0].carrier.inertia", "stages[0].sun.inertia"
+PLATE = f"{PLATE_PATH}=0.106:100"  # the output's inertia: the plate on top of the file's 0.106 kg m^2
+MOTOR = f"{MOTOR_PATH}=4.44e-4:4.44e-3"  # the sun's: a motor and coupling of up to 9 times J_s on top
 
 
 def calibrated(fit: dict[int, float], parameters: list[str], predicted: dict[int, float] | None = None):
-    """The calibration of ``parameters`` on the model modes ``fit`` (mode number: Hz), ``predicted`` held out, and
-    the modes of the calibrated train; the inertias the fit added to the file's values."""
+    """The calibration of ``parameters`` on the model modes ``fit`` (mode number: Hz), ``predicted`` held out; the
+    modes of the calibrated train; the inertias the fit added to the file's output and sun (J_plate, J_input)."""
     entries = [{"frequency_hz": f, "mode": k} for k, f in fit.items()]
     entries += [{"frequency_hz": f, "mode": k, "role": "predict"} for k, f in (predicted or {}).items()]
     result = gearcheck.calibrate("rv-reducer", parameters, measurements={"natural_frequencies": entries})
-    return result, modes_of(result), result.fitted - result.start
+    added = dict(zip(result.names, result.fitted - result.start))
+    return result, modes_of(result), added.get(PLATE_PATH, 0.0), added.get(MOTOR_PATH, 0.0)
 
 
 def modes_of(result):
@@ -59,9 +61,9 @@ def main() -> None:
           f"next torsional mode {f[3]:.1f} Hz (output against the pins)\n")
 
     print("(b) what it would take to reach the paper's model column")
-    _, g, (j,) = calibrated({1: PAPER[0]}, [PLATE])
+    _, g, j, _ = calibrated({1: PAPER[0]}, [PLATE])
     print(f"    output inertia {j:.3f} kg m^2 puts mode 1 at {PAPER[0]} Hz; mode 2 is then {g[1]:.1f} Hz")
-    fit, g, (jp, ji) = calibrated({1: PAPER[0], 2: PAPER[1]}, [PLATE, MOTOR], {3: PAPER[2]})
+    fit, g, jp, ji = calibrated({1: PAPER[0], 2: PAPER[1]}, [PLATE, MOTOR], {3: PAPER[2]})
     print(f"    with {ji:.3e} kg m^2 more on the input as well (output {jp:.3f}): modes 1-2 at {PAPER[0]}, "
           f"{PAPER[1]} Hz and mode 3 at {g[2]:.2f} Hz, {pct(g[2], PAPER[2])} from the paper's {PAPER[2]} "
           f"({fit.starts_at_best} of {len(fit.search.starts)} starts)\n")
@@ -75,14 +77,12 @@ def main() -> None:
           f"(nearest {pct(g[1], TEST[1])})")
     print(f"    test mode 3 {TEST[2]} Hz <- model {g[1]:.2f} Hz (input side against k_st): {pct(g[1], TEST[2])}")
     alternatives = [
-        ("input inertia on mode 1", {1: TEST[0]}, ["stages[0].sun.inertia=4.44e-4:1"], 1),
+        ("input inertia on mode 1", {1: TEST[0]}, [f"{MOTOR_PATH}=4.44e-4:1"], 1),
         ("J_plate on mode 2 (mode 1 unexplained)", {1: TEST[1]}, [PLATE], 1),
         ("J_plate + input inertia on modes 1-2", {1: TEST[0], 2: TEST[1]}, [PLATE, MOTOR], 2),
     ]
     for name, measured, parameters, third in alternatives:
-        _, h, added = calibrated(measured, parameters)
-        jp, ji = (added[0], 0.0) if parameters[0] == PLATE else (0.0, added[0])
-        ji = added[1] if len(added) == 2 else ji
+        _, h, jp, ji = calibrated(measured, parameters)
         print(f"    alt. {name}: J_plate {jp:.3f}, J_input {ji:.3e} -> next mode {h[third]:.2f} Hz vs "
               f"{TEST[2]} Hz: {pct(h[third], TEST[2])}")
     print(f"    any added inertia on two coordinates leaves the third mode >= {f[0]:.2f} Hz (interlacing), "

@@ -168,3 +168,16 @@ def test_table3_as_a_command(tmp_path, capsys):
     assert "| natural frequency, mode 2 (model mode 2) | — | prediction | 681.47 |" in capsys.readouterr().out
     written = tomllib.loads((out / "rv-reducer-calibrated.toml").read_text())["stages"][0]["carrier"]["inertia"]
     assert written == pytest.approx(0.106 + plate, rel=1e-9)
+
+
+def test_a_train_files_measurements_file_brings_its_natural_frequencies(tmp_path):
+    """A train file whose measurements_file holds natural frequencies is calibrated on them without
+    --measurements: the same plate as Table 3's file given on the command line."""
+    (tmp_path / "table3.toml").write_text(open(TABLE3, encoding="utf-8").read(), encoding="utf-8")
+    train = tmp_path / "rv.toml"
+    train.write_text(RV.replace('output = "rv.carrier"', 'output = "rv.carrier"\nmeasurements_file = "table3.toml"'),
+                     encoding="utf-8")
+    own = gearcheck.calibrate(train, [f"{PLATE}=0.106:100"])
+    given = gearcheck.calibrate("rv-reducer", [f"{PLATE}=0.106:100"], measurements=TABLE3)
+    assert [r["role"] for r in own.rows()] == ["fit", "prediction"]
+    assert own.fitted == pytest.approx(given.fitted, rel=1e-12)

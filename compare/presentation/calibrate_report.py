@@ -49,9 +49,10 @@ def write_calibration(result, name: str, out: Path, final: Path | None = None) -
         lines.append(f"| {what} | {speed} | {r['role']} | {r['measured']:.6g} | {pub} | {r['before']:.6g} "
                      f"| {r['after']:.6g} | {epub} | {100 * r['error_before']:+.2f} % "
                      f"| {100 * r['error_after']:+.2f} % |")
-    lines += ["", f"{len(result.search.starts)} starts (the file's values and a Latin hypercube in ln p within the "
-                  f"bounds); {result.starts_at_best} reached the best minimum; {len(minima)} distinct "
-                  f"minim{'um' if len(minima) == 1 else 'a'}:", "",
+    starts = len(result.search.starts)
+    design = "the file's values" if starts == 1 else "the file's values and a Latin hypercube in ln p within the bounds"
+    lines += ["", f"{starts} start{'' if starts == 1 else 's'} ({design}); {result.starts_at_best} reached the best "
+                  f"minimum; {len(minima)} distinct minim{'um' if len(minima) == 1 else 'a'}:", "",
               "| chi^2 | starts | " + " | ".join(f"`{p}`" for p in result.names) + " |",
               "|---|---|" + "---|" * len(result.names)]
     lines += [f"| {m['chi2']:.6g} | {m['starts']} | " + " | ".join(f"{v:.6g}" for v in m["values"]) + " |"

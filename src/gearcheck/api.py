@@ -277,7 +277,7 @@ def calibrate(train, fit, *, measurements=None, duration: float = 0.6, fit_speed
     measurements : path or dict, optional
         A TOML file of ``[[measurements]]`` (amplitudes) and ``[[natural_frequencies]]``, or such a file's content
         as a dict (``{"natural_frequencies": [{"frequency_hz": 148.95, "mode": 1}]}``); default the train file's
-        own ``[[measurements]]``.
+        own ``[[measurements]]`` and its ``measurements_file``'s.
     duration : float
         Simulated time per run, s (amplitudes only).
     fit_speed : list of float, optional
@@ -302,7 +302,8 @@ def calibrate(train, fit, *, measurements=None, duration: float = 0.6, fit_speed
         found = load_measurements_file(measurements)
         entries, frequencies = found["measurements"], found["natural_frequencies"]
     else:
-        entries, frequencies = list(load(train).measurements), []
+        spec = load(train)
+        entries, frequencies = list(spec.measurements), list(spec.natural_frequencies)
     return fit_train(text, source, entries, [FitParameter.parse(f) for f in fit], duration, fit_speed, progress,
                      frequencies, starts)
 

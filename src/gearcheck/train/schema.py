@@ -686,8 +686,9 @@ TRAIN_TABLE = Table(
         "held": ListOf(Text("member", REQUIRED),
                        "members held by their torsional support stiffness: each needs "
                        "`support.torsional_stiffness` > 0, so that its vibration is still modelled", ()),
-        "measurements_file": Text("a TOML file of [[measurements]] (relative to the train file) shown in every "
-                                  "cross-check and used by calibrate", None),
+        "measurements_file": Text("a TOML file of [[measurements]] and [[natural_frequencies]] (relative to the "
+                                  "train file): the amplitudes shown in every cross-check, both used by calibrate",
+                                  None),
         "user_model": Text("your own model of this train, checked by `crosscheck --model user`: a .mat or .npz "
                            "file of matrices (relative to the train file), or `module:factory` or "
                            "`file.py:factory` (code, run only with `--trust`)", None),
@@ -735,11 +736,6 @@ def parse_measurements_file(document: dict, source: str) -> dict:
             raise ctx.fail(f"{path}.shape", "is zero everywhere")
         entry["where"] = f"{source}: {path}"
     return parsed
-
-
-def parse_measurements(document: dict, source: str) -> list[dict]:
-    """The ``[[measurements]]`` (amplitudes) of a measurements file (:func:`parse_measurements_file`)."""
-    return parse_measurements_file(document, source)["measurements"]
 
 
 def markdown_reference(root: Table = TRAIN) -> str:

@@ -23,7 +23,8 @@ from gearcheck.shared.errors import GearcheckError, did_you_mean
 from gearcheck.shared.modal import frequency_groups, modal_assurance
 
 
-RANK_TOLERANCE = 1e-12  # a direction of a frequency's modes below it (relative) on the measured coordinates: none
+RANK_TOLERANCE = 1e-12  # of a mass-normalised mode's norm: a direction of its modes below it on the measured
+# coordinates is round-off, far below any measurable share
 
 
 @dataclass(frozen=True)
@@ -79,7 +80,8 @@ def pair(entries: list[dict], modal, labels: list[str], M: np.ndarray) -> list[P
 
 
 def _shares(entry: dict, groups: list[list[int]], modal, labels: list[str], M: np.ndarray) -> list[float]:
-    """The measured shape's share in each of ``groups`` (the sum of its MAC with their modes)."""
+    """The measured shape's share in each of ``groups``: the sum of its MAC over a mass-orthonormal basis of their
+    modes on the measured coordinates."""
     keep = []
     for name in entry["shape"]:
         if name not in labels:
@@ -93,10 +95,11 @@ def _shares(entry: dict, groups: list[list[int]], modal, labels: list[str], M: n
 
 
 def _orthonormal(mass: np.ndarray, shapes: np.ndarray) -> np.ndarray:
-    """A mass-orthonormal basis of the span of ``shapes`` (columns) on the measured coordinates, where the modes of
-    a multiple frequency need not be orthogonal: the sum of a shape's MAC over it is its share in that span (at most
-    1).  A span that vanishes there (the modes hold still on every measured coordinate) gives an empty basis."""
+    """A mass-orthonormal basis of the span of ``shapes`` (mass-normalised modes, columns) on the measured
+    coordinates, where the modes of a multiple frequency need not be orthogonal: the sum of a shape's MAC over it is
+    its share in that span (at most 1).  Directions whose mass norm there is below :data:`RANK_TOLERANCE` of a whole
+    mode's are round-off (a translational mode on the rotations) and left out."""
     gram = shapes.T @ mass @ shapes
     values, vectors = np.linalg.eigh((gram + gram.T) / 2)
-    kept = values > RANK_TOLERANCE * max(values.max(), 0.0) if values.max() > 0 else np.zeros(len(values), bool)
+    kept = values > RANK_TOLERANCE
     return shapes @ vectors[:, kept] / np.sqrt(values[kept])

@@ -54,6 +54,7 @@ def start_points(x0: np.ndarray, low: np.ndarray, high: np.ndarray, count: int) 
     design = qmc.LatinHypercube(d=len(x0), rng=SEED).random(count - 1)
     return np.vstack([x0, low + design * (high - low)])
 
+
 def multistart(fun, x0: np.ndarray, low: np.ndarray, high: np.ndarray, count: int, **options) -> MultiStart:
     """Minimise sum fun(x)^2 within [low, high] from the :func:`start_points`; ``options`` go to least_squares."""
     starts = start_points(np.asarray(x0, float), low, high, count)

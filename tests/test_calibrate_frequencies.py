@@ -14,6 +14,7 @@ from scipy.optimize import brentq
 
 import gearcheck
 from gearcheck.cli import main
+from gearcheck.compare.studies.measured_modes import pair
 from gearcheck.compare.studies.multistart import SAME_MINIMUM
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.modal import modes
@@ -181,3 +182,14 @@ def test_a_train_files_measurements_file_brings_its_natural_frequencies(tmp_path
     given = gearcheck.calibrate("rv-reducer", [f"{PLATE}=0.106:100"], measurements=TABLE3)
     assert [r["role"] for r in own.rows()] == ["fit", "prediction"]
     assert own.fitted == pytest.approx(given.fitted, rel=1e-12)
+
+
+def test_a_shape_over_the_central_rotations_has_no_share_in_a_translational_mode():
+    """The central members do not turn in a translational mode (Lin & Parker 1999): their rotations there are
+    round-off (1e-14), and a shape measured over them has no share in the pair, however that round-off points."""
+    model = build_model(load_text(preset_text("demo-3p"), "demo-3p"))
+    modal = modes(model)
+    assert modal.types[1:3] == ["translational"] * 2
+    entry = {"mode": 2, "type": None, "order": None, "where": "m.toml: natural_frequencies[0]",
+             "shape": {f"stage1.{m}.theta": 1.0 for m in ("sun", "ring", "carrier")}}
+    assert pair([entry], modal, model.dofs.labels(), model.M)[0].mac < 1e-12

@@ -14,6 +14,7 @@ from gearcheck.cli import main
 from gearcheck.train.loader import preset_text
 
 DEMO = preset_text("demo-3p")
+TABLE3 = Path(__file__).parents[1] / "src" / "gearcheck" / "train" / "presets" / "data" / "rv-reducer-table3.toml"
 
 
 def demo(*pairs) -> str:
@@ -246,6 +247,29 @@ FILES = [
      lambda f: ["show", _train_with(f, 'torque_csv = "p.csv"')], "times must increase strictly"),
     ("measurements-file-not-utf8", raw_file("m.toml", b"\xff\xfe"),
      lambda f: ["show", _train_with(f, "", 'measurements_file = "m.toml"')], "train.measurements_file:"),
+    *[(f"natural-frequency-{name}", raw_file("m.toml", b"[[natural_frequencies]]\n" + entry),
+       lambda f: ["calibrate", "rv-reducer", "--fit", "stages[0].carrier.inertia", "--measurements", f],
+       f"m.toml: natural_frequencies[0]{expected}")
+      for name, entry, expected in [
+          ("past-the-modes", b"frequency_hz = 150.0\nmode = 40\n", ".mode: 40 but the model has 30 modes"),
+          ("no-such-coordinate", b'frequency_hz = 150.0\nshape = { "rv.sun.thta" = 1.0 }\n',
+           ".shape: the model has no coordinate 'rv.sun.thta' (did you mean 'rv.sun.theta'?)"),
+          ("zero-shape", b'frequency_hz = 150.0\nshape = { "rv.sun.theta" = 0.0 }\n', ".shape: is zero everywhere"),
+          ("two-pairings", b'frequency_hz = 150.0\nmode = 1\ntype = "mixed"\n',
+           ".mode: 1 pairs by number, type by type and order: give one"),
+          ("order-without-type", b"frequency_hz = 150.0\norder = 2\n", ".order: 2 counts within a type: give type"),
+          ("unpaired", b"frequency_hz = 150.0\n", ": needs mode, type (with order) or shape"),
+          ("no-such-type", b'frequency_hz = 150.0\ntype = "rotatonal"\n',
+           ".type: must be one of rotational, translational, planet, mixed, elastic; got 'rotatonal'"),
+          ("past-the-type", b'frequency_hz = 150.0\ntype = "translational"\norder = 9\n',
+           ".order: 9 but the model has 2 translational frequencies"),
+          ("negative", b"frequency_hz = -150.0\nmode = 1\n", ".frequency_hz: must be > 0 Hz, got -150"),
+          ("bad-role", b'frequency_hz = 150.0\nmode = 1\nrole = "check"\n',
+           ".role: must be one of fit, predict; got 'check'")]],
+    ("natural-frequency-only-predicted", raw_file("m.toml", b'[[natural_frequencies]]\nfrequency_hz = 150.0\n'
+                                                            b'mode = 1\nrole = "predict"\n'),
+     lambda f: ["calibrate", "rv-reducer", "--fit", "stages[0].carrier.inertia", "--measurements", f],
+     "nothing to fit: every natural frequency has role = 'predict'"),
 ]
 
 
@@ -263,7 +287,8 @@ def test_a_bad_file_is_refused_with_one_line(make, argv, expected, tmp_path, cap
     (tmp_path / "data").mkdir()
     out = tmp_path / "out"
     command = argv(make(tmp_path / "data"))
-    assert_refused(command + (["--out", out] if command[0] == "crosscheck" else []), expected, capsys, out)
+    assert_refused(command + (["--out", out] if command[0] in ("crosscheck", "calibrate") else []), expected, capsys,
+                   out)
 
 
 OPTIONS = [
@@ -322,6 +347,8 @@ OPTIONS = [
      "hub-drive: the harmonic methods solve a linear problem with constant load; this train has backlash"),
     (["sensitivity", "rv-reducer", "--parameter", "stages[0].sun.mass", "--speeds", "0:1000:3"],
      "--speeds: every speed must be a positive number of rpm, got 0"),
+    (["calibrate", "rv-reducer", "--fit", "stages[0].carrier.inertia", "--measurements", TABLE3, "--starts", "0"],
+     "--starts 0: must be a whole number from 1 to 1000"),
     (["pins", "demo-3p"], "demo-3p has no cycloid-pin stage"),
     (["pins", "rv-reducer", "--samples", "0"], "--samples 0: a whole number of frozen times from 1 to 10000"),
 ]

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from gearcheck.compare.engine.measure import chain_statistic
 from gearcheck.train.files import read_toml
-from gearcheck.train.schema import parse_measurements
+from gearcheck.train.schema import parse_measurements_file
 from gearcheck.shared.errors import GearcheckError, did_you_mean
 
 SPEED_MATCH = 1e-6  # relative
@@ -24,7 +24,12 @@ SPEED_MATCH = 1e-6  # relative
 
 def load_measurements(path: str | Path) -> list[dict]:
     """The checked ``[[measurements]]`` of a TOML file."""
-    return parse_measurements(read_toml(path, "measurements file"), str(path))
+    return load_measurements_file(path)["measurements"]
+
+
+def load_measurements_file(path: str | Path) -> dict:
+    """The checked ``measurements`` (amplitudes) and ``natural_frequencies`` of a TOML measurements file."""
+    return parse_measurements_file(read_toml(path, "measurements file"), str(path))
 
 
 def check_quantities(entries, quantities) -> None:

@@ -1,17 +1,24 @@
-"""Least-squares calibration of uncertain train parameters against measured amplitudes.
+"""Least-squares calibration of uncertain train parameters against measured amplitudes and natural frequencies.
 
 A parameter is addressed by its path in the train file, in the file's own units
 (``stages[0].mesh.ste[0].amplitude_um``, ``operating.output_torque``), with bounds.  The fit
-minimises sum_i ((ln y_i(p) - ln m_i)/s_i)^2 over ln p, y_i the lumped model's statistic of
-measurement i read through its measuring chain (:func:`gearcheck.compare.engine.measure.measure`), m_i the
-measured value and s_i its relative uncertainty (``uncertainty``, default 0.1): relative
-errors, and positive parameters by construction.  Parameter uncertainties come from the
-Jacobian at the optimum, cov(ln p) = (J^T J)^-1 with the residuals already divided by s_i;
-they are the measurement uncertainties propagated, valid also when the fit is exactly
-determined (as many measurements as parameters), where the residuals carry no information.
+minimises sum_i ((ln y_i(p) - ln m_i)/s_i)^2 over ln p, m_i the measured value and s_i its relative
+uncertainty (``uncertainty``): relative errors, and positive parameters by construction.  y_i is
 
-The honest protocol for a paper's table: fit on the measurements at one speed
-(``fit_speeds``), then predict the others and report the prediction errors.
+* for an amplitude, the lumped model's statistic of measurement i read through its measuring chain
+  (:func:`gearcheck.compare.engine.measure.measure`), from a time run;
+* for a natural frequency, the frequency of the model mode it is paired with
+  (:mod:`gearcheck.compare.studies.measured_modes`), from the modes alone; a measured shape adds the residual
+  (1 - MAC)/s_shape of its share in that mode (the updating residuals of Friswell & Mottershead 1995).
+
+Parameter uncertainties come from the Jacobian at the optimum, cov(ln p) = (J^T J)^-1 with the residuals already
+divided by s_i; they are the measurement uncertainties propagated, valid also when the fit is exactly determined
+(as many measurements as parameters), where the residuals carry no information.  A fit of natural frequencies is
+not convex (modes cross and swap order as parameters move): it runs from several starts
+(:mod:`gearcheck.compare.studies.multistart`) and reports the distinct minima.
+
+The honest protocol for a paper's table: fit on the measurements at one speed (``fit_speeds``; a natural
+frequency's ``role``), then predict the others and report the prediction errors.
 """
 
 from __future__ import annotations
@@ -25,14 +32,15 @@ from pathlib import Path
 
 import numpy as np
 import tomli_w
-from scipy.optimize import least_squares
 
 from gearcheck.compare.engine.align import STEADY_THRESHOLD
 from gearcheck.compare.engine.measure import MIN_CYCLES, measure
+from gearcheck.compare.studies.measured_modes import Paired, label, pair
+from gearcheck.compare.studies.multistart import MultiStart, multistart
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.kinematics import kinematics, require_mesh_cycle
 from gearcheck.train.loader import load_text, load_train
-from gearcheck.lumped.modal import settling_time
+from gearcheck.lumped.modal import modes, settling_time
 from gearcheck.train.spec import beside, named_file
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.shared.errors import GearcheckError
@@ -40,6 +48,9 @@ from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
 
 SPEED_MATCH = 1e-6
+MAX_STARTS = 1000  # every start is a whole fit: a thousand of a time-run fit's hundred runs is days
+STARTS = 16  # the default number of starts of a fit that needs no time run: the file's values and a Latin
+# hypercube of 15: cheap (a few ms an evaluation), and enough to reach the basins of a handful of parameters
 LOG_STEP = 0.05  # finite-difference step in ln p: a peak of a simulated signal is only piecewise smooth
 # in the parameters, so a 5 % step sees the trend, not the jitter of which sample is the largest
 
@@ -108,15 +119,19 @@ class Calibration:
     start: np.ndarray
     fitted: np.ndarray
     relative_uncertainty: np.ndarray  # standard uncertainty of each fitted value, relative
-    entries: list[dict]
+    entries: list[dict]  # the amplitudes
     speeds_rpm: list[float]
-    used: list[bool]  # which entries the fit used
+    used: list[bool]  # which amplitudes the fit used
     before: list[float]  # model statistics with the start values
     after: list[float]  # with the fitted values
     evaluations: int
     document: dict  # the calibrated train file, parsed
     source: str  # where the original came from (its relative file references are resolved from there)
     header: str
+    frequencies: list[dict] = field(default_factory=list)  # the natural frequencies
+    frequencies_before: list[Paired] = field(default_factory=list)
+    frequencies_after: list[Paired] = field(default_factory=list)
+    search: MultiStart | None = None  # the fits from every start, in ln p
 
     def _named_files(self) -> list[tuple[str, str, str, Path, str]]:
         """(table, key, the copy's name, the original, what follows the file) of each file the train file names
@@ -145,16 +160,30 @@ class Calibration:
         return self.header + tomli_w.dumps(doc)
 
     def rows(self) -> list[dict]:
+        """Every measurement against the model before and after the fit: the amplitudes, then the natural
+        frequencies (with the model mode each is paired with after the fit, numbered from 1, and its MAC)."""
         out = []
         for entry, rpm, used, b, a in zip(self.entries, self.speeds_rpm, self.used, self.before, self.after):
-            m = entry["value"]
-            out.append({"quantity": entry["quantity"], "metric": entry["metric"], "speed_rpm": rpm,
-                        "measured": m, "published_model": entry.get("published_model"), "before": b, "after": a,
-                        "error_before": (b - m) / abs(m), "error_after": (a - m) / abs(m),
-                        "error_published_model": None if entry.get("published_model") is None
-                        else (entry["published_model"] - m) / abs(m),
-                        "role": "fit" if used else "prediction"})
+            out.append(_row(entry, entry["quantity"], entry["metric"], rpm, b, a, used))
+        for entry, b, a in zip(self.frequencies, self.frequencies_before, self.frequencies_after):
+            row = _row({**entry, "value": entry["frequency_hz"]}, label(entry), "frequency_hz", None, b.frequency,
+                       a.frequency, entry["role"] == "fit")
+            out.append({**row, "model_mode": a.mode + 1, "mac": a.mac})
         return out
+
+    @property
+    def starts_at_best(self) -> int:
+        """How many starts reached the best minimum."""
+        return self.search.minima[0].starts
+
+
+def _row(entry, quantity, metric, rpm, before, after, used) -> dict:
+    m, published = entry["value"], entry.get("published_model")
+    return {"quantity": quantity, "metric": metric, "speed_rpm": rpm, "measured": m, "published_model": published,
+            "before": before, "after": after, "error_before": (before - m) / abs(m),
+            "error_after": (after - m) / abs(m),
+            "error_published_model": None if published is None else (published - m) / abs(m),
+            "role": "fit" if used else "prediction"}
 
 
 def _speeds(entries, default_rpm):
@@ -165,23 +194,34 @@ def _speeds(entries, default_rpm):
     return out
 
 
+def default_starts(entries) -> int:
+    """How many starts a fit takes unless told: :data:`STARTS` when it needs the modes alone, 1 (the file's values)
+    when amplitudes need a time run per evaluation."""
+    return 1 if entries else STARTS
+
+
 def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParameter], duration: float,
-              fit_speeds: list[float] | None = None, progress=None) -> Calibration:
-    """Fit ``fits`` of the train file ``text`` to the measurement ``entries`` (lumped solver)."""
+              fit_speeds: list[float] | None = None, progress=None, frequencies: list[dict] = (),
+              starts: int | None = None) -> Calibration:
+    """Fit ``fits`` of the train file ``text`` to the amplitude ``entries`` and the natural ``frequencies``
+    (lumped solver) from ``starts`` starting points (default :func:`default_starts`)."""
     document = tomllib.loads(text)
-    if not entries:
+    frequencies = list(frequencies)
+    if not entries and not frequencies:
         raise GearcheckError("calibrate needs measurements: the train file's [[measurements]] or measurements=")
     base_spec = load_text(text, source)
-    require_mesh_cycle(base_spec, "a calibration (its time runs)")
-    base_rpm = rad_s_to_rpm(base_spec.operating.input_speed)
-    rpm = _speeds(entries, base_rpm)
+    rpm = _speeds(entries, rad_s_to_rpm(base_spec.operating.input_speed))
     used = [fit_speeds is None or any(abs(r - f) <= SPEED_MATCH * f for f in fit_speeds) for r in rpm]
-    cycle = 1.0 / min(kinematics(base_spec).mesh_frequency.values()) * base_rpm / min(rpm)  # at the lowest speed
-    if duration < MIN_CYCLES * cycle:
-        raise GearcheckError(f"duration {duration:g} s is shorter than a cycle of the slowest mesh ({cycle:.4g} s), "
-                             "the least a measured statistic needs")
-    if not any(used):
+    if entries:
+        _check_time_runs(base_spec, rpm, duration)
+    if entries and not any(used) and fit_speeds is not None:
         raise GearcheckError(f"no measurement at the fit speeds {fit_speeds} rpm (have {sorted(set(rpm))})")
+    fitted_frequencies = [i for i, e in enumerate(frequencies) if e["role"] == "fit"]
+    if not any(used) and not fitted_frequencies:
+        raise GearcheckError("nothing to fit: every natural frequency has role = 'predict'")
+    count = default_starts(entries) if starts is None else starts
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_STARTS:
+        raise GearcheckError(f"starts={count!r}: must be a whole number from 1 to {MAX_STARTS}")
     start = np.array([f.get(document) for f in fits])
     for i, (f, x0) in enumerate(zip(fits, start)):
         if math.isnan(f.low):
@@ -190,8 +230,8 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
             start[i] = math.sqrt(f.low * f.high)
     evaluations = 0
 
-    def model(values, which) -> list[float]:
-        nonlocal evaluations
+    def model(values, which) -> tuple[list[float], list[Paired]]:
+        """The amplitudes ``which`` (the others NaN) and the paired natural frequencies at ``values``."""
         doc = tomllib.loads(text)
         for f, v in zip(fits, values):
             f.set(doc, float(v))
@@ -205,22 +245,42 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
             settle = settling_time(lumped, STEADY_THRESHOLD)
             for i, value in zip(idx, measure(result, [entries[i] for i in idx], cycle, settle)):
                 out[i] = value
-            evaluations += 1
-            if progress is not None:
-                progress(evaluations)
-        return out
+            counted()
+        paired = []
+        if frequencies:
+            lumped = build_model(spec)
+            paired = pair(frequencies, modes(lumped), lumped.dofs.labels(), lumped.M)
+            counted()
+        return out, paired
+
+    def counted():
+        nonlocal evaluations
+        evaluations += 1
+        if progress is not None:
+            progress(evaluations)
 
     fit_idx = [i for i, u in enumerate(used) if u]
-    measured = np.array([entries[i]["value"] for i in fit_idx])
-    sigma = np.array([entries[i]["uncertainty"] for i in fit_idx])
+    measured = np.log([entries[i]["value"] for i in fit_idx]
+                      + [frequencies[i]["frequency_hz"] for i in fitted_frequencies])
+    sigma = np.array([entries[i]["uncertainty"] for i in fit_idx]
+                     + [frequencies[i]["uncertainty"] for i in fitted_frequencies])
+    shaped = [i for i in fitted_frequencies if frequencies[i]["shape"] is not None]
+    shape_sigma = np.array([frequencies[i]["shape_uncertainty"] for i in shaped])
 
     def residual(log_values):
-        y = np.array(model(np.exp(log_values), fit_idx))[fit_idx]
-        return (np.log(np.maximum(y, 1e-300)) - np.log(measured)) / sigma
+        amplitudes, paired = model(np.exp(log_values), fit_idx)
+        y = [amplitudes[i] for i in fit_idx] + [paired[i].frequency for i in fitted_frequencies]
+        mismatch = (np.log(np.maximum(y, 1e-300)) - measured) / sigma
+        return np.concatenate([mismatch, [(1 - paired[i].mac) / s for i, s in zip(shaped, shape_sigma)]])
 
-    solution = least_squares(residual, np.log(start), bounds=(np.log([f.low for f in fits]),
-                                                              np.log([f.high for f in fits])),
-                             diff_step=LOG_STEP, x_scale=1.0, xtol=1e-4, ftol=1e-6)
+    low, high = np.log([f.low for f in fits]), np.log([f.high for f in fits])
+    if fit_idx:  # time runs: a coarse step and tolerances (LOG_STEP)
+        options = {"diff_step": LOG_STEP, "xtol": 1e-4, "ftol": 1e-6}
+    else:  # smooth in ln p: central differences, which also make the uncertainties accurate to ~1e-8
+        options = {"jac": "3-point", "xtol": 1e-12, "ftol": 1e-12, "gtol": 1e-12}
+    search = multistart(residual, np.log(start), low, high, count,
+                        x_scale=1.0, **options)
+    solution = search.best
     fitted = np.exp(solution.x)
     J = solution.jac
     try:
@@ -229,8 +289,8 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
     except np.linalg.LinAlgError:
         rel_unc = np.full(len(fits), math.inf)
     everything = list(range(len(entries)))
-    before = model(start, everything)
-    after = model(fitted, everything)
+    before, frequencies_before = model(start, everything)
+    after, frequencies_after = model(fitted, everything)
     doc = tomllib.loads(text)
     for f, v in zip(fits, fitted):
         f.set(doc, float(v))
@@ -238,4 +298,13 @@ def calibrate(text: str, source: str, entries: list[dict], fits: list[FitParamet
               + ", ".join(f"{f.path} = {v:.6g}" for f, v in zip(fits, fitted))
               + ".\n# The original file carries the comments that document every value.\n")
     return Calibration([f.path for f in fits], start, fitted, rel_unc, entries, rpm, used, before, after,
-                       evaluations, doc, source, header)
+                       evaluations, doc, source, header, frequencies, frequencies_before, frequencies_after, search)
+
+
+def _check_time_runs(spec, rpm: list[float], duration: float) -> None:
+    """Refuse amplitudes the train cannot simulate, or a run too short for a cycle of the slowest mesh."""
+    require_mesh_cycle(spec, "a calibration (its time runs)")
+    cycle = 1.0 / min(kinematics(spec).mesh_frequency.values()) * rad_s_to_rpm(spec.operating.input_speed) / min(rpm)
+    if duration < MIN_CYCLES * cycle:
+        raise GearcheckError(f"duration {duration:g} s is shorter than a cycle of the slowest mesh ({cycle:.4g} s), "
+                             "the least a measured statistic needs")

@@ -15,7 +15,7 @@ from pathlib import Path
 from gearcheck.compare.studies.campbell import CampbellResult
 from gearcheck.compare.engine.crosscheck import crosscheck
 from gearcheck.compare.engine.mode_pairing import ModePairing
-from gearcheck.compare.engine.measurements import load_measurements
+from gearcheck.compare.engine.measurements import load_measurements_file
 from gearcheck.compare.presentation.dashboard import render
 from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.studies.calibrate import Calibration, FitParameter
@@ -25,6 +25,7 @@ from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.session import SOLVERS, Train
 from gearcheck.train.loader import load_train, preset_names, read_train_text
 from gearcheck.train.spec import TrainSpec
+from gearcheck.train.schema import parse_measurements_file
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
@@ -264,8 +265,10 @@ def pin_loads(train, times=None, *, span: str = "pitch", samples: int = 16, stag
     return Train(train).pin_loads(times, span=span, samples=samples, stage=stage)
 
 
-def calibrate(train, fit, *, measurements=None, duration: float = 0.6, fit_speed=None, progress=None) -> Calibration:
-    """Least-squares fit of train-file numbers to measured amplitudes (``gearcheck calibrate``).
+def calibrate(train, fit, *, measurements=None, duration: float = 0.6, fit_speed=None, starts: int | None = None,
+              progress=None) -> Calibration:
+    """Least-squares fit of train-file numbers to measured amplitudes and natural frequencies (``gearcheck
+    calibrate``).
 
     Parameters
     ----------
@@ -273,23 +276,38 @@ def calibrate(train, fit, *, measurements=None, duration: float = 0.6, fit_speed
         A preset name or the path of a train file (the calibrated file is this text with the fitted values).
     fit : list of str
         Train-file fields in their own units with optional bounds, ``"stages[0].mesh.ste[0].amplitude_um=0.05:20"``.
-    measurements : path, optional
-        A TOML file of ``[[measurements]]``; default the train file's own.
+    measurements : path or dict, optional
+        A TOML file of ``[[measurements]]`` (amplitudes) and ``[[natural_frequencies]]``, or such a file's content
+        as a dict (``{"natural_frequencies": [{"frequency_hz": 148.95, "mode": 1}]}``); default the train file's
+        own ``[[measurements]]`` and its ``measurements_file``'s.
     duration : float
-        Simulated time per run, s.
+        Simulated time per run, s (amplitudes only).
     fit_speed : list of float, optional
-        Fit only the measurements at these speeds (rpm); the others are predicted.
+        Fit only the amplitudes measured at these speeds (rpm); the others are predicted.
+    starts : int, optional
+        How many starting points the fit runs from (the file's values, then a Latin hypercube in ln p within the
+        bounds); default 16 when every measurement is a natural frequency, 1 when amplitudes need time runs.
     progress : callable, optional
-        Called with the number of runs done.
+        Called with the number of model evaluations done.
 
     Returns
     -------
     Calibration
-        The fitted values, their uncertainty, the measured against predicted amplitudes, the calibrated text.
+        The fitted values, their uncertainty, the measured against predicted values, the minima the starts reached,
+        the calibrated text.
     """
     text, source = read_train_text(train)
-    entries = load_measurements(measurements) if measurements else list(load(train).measurements)
-    return fit_train(text, source, entries, [FitParameter.parse(f) for f in fit], duration, fit_speed, progress)
+    if isinstance(measurements, dict):
+        found = parse_measurements_file(measurements, "measurements=")
+        entries, frequencies = found["measurements"], found["natural_frequencies"]
+    elif measurements:
+        found = load_measurements_file(measurements)
+        entries, frequencies = found["measurements"], found["natural_frequencies"]
+    else:
+        spec = load(train)
+        entries, frequencies = list(spec.measurements), list(spec.natural_frequencies)
+    return fit_train(text, source, entries, [FitParameter.parse(f) for f in fit], duration, fit_speed, progress,
+                     frequencies, starts)
 
 
 def dashboard(store, out) -> Path:

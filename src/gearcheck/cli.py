@@ -75,7 +75,7 @@ FLAGS = {  # a library error's Python parameter -> this command line's flag
     "samples": "--samples", "seed": "--seed", "harmonics": "--harmonics", "refine": "--refine", "workers": "--workers",
     "scheduler": "--scheduler", "speeds": "--speeds", "cache": "--cache", "fit": "--fit", "parameter": "--parameter",
     "orders": "--orders", "trust": "--trust", "data_root": "--data-root", "fps": "--fps",
-    "slow_motion": "--slow-motion", "magnify": "--magnify", "output_dt": "--output-dt",
+    "slow_motion": "--slow-motion", "magnify": "--magnify", "output_dt": "--output-dt", "starts": "--starts",
     # a parameter that the command line names otherwise: a repeatable flag gives one entry of its list or dict
     "fields": "--set", "distributions": "--vary", "parameters": "--parameter", "quantities": "--quantity"}
 _PARAMETER = re.compile(rf"(?<![.\]-])\b({'|'.join(FLAGS)})=(?=([^\s,.;:)]?))")
@@ -630,11 +630,11 @@ def cmd_calibrate(args) -> int:
 
     def progress(runs):
         if sys.stderr.isatty():
-            print(f"\rcalibrate {spec.name}: {runs} runs", end="", file=sys.stderr, flush=True)
+            print(f"\rcalibrate {spec.name}: {runs} evaluations", end="", file=sys.stderr, flush=True)
 
     with OutputDirectory(args.out) as place:
         result = gearcheck.calibrate(args.train, args.fit, measurements=args.measurements, duration=args.duration,
-                                     fit_speed=args.fit_speed, progress=progress)
+                                     fit_speed=args.fit_speed, starts=args.starts, progress=progress)
         if sys.stderr.isatty():
             print(file=sys.stderr)
         lines = write_calibration(result, spec.name, place.path, args.out)
@@ -898,14 +898,19 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "calibrate": Command(
-        cmd_calibrate, "least-squares fit of train-file parameters to measured amplitudes",
+        cmd_calibrate, "least-squares fit of train-file parameters to measured amplitudes and natural frequencies, "
+                       "from several starts",
         TRAIN,
         arg("--fit", action="append", required=True, metavar="PATH[=LOW:HIGH]",
             help="a train-file field in its own units, e.g. stages[0].mesh.ste[0].amplitude_um=0.05:20"),
         arg("--measurements", type=PATH, metavar="FILE",
-            help="TOML file with [[measurements]] (default: the train file's)"),
+            help="TOML file with [[measurements]] (amplitudes) and [[natural_frequencies]] (default: the train "
+                 "file's [[measurements]])"),
         arg("--fit-speed", type=RPM, action="append", metavar="RPM",
-            help="use only the measurements at this speed for the fit; the others are predicted"),
+            help="use only the amplitudes at this speed for the fit; the others are predicted"),
+        arg("--starts", type=int, metavar="N",
+            help="starting points of the fit: the file's values and a Latin hypercube in ln p within the bounds "
+                 "(default 16 when every measurement is a natural frequency, 1 when amplitudes need time runs)"),
         arg("--duration", type=SECONDS, default=0.6, metavar="S", help="simulated time per run (default 0.6 s)"),
         arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),

@@ -1,7 +1,7 @@
 """The README's generated reference: train-file fields and mesh stiffness models.
 
 ``python -m gearcheck.train.docs [README.md]`` rewrites the blocks between the README's
-``<!-- NAME:begin -->``/``<!-- NAME:end -->`` markers (NAME: schema, models, references);
+``<!-- NAME:begin -->``/``<!-- NAME:end -->`` markers (NAME: schema, models, references, measurements);
 ``tests/test_readme.py`` fails when they are stale.
 """
 
@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from gearcheck.train.mesh_stiffness import MODELS
-from gearcheck.train.schema import _row, markdown_reference
+from gearcheck.train.schema import MEASUREMENTS_FILE, _row, markdown_reference
 from gearcheck.shared.citations import REFERENCES
 
 
@@ -33,7 +33,13 @@ def references_table() -> str:
     return "\n".join(rows) + "\n"
 
 
-BLOCKS = {"schema": markdown_reference, "models": models_reference, "references": references_table}
+def measurements_reference() -> str:
+    """The field-by-field reference of a measurements file (``--measurements``)."""
+    return markdown_reference(MEASUREMENTS_FILE)
+
+
+BLOCKS = {"schema": markdown_reference, "models": models_reference, "references": references_table,
+          "measurements": measurements_reference}
 
 
 def _split(text: str, name: str) -> tuple[str, str, str]:

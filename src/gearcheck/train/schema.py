@@ -663,7 +663,36 @@ MEASUREMENT = Table(
     "a measured reference value ([[measurements]])",
 )
 
-MEASUREMENTS_FILE = Table({"measurements": TableList(MEASUREMENT, "measured values", min_length=1)},
+MAX_MODES = 10000  # a lumped train's coordinates: 32 planets of 6 stages with every axis are under 2000
+MODE_TYPES = ("rotational", "translational", "planet", "mixed", "elastic")  # gearcheck.shared.modal.mode_types
+
+NATURAL_FREQUENCY = Table(
+    {
+        "frequency_hz": Positive("the measured natural frequency", "Hz", REQUIRED, bound("frequency")),
+        "mode": Integer("the model mode it is, numbered as `gearcheck modes` lists them (1: the lowest)", None, 1,
+                        maximum=MAX_MODES),
+        "type": Text("the type of the model mode it is (Lin & Parker 1999), with `order`", None, MODE_TYPES),
+        "order": Integer("which frequency of that type, counted from the lowest (a multiple one once)", None, 1,
+                         maximum=MAX_MODES),
+        "shape": Table({}, "the measured mode shape over the train's coordinates (`stage.member.dof`), compared "
+                           "by MAC; alone, it pairs with the model mode of largest MAC", None,
+                       patterns=((r"[\w\-]+(\.[\w\-]+)+", Number("shape amplitude", "", REQUIRED, -1e12, False,
+                                                                    1e12)),), pattern_label="COORDINATE"),
+        "uncertainty": Positive("relative standard uncertainty of the frequency (calibration weights)", "-", 0.01,
+                                10.0),
+        "shape_uncertainty": Positive("standard uncertainty of the MAC of the shape (calibration weights)", "-", 0.1,
+                                      1.0),
+        "role": Text("fit: the calibration fits it; predict: held out, its model value is predicted", "fit",
+                     ("fit", "predict")),
+        "published_model": Positive("the value the source's own model gave", "Hz", None, bound("frequency")),
+        "source": Text("where the value comes from", ""),
+    },
+    "a measured natural frequency ([[natural_frequencies]])",
+)
+
+MEASUREMENTS_FILE = Table({"measurements": TableList(MEASUREMENT, "measured values", default=()),
+                           "natural_frequencies": TableList(NATURAL_FREQUENCY, "measured natural frequencies",
+                                                            default=())},
                           "a measurements file")
 
 TRAIN_TABLE = Table(
@@ -679,8 +708,9 @@ TRAIN_TABLE = Table(
         "held": ListOf(Text("member", REQUIRED),
                        "members held by their torsional support stiffness: each needs "
                        "`support.torsional_stiffness` > 0, so that its vibration is still modelled", ()),
-        "measurements_file": Text("a TOML file of [[measurements]] (relative to the train file) shown in every "
-                                  "cross-check and used by calibrate", None),
+        "measurements_file": Text("a TOML file of [[measurements]] and [[natural_frequencies]] (relative to the "
+                                  "train file): the amplitudes shown in every cross-check, both used by calibrate",
+                                  None),
         "user_model": Text("your own model of this train, checked by `crosscheck --model user`: a .mat or .npz "
                            "file of matrices (relative to the train file), or `module:factory` or "
                            "`file.py:factory` (code, run only with `--trust`)", None),
@@ -707,13 +737,31 @@ def parse(document: dict, source: str) -> dict:
     return TRAIN.parse(document, "", Context(source))
 
 
-def parse_measurements(document: dict, source: str) -> list[dict]:
-    """Validate a measurements file (a ``[[measurements]]`` array) against :data:`MEASUREMENTS_FILE`."""
-    return MEASUREMENTS_FILE.parse(document, "", Context(source))["measurements"]
+def parse_measurements_file(document: dict, source: str) -> dict:
+    """Validate a measurements file against :data:`MEASUREMENTS_FILE`: ``measurements`` (amplitudes) and
+    ``natural_frequencies``, at least one entry in all, each natural frequency paired one way: ``mode``, ``type``
+    with ``order``, or a ``shape`` alone (which ``type`` may narrow); a shape given with the others is compared
+    with the mode they pair."""
+    ctx = Context(source)
+    parsed = MEASUREMENTS_FILE.parse(document, "", ctx)
+    if not parsed["measurements"] and not parsed["natural_frequencies"]:
+        raise ctx.fail("measurements", "missing required field (or [[natural_frequencies]])")
+    for i, entry in enumerate(parsed["natural_frequencies"]):
+        path = f"natural_frequencies[{i}]"
+        if entry["mode"] is not None and entry["type"] is not None:
+            raise ctx.fail(f"{path}.mode", f"{entry['mode']} pairs by number, type by type and order: give one")
+        if entry["order"] is not None and entry["type"] is None:
+            raise ctx.fail(f"{path}.order", f"{entry['order']} counts within a type: give type")
+        if entry["mode"] is None and entry["type"] is None and entry["shape"] is None:
+            raise ctx.fail(path, "needs mode, type (with order) or shape, to pair it with a model mode")
+        if entry["shape"] is not None and not any(entry["shape"].values()):
+            raise ctx.fail(f"{path}.shape", "is zero everywhere")
+        entry["where"] = f"{source}: {path}"
+    return parsed
 
 
-def markdown_reference() -> str:
-    """The field-by-field reference of the train file, as a Markdown table."""
+def markdown_reference(root: Table = TRAIN) -> str:
+    """The field-by-field reference of the train file (or of another file, ``root``), as a Markdown table."""
     rows = ["| field | type | unit | default | range | meaning |", "|---|---|---|---|---|---|"]
     seen: dict[int, str] = {}
 
@@ -732,7 +780,7 @@ def markdown_reference() -> str:
             else:
                 rows.append(_row(path, spec))
 
-    walk(TRAIN, "")
+    walk(root, "")
     return "\n".join(rows) + "\n"
 
 

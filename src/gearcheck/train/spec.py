@@ -25,7 +25,7 @@ from gearcheck.train.geometry import (Gear, MeshGeometry, gear_problem, helix_pr
                                       mesh_geometry, mesh_problem)
 from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import Part, train_parts
-from gearcheck.train.schema import Context, parse_measurements
+from gearcheck.train.schema import Context, parse_measurements_file
 from gearcheck.train.torsional import check_torsional_couplings, torsional_members
 from gearcheck.shared.errors import GearcheckError, TrainFileError, TrainNote, did_you_mean, shown
 from gearcheck.shared.trust import inside_roots
@@ -336,6 +336,7 @@ class TrainSpec:
     text_hash: str = ""
     references: tuple[str, ...] = ()  # keys of gearcheck.shared.citations.REFERENCES
     measurements: tuple[dict, ...] = ()  # measured reference values, SI (see schema.MEASUREMENT)
+    natural_frequencies: tuple[dict, ...] = ()  # measured ones of train.measurements_file, which calibrate fits
     tolerances: dict = field(default_factory=dict)  # cross-check tolerance overrides, flat keys
     user_model: str | None = None  # a user's model of the train (a file path or module:factory), --model user
 
@@ -440,7 +441,7 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
         input=train["input"], output=train["output"], held=tuple(train["held"]), members=members,
         stages=tuple(stages), meshes=tuple(meshes), couplings=tuple(couplings), cycloids=tuple(cycloids),
         operating=operating, text_hash=text_hash, references=tuple(train["references"]),
-        measurements=tuple(_measurements(data, source, fail)),
+        **_measurements(data, source, fail),
         tolerances=flat_tolerances(data["tolerances"] or {}, lambda key, msg: fail(f"tolerances.{key}", msg)),
         user_model=_user_model(train["user_model"], source, fail),
     )
@@ -535,10 +536,11 @@ def _user_model(name: str | None, source: str, fail) -> str | None:
         raise fail("train.user_model", str(exc)) from None
 
 
-def _measurements(data: dict, source: str, fail) -> list[dict]:
-    """Inline [[measurements]] plus those of train.measurements_file, checked."""
+def _measurements(data: dict, source: str, fail) -> dict:
+    """Inline [[measurements]] plus those of train.measurements_file, and that file's [[natural_frequencies]],
+    checked: the TrainSpec's ``measurements`` and ``natural_frequencies``."""
 
-    entries = list(data["measurements"])
+    entries, frequencies = list(data["measurements"]), []
     name = data["train"]["measurements_file"]
     if name is not None:
         try:
@@ -548,8 +550,10 @@ def _measurements(data: dict, source: str, fail) -> list[dict]:
             raise
         except GearcheckError as exc:
             raise fail("train.measurements_file", str(exc)) from None
-        entries += parse_measurements(document, str(path))
-    return entries
+        found = parse_measurements_file(document, str(path))
+        entries += found["measurements"]
+        frequencies = found["natural_frequencies"]
+    return {"measurements": tuple(entries), "natural_frequencies": tuple(frequencies)}
 
 
 def _torque_profile(name: str, source: str, fail):

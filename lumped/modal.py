@@ -21,7 +21,7 @@ def central_coordinates(spec, labels) -> tuple[list[int], list[int]]:
     their rotations (a helical mesh's axial force goes with its torque, Eritenel & Parker 2009: the axial
     slides count with the rotations); labels of no member of ``spec`` are neither."""
     named = [(i, label.rsplit(".", 1)) for i, label in enumerate(labels) if "." in label]
-    central = [(i, dof) for i, (member, dof) in named if member in spec.members and not spec.members[member].orbits]
+    central = [(i, dof) for i, (member, dof) in named if member in spec.members and spec.members[member].central]
     turning = (ROTATION, AXIAL)
     return [i for i, d in central if d not in turning], [i for i, d in central if d in turning]
 

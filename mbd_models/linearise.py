@@ -202,9 +202,9 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
 
 def _central(mb) -> tuple[list[int], list[int]]:
     """(translation, rotation) dofs of the central members; an axial slide goes with the rotation (a helical
-    mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes).  A cycloid disc's are
-    its x, y and rotation in place of its polar joints (:func:`_disc_axes`)."""
-    central = [mid for mid, member in mb.spec.members.items() if not member.orbits]
+    mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes).  A cycloid disc is a
+    planetary component, not a central member (:attr:`~gearcheck.train.spec.Member.central`)."""
+    central = [mid for mid, member in mb.spec.members.items() if member.central]
     axial = [dof for mid in central if (dof := _axial_dof(mb, mid)) is not None]
     return ([i for mid in central for a, i in mb.dadr[mid].items() if a != ROTATION],
             [mb.dadr[mid][ROTATION] for mid in central] + axial)

@@ -105,3 +105,16 @@ def test_slow_eccentric_motion_is_quasi_static():
         quasi_static = element.pin_forces(run.t[i], frozen.q, np.zeros_like(frozen.q))
         assert np.abs(dynamic - quasi_static).max() < 1e-4 * quasi_static.max()
         assert q[i, theta] == pytest.approx(frozen.q[theta], rel=1e-5)
+
+
+def test_modes_read_like_the_papers_classes(model):
+    """Yang, Chen & Wang (2018, Section 3.2) type an RV reducer's modes as planar planetary ones: the sun and the
+    output wheel are the central members, planets, crankshafts and cycloid discs the planetary components.  Read
+    so, every mode of the preset is rotational (central members only turn) or translational (they only
+    translate) -- none mixed, where counting the discs as central left 22 of its first 23 mixed -- and the twin,
+    typing from its own joints, agrees mode by mode."""
+    import gearcheck
+
+    lumped, twin = modes(model), gearcheck.modes("rv-reducer", solver="mujoco")
+    assert set(lumped.types) == {"rotational", "translational"} and lumped.types == twin.types
+    assert lumped.types[:4] == ["rotational", "translational", "translational", "rotational"]

@@ -106,6 +106,13 @@ class Member:
         return FRAMES[self.kind]
 
     @property
+    def central(self) -> bool:
+        """On the stage axis (sun, ring, carrier, pin wheel): the members whose motion types the modes (Lin & Parker
+        1999); planets, crankshafts and cycloid discs are the planetary components (Yang, Chen & Wang 2018,
+        Section 3.2)."""
+        return self.frame == "axis"
+
+    @property
     def orbits(self) -> bool:
         """Sits on a pin of its carrier (a planet, an RV reducer's crankshaft): its translations are along the
         carrier's radial and tangential axes at its place."""

@@ -220,6 +220,11 @@ def bad_files(tmp):
         (edit("extra", Q=np.eye(2)), "Q: unknown variable"),
         (edit("mesh-id", mesh_ids=np.array(["stage1.nope"] * 6)), "'stage1.nope' is not a mesh of demo-3p"),
         (edit("mesh-rows", mesh_rows=np.zeros((6, 3))), "mesh_rows: shape (6, 3), expected (6, 18)"),
+        (edit("interpolation", mesh_interpolation=np.array("cubic")), "mesh_interpolation: 'cubic': choose linear "
+                                                                        "or hold"),
+        (edit("mesh-error", mesh_error=np.zeros(6), period=np.array(0.01)), "mesh_error: shape (6,), expected (6, N)"),
+        (edit("mesh-error-nan", mesh_error=np.full((6, 8), np.nan), period=np.array(0.01)),
+         "meshes[0].error"),
         (tmp / "broken.mat", "broken.mat: cannot be read as .mat"),
         (tmp / "model.txt", "a model file is .mat or .npz, not '.txt'"),
         (tmp / "absent.npz", "absent.npz: no such model file"),

@@ -321,7 +321,8 @@ def test_diagnosis_uses_the_declared_reduction(how):
     the reference reduced as it declares, at rest and at speed; declared the other way, it does not."""
     model = ring_eliminated(how=how, gyroscopic=True)
     diagnosis = diagnose_side(build_model(SPEC), LinearSide(model, SPEC))
-    assert diagnosis.agrees and diagnosis.reduced_to == 15, diagnosis.summary()
+    assert diagnosis.agrees and diagnosis.reduced_to == 15 and diagnosis.reduction == how, diagnosis.summary()
+    assert {"held": "the others held", "condensed": "the others condensed out"}[how] in diagnosis.lines()[0]
     other = replace(model, reduction="condensed" if how == "held" else "held")
     assert not diagnose_side(build_model(SPEC), LinearSide(other, SPEC)).agrees
 

@@ -160,6 +160,7 @@ class Diagnosis:
     evidence: dict[str, int]  # how much evidence: frequencies at rest, shapes, frequencies at speed
     tried: int  # one-term changes scored
     reduced_to: int | None = None  # coordinates of the reduced reference it was compared with, if reduced
+    reduction: str | None = None  # what that reference did with the others: "held" or "condensed"
     rigid_modes: dict[str, int] = field(default_factory=dict)  # zero frequencies: evidence's and reference's
     pairs: int = 0  # pairs of changes scored (when no one-term change explains the evidence)
 
@@ -176,9 +177,11 @@ class Diagnosis:
         """A few plain sentences."""
         best, out = self.best, []
         if self.agrees and self.reduced_to:
+            others = {"held": "the others held", "condensed": "the others condensed out (Guyan 1965)"}
             out.append(f"No single-term mistake: agrees with the reference reduced to its {self.reduced_to} "
-                       f"coordinates (score {self.reference_score:.2g}); what differs from the full reference is "
-                       "the reduction itself (the coordinates it holds or ties), not a wrong term.")
+                       f"coordinates, {others.get(self.reduction, 'the others held')} (score "
+                       f"{self.reference_score:.2g}); what differs from the full reference is the reduction itself "
+                       "(the coordinates it holds or ties), not a wrong term.")
         elif self.agrees:
             out.append(f"No single-term mistake: agrees with the reference (score {self.reference_score:.2g}).")
         else:
@@ -216,7 +219,7 @@ class Diagnosis:
         return "\n".join(self.lines())
 
     def to_dict(self) -> dict:
-        return {"train": self.train, "agrees": self.agrees, "reduced_to": self.reduced_to,
+        return {"train": self.train, "agrees": self.agrees, "reduced_to": self.reduced_to, "reduction": self.reduction,
                 "reference_score": self.reference_score,
                 "held": list(self.held), "evidence": dict(self.evidence), "tried": self.tried,
                 "rigid_modes": dict(self.rigid_modes), "pairs": self.pairs,
@@ -769,7 +772,7 @@ def diagnose_side(model: LumpedModel, side, modal=None, top: int = 3) -> Diagnos
         diagnosis = diagnose(reduced, Evidence(coordinates, modal.frequencies, modal.shapes[own],
                                                linear.M[np.ix_(own, own)], at_speed), top)
         if len(coordinates) < model.n:
-            diagnosis.reduced_to = len(coordinates)
+            diagnosis.reduced_to, diagnosis.reduction = len(coordinates), linear.reduction
         return diagnosis
     try:
         labels, mass, shapes = side.physical_modes(modal)

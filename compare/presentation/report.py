@@ -612,6 +612,7 @@ def _diagnosis_schema() -> dict:
     """``diagnosis``: a user's model's best-explaining term of the reference, or null."""
     return {"anyOf": [_object({
         "train": STRING, "agrees": BOOLEAN, "reduced_to": {"type": ["integer", "null"]},
+        "reduction": {"enum": ["held", "condensed", None]},
         "reference_score": NULLABLE_NUMBER, "held": _array(STRING),
         "evidence": _object({k: {"type": "integer"} for k in ("rest", "shapes", "speed")}),
         "tried": {"type": "integer"}, "candidates": _array({"$ref": "#/$defs/candidate"}),

@@ -32,6 +32,7 @@ def describe(spec) -> dict:
         out["stages"].append({
             "name": stage.name, "planets": len(stage.planets), "carrier_radius_m": stage.carrier_radius,
             "planet_angles_deg": [math.degrees(a) for a in stage.planet_angles],
+            "torsional": [mid for mid, m in spec.members.items() if m.stage == stage.name and m.torsional],
             "gears": {_gear_label(spec.members[mid], g): {
                 "teeth": g.teeth, "pitch_radius_m": g.pitch_radius, "base_radius_m": g.base_radius,
                 "tip_radius_m": g.tip_radius, "profile_shift": g.profile_shift,

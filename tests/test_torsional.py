@@ -7,6 +7,7 @@ bearings stiffen (converging as 1/k), the twin's modes, the count of its modes; 
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import warnings
@@ -17,6 +18,7 @@ import pytest
 import scipy.linalg as sla
 
 import gearcheck
+from gearcheck.cli import main
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.modal import modes
@@ -198,3 +200,12 @@ def test_bad_input_is_one_line(tmp_path, text, expected):
 def test_an_rv_reducer_has_no_torsional_level():
     with pytest.raises(TrainFileError, match=r"stages\[0\].torsional: an RV reducer's stage has no torsional level"):
         edited("rv-reducer", [(r'^name = "rv"', 'name = "rv"\ntorsional = true')])
+
+
+def test_show_lists_the_torsional_members(tmp_path, capsys):
+    path = tmp_path / "planets.toml"
+    path.write_text(edited_text("demo-3p", [PLANETS]))
+    assert main(["show", str(path), "--json"]) == 0
+    stage = json.loads(capsys.readouterr().out)["stages"][0]
+    assert stage["torsional"] == ["stage1.planet1", "stage1.planet2", "stage1.planet3"]
+    assert main(["show", "demo-3p"]) == 0 and "torsional" not in capsys.readouterr().out

@@ -273,6 +273,8 @@ def cmd_show(args) -> int:
         print(f"  stage {st['name']}: {st['planets']} planets at "
               f"{', '.join(f'{a:.6g}' for a in st['planet_angles_deg'])} deg, carrier radius "
               f"{st['carrier_radius_m'] * 1e3:.6g} mm")
+        if st["torsional"]:
+            print(f"    torsional (rotation only): {', '.join(st['torsional'])}")
         for name, g in st["gears"].items():
             helix = f"  beta={g['helix_angle_deg']:+.6g} deg" if g["helix_angle_deg"] else ""
             teeth = "—" if g["teeth"] is None else g["teeth"]  # an idealised gear's

@@ -19,6 +19,15 @@ from gearcheck.lumped.linear_model import LinearModel, Periodic
 MOVING = ("C", "G", "K_omega", "G_per_speed", "K_omega_per_speed2")  # terms that would make the condensation inexact
 
 
+def static_response(K: np.ndarray, s: list[int], m: list[int]) -> np.ndarray | None:
+    """R = -K_ss^-1 K_sm: the coordinates ``s`` as the static response to the coordinates ``m`` (Guyan 1965), or
+    None when no stiffness of their own holds them (K_ss singular)."""
+    K_ss = K[np.ix_(s, s)]
+    if np.linalg.matrix_rank(K_ss) < len(s):
+        return None
+    return -np.linalg.solve(K_ss, K[np.ix_(s, m)])
+
+
 def condense_massless(model: LinearModel) -> LinearModel:
     """``model`` with its massless coordinates (:attr:`LinearModel.massless`) condensed out, and a note naming
     them; ``model`` itself when it has none."""
@@ -28,14 +37,13 @@ def condense_massless(model: LinearModel) -> LinearModel:
     m = [i for i in range(model.n) if i not in s]
     names = [model.coordinates[i] for i in s]
     _refuse_moving(model, s)
-    K = model.matrix("K")
-    K_ss = K[np.ix_(s, s)]
-    if np.linalg.matrix_rank(K_ss) < len(s):
+    R = static_response(model.matrix("K"), s, m)
+    if R is None:
         raise model._error("K", f"massless coordinates {', '.join(names)} are held by no stiffness of their own: "
                            "their static condensation is undetermined")
     T = np.zeros((model.n, len(m)))
     T[m, np.arange(len(m))] = 1.0
-    T[s] = -np.linalg.solve(K_ss, K[np.ix_(s, m)])
+    T[s] = R
 
     def reduce(name):
         return None if getattr(model, name) is None else T.T @ model.matrix(name) @ T

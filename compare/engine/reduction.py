@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gearcheck.lumped.condensation import static_response
 from gearcheck.lumped.linear_model import REDUCTIONS
 from gearcheck.lumped.modal import central_coordinates
 from gearcheck.shared.errors import GearcheckError, UnsupportedError
@@ -32,11 +33,11 @@ def reduction_basis(K: np.ndarray, T: np.ndarray, mapped: list[bool], how: str) 
     s = [i for i, m in enumerate(mapped) if not m]
     if how == "condensed" and s:
         m = [i for i, x in enumerate(mapped) if x]
-        K_ss = K[np.ix_(s, s)]
-        if np.linalg.matrix_rank(K_ss) < len(s):
+        R = static_response(K, s, m)
+        if R is None:
             raise GearcheckError("reduction=condensed: the coordinates the model lacks are not held by the rest "
                                  "(their stiffness is singular): they cannot be condensed out; declare them held")
-        psi[s] = -np.linalg.solve(K_ss, K[np.ix_(s, m)] @ psi[m])
+        psi[s] = R @ psi[m]
     return psi
 
 

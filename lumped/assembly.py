@@ -76,6 +76,12 @@ class LumpedModel:
     excitation: Excitation
     rotating_frame_terms: bool = True
     turning: list = field(default_factory=list)  # elements whose rows move with time (elements.base.Turning)
+    # per unit of the speed scale's rate lambda' (a speed history, :mod:`gearcheck.lumped.frame_schedule`): the Euler
+    # terms of the frames' angular acceleration and the loads that accelerate the rigid train; the part of F_static
+    # that goes with Omega^2
+    K_euler: np.ndarray | None = None
+    F_inertia: np.ndarray | None = None
+    F_centripetal: np.ndarray | None = None
     expansion: np.ndarray | None = None  # T: the train's coordinates are T q where some are tied (constraints)
     train_dofs: DofMap | None = None  # the train's coordinates, where they are not the model's (``expansion``)
 
@@ -128,7 +134,8 @@ class LumpedModel:
         zero = np.zeros_like(self.M)
         turning = [e.without_frame_terms() for e in self.turning]
         held = sum((e.held_load(self.n) for e in turning), np.zeros(self.n))
-        return replace(self, G=zero, K_centripetal=zero, K_circulatory=zero, F_static=held,
+        return replace(self, G=zero, K_centripetal=zero, K_circulatory=zero, F_static=held, K_euler=zero,
+                       F_centripetal=np.zeros(self.n),
                        rotating_frame_terms=False, turning=turning)
 
 
@@ -152,7 +159,10 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     G = np.zeros((n, n))
     K_cent = np.zeros((n, n))
     K_circ = np.zeros((n, n))
+    K_euler = np.zeros((n, n))
     F = np.zeros(n)
+    F_cent = np.zeros(n)
+    F_inertia = np.zeros(n)
     for mid, member in spec.members.items():
         u, v = member.dofs[:2]
         iu, iv, ith = dofs(mid, u), dofs(mid, v), dofs(mid, ROTATION)
@@ -162,17 +172,24 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
             M[dofs(mid, AXIAL), dofs(mid, AXIAL)] = member.mass
         carrier = f"{member.stage}.carrier"
         omega = kin.speeds[carrier]
-        # Coriolis 2 m Omega k x q' and centripetal -m Omega^2 q of the translations (rotating frame)
+        # Coriolis 2 m Omega k x q', Euler Omega' k x q and centripetal -m Omega^2 q of the translations (rotating
+        # frame; the Euler terms per unit lambda', Omega' = lambda' Omega)
         G[iu, iv] -= 2.0 * member.mass * omega
         G[iv, iu] += 2.0 * member.mass * omega
+        K_euler[iu, iv] -= member.mass * omega
+        K_euler[iv, iu] += member.mass * omega
         K_cent[iu, iu] = K_cent[iv, iv] = -member.mass * omega**2
+        F_inertia[ith] -= member.inertia * kin.speeds[mid]  # -J w: the torque that accelerates its rotation
         if member.orbits:
-            F[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
+            F_cent[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
+            F_inertia[iv] -= member.mass * member.radius * omega  # -m r_c Omega: the orbit's tangential inertia
             # m Omega^2 (r_c^2 theta_c^2 / 2 + r_c theta_c s_t): the potential in carrier coordinates
             e_c = dofs.unit((carrier, ROTATION, 1.0))
-            s_t = pin_rows(spec, dofs, mid)[1]
+            s_r, s_t = pin_rows(spec, dofs, mid)
             K_cent += member.mass * omega**2 * member.radius * (
                 member.radius * np.outer(e_c, e_c) + np.outer(e_c, s_t) + np.outer(s_t, e_c))
+            # the Euler load -m Omega' r_c along the turned tangent, in carrier coordinates: m Omega' r_c theta_c s_r
+            K_euler += member.mass * omega * member.radius * (np.outer(e_c, s_r) + np.outer(s_r, e_c))
         elif member.support:
             c = member.support.radial_damping  # damping relative to the housing: -c (q' + Omega k x q)
             K_circ[iu, iv] -= c * omega
@@ -188,8 +205,9 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     damping = np.array([c for _, c in meshes])
     b_in = dofs.unit((spec.input, ROTATION, 1.0))
     b_out = dofs.unit((spec.output, ROTATION, 1.0))
-    model = LumpedModel(spec, kin, dofs, M, G, K_cent, K_circ, rows, mesh_rows, damping, F, b_in, b_out, excitation,
-                        turning=[e for p in parts for e in p.turning])
+    model = LumpedModel(spec, kin, dofs, M, G, K_cent, K_circ, rows, mesh_rows, damping, F + F_cent, b_in, b_out,
+                        excitation, turning=[e for p in parts for e in p.turning], K_euler=K_euler,
+                        F_inertia=F_inertia, F_centripetal=F_cent)
     for p in parts:
         if p.place:
             model = p.place(model)

@@ -38,6 +38,8 @@ def constrained(model, coordinates: list[str], T: np.ndarray):
                    K_centripetal=T.T @ model.K_centripetal @ T, K_circulatory=T.T @ model.K_circulatory @ T,
                    rows=[replace(r, a=r.a @ T) for r in model.rows], mesh_rows=model.mesh_rows @ T,
                    F_static=T.T @ model.F_static, b_input=T.T @ model.b_input, b_output=T.T @ model.b_output,
+                   K_euler=T.T @ model.K_euler @ T, F_inertia=T.T @ model.F_inertia,
+                   F_centripetal=T.T @ model.F_centripetal,
                    expansion=T if model.expansion is None else model.expansion @ T,
                    train_dofs=model.train_dofs or model.dofs)
 

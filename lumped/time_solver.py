@@ -30,6 +30,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from gearcheck.lumped.compiled_steps import Chunk, Output, kernel_groups, rk4_steps, switching_count
+from gearcheck.lumped.frame_schedule import with_schedule
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
@@ -41,15 +42,19 @@ from gearcheck.shared.results import TimeResult, bearing_names, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS
+from gearcheck.train.history import check_duration
 
 CHUNK = 20000  # steps between divergence checks and progress reports
 CHUNK_BYTES = 16 * 2**20  # at most this much drive per chunk (the tooth pairs take a lot per step)
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
 
-def step_limits(model) -> stepping.StepLimits:
+def step_limits(model, top: float = 1.0) -> stepping.StepLimits:
     """The RK4 step limits of the model with every mesh at its largest stiffness over a cycle, damping,
-    gyroscopic and rotating-frame terms included."""
+    gyroscopic and rotating-frame terms included, at ``top`` times the reference speed (an operating history's
+    fastest)."""
+    if top != 1.0:
+        model = model.at_speed(top * model.spec.operating.input_speed)
     K = model.K_b + model.K_mesh(model.excitation.max_stiffness) + model.K_frame
     return stepping.StepLimits.of(model.M, K, model.C + model.G)
 
@@ -158,7 +163,11 @@ class _System:
 
 
 def initial_state(model) -> tuple[np.ndarray, np.ndarray]:
-    """Static deflection under the mean load, or the unloaded state when the load is ramped."""
+    """Static deflection under the mean load, or the unloaded state when the load is ramped; at rest and
+    undeformed for an operating history that starts from rest."""
+    history = model.spec.operating.history
+    if history is not None and history.start == "rest":
+        return np.zeros(model.n), np.zeros(model.n)
     scale = 0.0 if model.spec.operating.ramp > 0 else 1.0
     return static_solution(model, load_scale=scale).q, np.zeros(model.n)
 
@@ -183,10 +192,16 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     """
     if method not in ("rk4", "rk4-stages") + ADAPTIVE_METHODS:
         raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
-    limits = step_limits(model)
-    dt = stepping.default_step(limits, model.excitation.frequency) if settings.dt is None else settings.dt
     what = f"lumped model of {model.spec.name}"
-    stepping.check_step(dt, limits, model.excitation.frequency, what)
+    model = with_schedule(model)
+    nominal = model.excitation.clock
+    top = 1.0 if nominal is None else max(1.0, nominal.top(settings.duration))
+    if nominal is not None:
+        check_duration(model.spec.operating.history, settings.duration, what)
+    limits = step_limits(model, top)
+    frequency = top * model.excitation.frequency
+    dt = stepping.default_step(limits, frequency) if settings.dt is None else settings.dt
+    stepping.check_step(dt, limits, frequency, what)
     n_steps, every = settings.check_work(dt, len(model.spec.members) * 5 + len(model.spec.meshes) * 4 + 4 * model.n,
                                          what)
     q0, v0 = initial_state(model) if y0 is None else y0
@@ -392,7 +407,8 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     k = sys.contact_stiffness(q, k, e, pairs)
     spec, dofs = model.spec, model.dofs
     q_t, v_t, qdd_t = (q, v, qdd) if model.expansion is None else (x @ model.expansion.T for x in (q, v, qdd))
-    acc, angle = member_motion(spec, model.kin, model.physical_dofs, t, q_t, v_t, qdd_t, model.rotating_frame_terms)
+    acc, angle = member_motion(spec, model.kin, model.physical_dofs, t, q_t, v_t, qdd_t, model.rotating_frame_terms,
+                               model.excitation.clock)
     rows = {r.name: r for r in model.rows if r.kind == "bearing"}
     bearings = [rows[name] for name in bearing_names(spec)]
     a = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)

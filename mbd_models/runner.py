@@ -79,6 +79,7 @@ from gearcheck.shared.results import TimeResult, train_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS
+from gearcheck.train.history import check_duration
 
 CHUNK = 10000
 
@@ -96,7 +97,7 @@ class _Drive:
 
     def controls(self, t: np.ndarray) -> np.ndarray:
         """Actuator controls at times t: w_in for the input servo and its damper, torques (ramp included)."""
-        a, w_in = self.mb.actuator, self.mb.spec.operating.input_speed
+        a, w_in = self.mb.actuator, self.mb.spec.operating.input_speed * self.exc.speed_scale(t)
         u = np.zeros(np.shape(t) + (self.mb.model.nu,))
         t_in, t_out = self.exc.torques(t)
         if "input_shaft" in a:
@@ -463,12 +464,17 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         raise SolverError(f"the compiled MuJoCo runner cannot run {mb.spec.name}: {unsupported}")
     use_compiled = engine != "python" and not unsupported
     spec, m = mb.spec, mb.model
-    dt = mb.default_step if settings.dt is None else settings.dt
     what = f"MuJoCo model of {spec.name}"
-    stepping.check_step(dt, mb.limits, mb.excitation.frequency, what)
+    nominal, history = mb.excitation.clock, spec.operating.history
+    check_duration(history, settings.duration, what)
+    frequency = mb.excitation.frequency * (1.0 if nominal is None else max(1.0, nominal.top(settings.duration)))
+    dt = stepping.default_step(mb.limits, frequency) if settings.dt is None else settings.dt
+    stepping.check_step(dt, mb.limits, frequency, what)
     n_steps, every = settings.check_work(dt, m.nsensordata + 3 * 3 * len(spec.members) + 2 * len(spec.meshes), what)
     static = static_state(mb)
-    if initial_state is None:
+    if initial_state is None and history is not None and history.start == "rest":
+        qpos0, qvel0 = m.qpos0.copy(), np.zeros(m.nv)  # every body at rest at its nominal place, undeformed
+    elif initial_state is None:
         start = static if spec.operating.ramp == 0 else static_state(mb, 0.0)
         qpos0, qvel0 = start.qpos, start.qvel
     else:

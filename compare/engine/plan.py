@@ -49,7 +49,8 @@ class TrainPlan:
     @classmethod
     def of(cls, spec, reference, duration: float) -> "TrainPlan":
         """The plan of ``spec`` for runs of ``duration`` s of the side ``reference``: its highest natural
-        frequency sets the round-off floor, the decay of its free vibration the earliest steady state."""
+        frequency sets the round-off floor, the decay of its free vibration the earliest steady state.  Under an
+        operating history the run is a transient by design: no steady state is sought, the whole run compared."""
         kin = kinematics(spec)
         stages = {}
         for stage in spec.stages:
@@ -57,7 +58,7 @@ class TrainPlan:
             stages[stage.name] = (f_mesh, abs(kin.speeds[stage.carrier]) / (2 * math.pi))
         return cls(spec, dict(kin.mesh_frequency), stages, round_off_floor(spec, kin, reference.omega_max(), duration),
                    reference.settling_time(STEADY_THRESHOLD), reference.operating(),
-                   switch_times=Excitation(spec, kin).switch_times)
+                   detect_steady=spec.operating.history is None, switch_times=Excitation(spec, kin).switch_times)
 
     def steady_groups(self, names) -> list[tuple[list[str], float]]:
         """The mesh-force signals among ``names`` with the cycle over which they repeat in steady state: all

@@ -407,7 +407,9 @@ def _summary_lines(data) -> list[str]:
     return [
         f"Train: {data['train']['name']} — {data['train']['description']} ({data['train']['source']})",
         f"Operating point: {s['input_speed']['value']:.6g} rpm, output torque {s['output_torque']['value']:.6g} N·m,"
-        f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})",
+        f" simulated {s['simulated']['value']:.6g} s; steady window from {steady['start']['value']:.6g} s ({how})"
+        + (f"; operating history: {s['operating_history']} (a transient by design: the two solvers' transients "
+           "are compared as they are)" if "operating_history" in s else ""),
         f"Sides: {A}, the {data['sides']['reference']} (reference, a); {B}, the {data['sides']['test']} (test, b)",
         *runs,
         f"gearcheck {p['gearcheck_version']} (git {p['git_revision']}), MuJoCo {p['mujoco_version']}, "

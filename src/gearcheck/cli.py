@@ -417,8 +417,17 @@ def cmd_ste(args) -> int:
     return 0
 
 
+def _profiled(args, train):
+    """The train under the command line's operating history (--speed-profile, --torque-profile, --load-profile,
+    --start), or as loaded."""
+    from gearcheck.train.spec import with_profiles
+
+    return with_profiles(gearcheck.load(train, args.speed), args.speed_profile, args.torque_profile,
+                         args.load_profile, args.start)
+
+
 def cmd_run(args) -> int:
-    spec = gearcheck.load(args.train, args.speed)
+    spec = _profiled(args, args.train)
     with OutputDirectory(args.out) as place:
         bar = ProgressBar(f"{args.solver} {spec.name}")
         result = gearcheck.simulate(spec, args.solver, args.duration, dt=args.dt, output_dt=args.output_dt,
@@ -737,6 +746,11 @@ def cmd_crosscheck(args) -> int:
         raise GearcheckError("--model FILE and --results check one train, not several")
     if fleet and args.speed is not None:
         raise GearcheckError("--speed applies to one train; several run each at its own speed")
+    profiled = any((args.speed_profile, args.torque_profile, args.load_profile))
+    if fleet and profiled:
+        raise GearcheckError("--speed-profile, --torque-profile and --load-profile apply to one train")
+    if profiled:
+        names = [_profiled(args, names[0])]
     specs = [gearcheck.load(name) for name in names]  # every train checked before anything runs or is written
     named = Counter(spec.name for spec in specs)
     for spec, name in zip(specs, names):
@@ -753,9 +767,10 @@ def cmd_crosscheck(args) -> int:
         commit = history.checked_commit(args.history, args.commit or os.environ.get("GITHUB_SHA") or head_commit())
     with OutputDirectory(args.out) as place:
         for name, folder in zip(names, folders):
-            bar = ProgressBar(f"crosscheck {name}")
+            bar = ProgressBar(f"crosscheck {getattr(name, 'name', name)}")
             result = gearcheck.crosscheck(
-                name, speed=args.speed, duration=args.duration, model=args.model, against=args.against,
+                name, speed=None if profiled else args.speed, duration=args.duration, model=args.model,
+                against=args.against,
                 results=args.results, columns=args.columns, modes=args.modes, dt_lumped=args.dt_lumped,
                 dt_mujoco=args.dt_mujoco, tolerances=args.tolerances, measurements=args.measurements,
                 sensor_band=args.sensor_band, baseline=args.baseline, update_baseline=args.update_baseline,
@@ -795,6 +810,19 @@ def _verdict_line(result, out: Path) -> str:
     if result.verdict == "INCONCLUSIVE":
         detail += f"; cannot decide: {', '.join(result.unresolved)}"
     return f"{result.spec.name}: {result.verdict}{detail} (report: {out / 'report.md'})"
+
+
+PROFILES = (  # an operating history from the command line (gearcheck.train.history)
+    arg("--speed-profile", metavar="FILE|T:RPM,...",
+        help="input speed over time: a CSV/Parquet table (time_s, speed_rpm) or points T:RPM,T:RPM,... joined by "
+             "straight lines (the train is driven through its input shaft)"),
+    arg("--torque-profile", metavar="FILE|T:NM,...",
+        help="input torque over time instead (N·m; the speed follows from the rigid train, the input shaft unused)"),
+    arg("--load-profile", metavar="FILE|T:NM,...", help="output load torque over time (N·m, opposing rotation)"),
+    arg("--start", choices=("steady", "rest"),
+        help="start of a profile run: steady state at its initial speed, or at rest (default: rest from 0 rpm or a "
+             "torque, else steady)"),
+)
 
 
 COMMANDS = {  # name: the function that runs it, its help line, its arguments (argparse's, by flags)
@@ -856,6 +884,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--format", choices=("parquet", "csv"), default="parquet",
             help="time series file format: parquet (default: full precision, compressed, units in its metadata) or "
                  "csv"),
+        *PROFILES,
         arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "crosscheck": Command(
@@ -897,6 +926,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
                  "commit and train (a rerun replaces it); draw it with `gearcheck dashboard`"),
         arg("--commit", metavar="SHA",
             help="the commit --history records (default: $GITHUB_SHA, else `git rev-parse HEAD` here)"),
+        *PROFILES,
         arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "calibrate": Command(

@@ -91,6 +91,9 @@ class Side(ABC):
         raise UnsupportedError(f"{self.solver} cannot start on its periodic steady state (run_periodic)")
 
     def operating(self) -> dict:
-        """The operating point a report of its runs states.  Default: the train's input speed and output torque."""
+        """The operating point a report of its runs states.  Default: the train's input speed and output torque (the
+        reference of an operating history, and the history in words)."""
+        history = self.spec.operating.history
         return {"input_speed_rpm": rad_s_to_rpm(self.spec.operating.input_speed),
-                "output_torque_nm": self.spec.operating.output_torque}
+                "output_torque_nm": self.spec.operating.output_torque} | \
+            ({} if history is None else {"operating_history": history.words()})

@@ -15,6 +15,7 @@ import numpy as np
 from gearcheck.shared.errors import GearcheckError, one_line, shown
 from gearcheck.shared.trust import named_code
 from gearcheck.train.expression import Expression
+from gearcheck.train.history import Clock, speed_clock, torque_clock
 from gearcheck.train.kinematics import Kinematics
 from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.mesh_stiffness import ConstantStiffness, stiffness_model
@@ -52,10 +53,46 @@ class Excitation:
         op = spec.operating
         # torque ripple harmonics: (member "input" | "output", amplitude, angular frequency rad/s, phase rad)
         self.ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
+        self._of_order = [r.frequency is None for r in op.ripple]  # turning with a member: on the nominal clock
         self._function = None  # the torque function, imported on first use (:meth:`torque_function`)
         self._profile = None if op.torque_profile is None else tuple(np.asarray(x) for x in op.torque_profile)
         self._expression = None if op.torque_expression is None else \
             Expression(op.torque_expression, f"{spec.path}: operating.torque_expression")
+        self.history = op.history
+        self.clock = None if op.history is None else self._clock()
+
+    # ------------------------------------------------------------------ the nominal clock
+    def nominal_time(self, t) -> np.ndarray:
+        """Lambda(t): every nominal angle is its member's reference speed times it (t at constant speed)."""
+        return np.asarray(t, dtype=float) if self.clock is None else self.clock.time(t)
+
+    def speed_scale(self, t) -> np.ndarray:
+        """lambda(t): the nominal speeds over their reference values (1 at constant speed)."""
+        return np.ones(np.shape(t)) if self.clock is None else self.clock.scale(t)
+
+    def _clock(self) -> Clock:
+        """The nominal clock of the history (:mod:`gearcheck.train.history`): a prescribed speed's, or the rigid
+        train's motion under the prescribed torques (the order ripple, whose phase needs the clock, left out: it
+        has no mean)."""
+        history, kin, spec = self.history, self.kin, self.spec
+        if history.driven_by == "speed":
+            return speed_clock(history, spec.operating.input_speed)
+        inertia = drag = 0.0
+        for mid, member in spec.members.items():
+            w = kin.speeds[mid]
+            inertia += member.inertia * w**2
+            if member.orbits:
+                inertia += member.mass * (member.radius * kin.speeds[f"{member.stage}.carrier"]) ** 2
+            elif member.support:
+                drag -= member.support.torsional_damping * w**2
+        w_in, w_out = kin.speeds[spec.input], kin.speeds[spec.output]
+
+        def power(t):
+            t_in, t_out = self._torques(t, None)
+            return w_in * t_in + w_out * t_out
+
+        return torque_clock(power, history.corners, inertia, drag, 0.0 if history.start == "rest" else 1.0,
+                            history.end)
 
     # ------------------------------------------------------------------ meshes
     def mesh_position(self, t, mesh: int | None = None) -> np.ndarray:
@@ -63,8 +100,8 @@ class Excitation:
         mesh of index ``mesh``."""
         t = np.asarray(t, dtype=float)
         if mesh is not None:
-            return self.frequency[mesh] * t - self.phase[mesh]
-        return np.multiply.outer(t, self.frequency) - self.phase
+            return self.frequency[mesh] * self.nominal_time(t) - self.phase[mesh]
+        return np.multiply.outer(self.nominal_time(t), self.frequency) - self.phase
 
     def stiffness(self, t) -> np.ndarray:
         """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...)."""
@@ -90,13 +127,19 @@ class Excitation:
         return k, e
 
     def switch_times(self, t0: float, t1: float) -> np.ndarray:
-        """Sorted times in (t0, t1) at which some mesh's stiffness jumps (its model's ``breaks``)."""
+        """Sorted times in (t0, t1) at which some mesh's stiffness jumps (its model's ``breaks``) or, under a
+        history, the speed's or a torque's slope does (their points)."""
         times = []
+        a0, a1 = (float(x) for x in self.nominal_time(np.array([t0, t1])))
         for f, phase, model in zip(self.frequency, self.phase, self.models):
             for b in model.breaks:
-                if f > 0:  # xi = f t - phase = n + b
-                    n = np.arange(math.floor(f * t0 - phase - b), math.ceil(f * t1 - phase - b) + 1)
-                    times.append((n + b + phase) / f)
+                if f > 0:  # xi = f Lambda(t) - phase = n + b
+                    n = np.arange(math.floor(f * a0 - phase - b), math.ceil(f * a1 - phase - b) + 1)
+                    at = (n + b + phase) / f
+                    at = at[(at > a0) & (at < a1)]
+                    times.append(at if self.clock is None else self.clock.times_at(at, t0, t1))
+        if self.clock is not None:
+            times += [self.clock.corners, self.history.corners]
         t = np.concatenate(times) if times else np.empty(0)
         return np.unique(t[(t > t0) & (t < t1)])
 
@@ -115,6 +158,8 @@ class Excitation:
             freqs.append(np.array([1.0 / (times[-1] - times[0])]))
         op = self.spec.operating
         aperiodic = [op.aperiodic_torque] if op.aperiodic_torque else []
+        if op.history is not None:
+            aperiodic.append(f"the operating history ({op.history.words()})")
         if op.ramp > 0:
             aperiodic.append(f"the load ramp over the first {op.ramp:g} s")
         return np.concatenate(freqs), meshes, aperiodic
@@ -150,14 +195,15 @@ class Excitation:
         t = np.asarray(t, dtype=float)
         e = np.zeros(t.shape + (len(self.mesh_ids),))
         de = np.zeros_like(e)
+        angle, scale = self.nominal_time(t), self.speed_scale(t)  # the angles turn at lambda times their speeds
         for i, h, amp, phi in self._ste:
-            arg = 2 * np.pi * h * (self.frequency[i] * t - self.phase[i]) + phi
+            arg = 2 * np.pi * h * (self.frequency[i] * angle - self.phase[i]) + phi
             e[..., i] += amp * np.cos(arg)
-            de[..., i] -= amp * 2 * np.pi * h * self.frequency[i] * np.sin(arg)
+            de[..., i] -= amp * 2 * np.pi * h * self.frequency[i] * scale * np.sin(arg)
         for i, amp, omega, beta0, dx, dy in self._eccentric:
-            beta = omega * t + beta0
+            beta = omega * angle + beta0
             e[..., i] += amp * (np.cos(beta) * dx + np.sin(beta) * dy)
-            de[..., i] += amp * omega * (-np.sin(beta) * dx + np.cos(beta) * dy)
+            de[..., i] += amp * omega * scale * (-np.sin(beta) * dx + np.cos(beta) * dy)
         return e, de
 
     @staticmethod
@@ -191,8 +237,13 @@ class Excitation:
         """(torque on the input member, torque on the output member) in N·m, signed; array-valued.
 
         A shaft-driven input gets its mean torque from the shaft spring; only ripple and
-        a user function act on it directly.  The load is ramped in over ``ramp_s``.
+        a user function act on it directly.  The load is ramped in over ``ramp_s``.  A history's input torque
+        replaces the mean input torque, its load the mean load (opposing the output's rotation).
         """
+        return self._torques(t, self.nominal_time(t))
+
+    def _torques(self, t, angle) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`torques`, the order ripple at the nominal time ``angle`` (None: left out)."""
         t = np.asarray(t, dtype=float)
         op = self.spec.operating
         ramp = smooth_ramp(t, op.ramp)
@@ -200,8 +251,16 @@ class Excitation:
         t_out_mean = self.kin.output_torque
         t_in = np.zeros_like(t) if op.input_shaft_stiffness is not None else t_in_mean * ramp
         t_out = t_out_mean * ramp
-        for member, amp, omega, phase in self.ripple:
-            wave = amp * np.cos(omega * t + phase) * ramp
+        history = self.history
+        if history is not None and history.torque is not None:
+            t_in = history.torque(t)
+        if history is not None and history.load is not None:
+            t_out = -math.copysign(1.0, self.kin.speeds[self.spec.output]) * history.load(t)
+        for (member, amp, omega, phase), order in zip(self.ripple, self._of_order):
+            if (order and angle is None) or (history is not None and
+                                             (history.torque if member == "input" else history.load) is not None):
+                continue  # a history's torques replace the mean torques and their ripple
+            wave = amp * np.cos(omega * (angle if order else t) + phase) * ramp
             if member == "input":
                 t_in = t_in + t_in_mean * wave
             else:

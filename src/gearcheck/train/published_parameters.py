@@ -66,6 +66,7 @@ class PaperParameters:
     ripple: tuple = field(default=())  # (member, amplitude, omega rad/s, phase) of the spec's ripple
     planet_sets: int = 1
     source: str = ""
+    history: object = None  # the spec's operating history (gearcheck.train.history.History): M_h(t), T_b(t)
 
     @classmethod
     def from_spec(cls, spec, planet_sets: int = 1) -> "PaperParameters":
@@ -108,7 +109,7 @@ class PaperParameters:
             k1=n * mesh_e.damping_coefficient, k2=n * mesh_b.damping_coefficient,
             input_torque=kin.input_torque, output_torque=kin.output_torque,
             input_speed=spec.operating.input_speed, ripple=tuple(Excitation(spec, kin).ripple), planet_sets=n,
-            source=spec.name,
+            source=spec.name, history=_torque_history(spec),
         )
 
     @property
@@ -122,13 +123,29 @@ class PaperParameters:
         t = np.asarray(t, dtype=float)
         m_h = np.full_like(t, self.input_torque)
         t_b = np.full_like(t, self.output_torque if load else 0.0)
+        h = self.history
         for member, amp, omega, phase in self.ripple:
+            if h is not None and (member == "input" or h.load is not None):
+                continue  # a history's torques replace the mean torques and their ripple
             wave = amp * np.cos(omega * t + phase)
             if member == "input":
                 m_h = m_h + self.input_torque * wave
             elif load:
                 t_b = t_b + self.output_torque * wave
+        if h is not None:
+            m_h = h.torque(t)
+            if h.load is not None:
+                t_b = np.copysign(1.0, self.output_torque) * h.load(t) * load
         return m_h, t_b
+
+
+def _torque_history(spec):
+    """The spec's operating history, which must prescribe the torque: the 4-DOF models are driven by M_h (Eq. 13)."""
+    history = spec.operating.history
+    if history is not None and history.driven_by != "torque":
+        raise GearcheckError(f"{spec.name}: the published 4-DOF models are driven by the carrier torque M_h "
+                             "(Matejic et al. 2021, Eq. 13): give a torque history, not a speed history")
+    return history
 
 
 DESCRIPTIONS = {"y1": "planet-set displacement y1 (Matejic et al. 2021)", "theta_h": "carrier h angle",

@@ -601,6 +601,36 @@ RIPPLE = Table(
     "harmonic torque ripple ([[operating.ripple]])",
 )
 
+def _points(what: str, unit: str, maximum: float) -> ListOf:
+    pair = ListOf(Number(f"time (s) or {what} ({unit})", "", REQUIRED, -maximum, False, maximum),
+                  f"(time s, {what} {unit})", REQUIRED, 2, max_length=2)
+    return ListOf(pair, f"{what} history as (time s, {unit}) points from 0 s on, joined by straight lines, the last "
+                        "held", None, 1, unit=f"s, {unit}", max_length=1_000_000)
+
+
+HISTORY = Table(
+    {
+        "speed_points": _points("input speed", "rpm", bound("speed", RAD_S_PER_RPM) / RAD_S_PER_RPM),
+        "speed_file": Text("CSV or Parquet file (relative to the train file) of time, input speed: the header's "
+                           "unit suffixes (time_s, speed_rpm, speed_rad_s) or s and rpm", None),
+        "speed_expression": Text("input speed in rpm as an expression of t in s (grammar of torque_expression); "
+                                 "needs until_s", None),
+        "torque_points": _points("input torque", "N·m", bound("torque")),
+        "torque_file": Text("CSV or Parquet file of time, input torque (time_s, torque_Nm or torque_kNm)", None),
+        "torque_expression": Text("input torque in N·m as an expression of t in s; needs until_s", None),
+        "load_points": _points("output load", "N·m", bound("torque")),
+        "load_file": Text("CSV or Parquet file of time, output load torque (opposing the output's rotation)", None),
+        "load_expression": Text("output load torque in N·m as an expression of t in s", None),
+        "start": Text("steady: from the steady state at the initial speed; rest: everything at rest, undeformed "
+                      "(default: rest when the history starts at 0 rpm or from a torque, else steady)", None,
+                      ("steady", "rest")),
+        "until_s": Positive("where a history given by expressions ends", "s", None, bound("time")),
+    },
+    "operating history: a prescribed input speed (through the input shaft) or input torque (the speed follows "
+    "from the rigid train), and the output load, as functions of time ([operating.history])",
+    default=None,
+)
+
 OPERATING = Table(
     {
         "input_speed_rpm": NonNegative("nominal input speed (positive = counter-clockwise seen from +z); 0 for "
@@ -625,6 +655,7 @@ OPERATING = Table(
                            "torque, repeated with the file's period", None),
         "ramp_s": NonNegative("duration of the smooth start-up ramp of the load torque (0 = start at the "
                               "static deflection)", "s", 0.0, bound("time")),
+        "history": HISTORY,
     },
     "operating point",
 )

@@ -21,6 +21,7 @@ import numpy as np
 from gearcheck.train.expression import Expression
 from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, min_curvature_radius, palmgren_stiffness
 from gearcheck.train.files import read_text, read_toml
+from gearcheck.train.history import History, parse_history
 from gearcheck.train.geometry import (Gear, MeshGeometry, gear_problem, helix_problem, idealised_mesh_geometry,
                                       mesh_geometry, mesh_problem)
 from gearcheck.train.mesh_stiffness import MODELS
@@ -214,11 +215,14 @@ class Operating:
     ramp: float
     input_torque: float | None = None  # N·m, as the train file gave it
     torque_expression: str | None = None  # of t in s, N·m (gearcheck.train.expression)
+    history: History | None = None  # speed or torque and load as functions of time (gearcheck.train.history)
 
     @property
     def torque_varies(self) -> bool:
-        """Whether a torque varies in time beyond the start-up ramp (ripple, a table, a function, an expression)."""
-        return bool(self.ripple or self.torque_function or self.torque_expression or self.torque_profile is not None)
+        """Whether a torque varies in time beyond the start-up ramp (ripple, a table, a function, an expression, a
+        history)."""
+        return bool(self.ripple or self.torque_function or self.torque_expression or self.torque_profile is not None
+                    or self.history is not None)
 
     @property
     def aperiodic_torque(self) -> str | None:
@@ -440,6 +444,9 @@ def build_spec(data: dict, source: str, text_hash: str = "") -> TrainSpec:
     operating = Operating(op["input_speed"], op["output_torque"] or 0.0, op["input_shaft_stiffness"],
                           op["input_shaft_damping"], tuple(ripples), op["torque_function"], profile, op["ramp_s"],
                           op["input_torque"], op["torque_expression"])
+    if op["history"] is not None:
+        operating = with_history(operating, parse_history(op["history"], source, lambda name: beside(source, name),
+                                                          fail), fail)
 
     _note_idealised(stages)
     _note_undamped(members)
@@ -505,6 +512,63 @@ def flat_tolerances(table: dict, fail) -> dict[str, float]:
 
     walk(table, "", 1)
     return flat
+
+
+def with_history(operating: Operating, history: History, fail) -> Operating:
+    """The operating point a history runs from.  Its reference speed (lambda = 1): the speed history's initial
+    speed for a steady start, else the train file's input speed.  A prescribed speed drives the input through the
+    input shaft; a prescribed torque drives the input member itself, so the input shaft is not used (said in
+    :meth:`History.words`).  With a load history the mean load is its initial value for a steady start, else its
+    largest magnitude (what the dynamic factors are taken against)."""
+    speed = operating.input_speed
+    if history.driven_by == "speed" and history.start == "steady":
+        speed = float(history.speed(0.0)) * 2.0 * math.pi / 60.0
+    elif not speed:
+        raise fail("operating.input_speed_rpm", "0, but a history from rest scales the train's kinematics from a "
+                                                "reference speed: give the speed it is to be compared at")
+    if history.driven_by == "speed" and operating.input_shaft_stiffness is None:
+        raise fail("operating.history", "a prescribed speed drives the input through its shaft: give "
+                                        "operating.input_shaft_stiffness (or prescribe the input torque instead)")
+    changes = {"input_speed": speed, "history": history, "input_torque": None}
+    if history.driven_by == "torque":
+        changes.update(input_shaft_stiffness=None, input_shaft_damping=0.0)
+    if history.load is not None:
+        values = history.load(np.union1d(history.load.corners, [0.0]))
+        changes["output_torque"] = abs(float(values[0])) if history.start == "steady" \
+            else float(np.max(np.abs(values)))
+    return replace(operating, **changes)
+
+
+def with_profiles(spec: TrainSpec, speed: str | None = None, torque: str | None = None, load: str | None = None,
+                  start: str | None = None) -> TrainSpec:
+    """``spec`` under the operating history of command-line profiles (``--speed-profile`` and the others): each a
+    table file (CSV or Parquet, :mod:`gearcheck.train.history_file`) or inline points ``T:V,T:V,...`` (s and rpm
+    or N·m); the train's own ``[operating.history]`` is replaced.  Unchanged without any."""
+    given = {"speed": speed, "torque": torque, "load": load}
+    if not any(given.values()):
+        if start is not None:
+            raise GearcheckError("--start applies to an operating history: give --speed-profile or --torque-profile")
+        return spec
+    raw = {f"{name}_{kind}": None for name in given for kind in ("points", "file", "expression")}
+    raw.update(start=start, until_s=None)
+    for name, value in given.items():
+        if value is None:
+            continue
+        if Path(value).suffix.lower() in (".csv", ".parquet"):
+            raw[f"{name}_file"] = value
+        else:
+            try:
+                raw[f"{name}_points"] = [[float(x) for x in pair.split(":")] for pair in value.split(",")]
+            except ValueError:
+                raise GearcheckError(f"--{name}-profile {value!r}: a .csv or .parquet file, or points "
+                                     "T:V,T:V,... (s and rpm or N·m)") from None
+
+    def fail(field, message):
+        option = field.removeprefix("operating.history.").split("_")[0]
+        return GearcheckError(f"--{option}-profile: {message}" if option in given else f"{field}: {message}")
+
+    history = parse_history(raw, "command line", Path, fail)
+    return replace(spec, operating=with_history(spec.operating, history, fail))
 
 
 def beside(source: str, name: str) -> Path:

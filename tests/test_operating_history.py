@@ -190,6 +190,7 @@ def test_euler_terms_bring_the_models_together():
     model = build_model(spec)
     twin = simulate_mujoco(compile_train(spec), settings)
     runs = [simulate(replace(model, K_euler=sign * model.K_euler), settings) for sign in (1.0, 0.0, -1.0)]
-    for name, ratio in (("stage1.planet1.bearing_tangential.force", 0.75), ("stage1.planet1.bearing_radial.force", 0.9)):
+    for name, ratio in (("stage1.planet1.bearing_tangential.force", 0.75),
+                        ("stage1.planet1.bearing_radial.force", 0.9)):
         error = [np.max(np.abs(run[name] - twin[name])) for run in runs]
         assert error[0] < ratio * error[1] < ratio * error[2], (name, error)

@@ -30,7 +30,8 @@ def order_figure(tracks: dict, steady: dict | None = None, unit: str = "", title
     orders = list(dict.fromkeys(k for track in tracks.values() for k in track.orders))
     for i, (label, track) in enumerate(tracks.items()):
         for k in track.orders:
-            style = {"color": COLOURS[i % len(COLOURS)], "ls": LINESTYLES[orders.index(k) % len(LINESTYLES)]}
+            colour, line = (i, orders.index(k)) if len(orders) == 1 else (orders.index(k), i)  # colour per order
+            style = {"color": COLOURS[colour % len(COLOURS)], "ls": LINESTYLES[line % len(LINESTYLES)]}
             j = track.column(k)
             top.plot(track.speed_rpm, track.amplitude[:, j], lw=1.2, label=f"order {k:g}, {label}", **style)
             bottom.plot(track.speed_rpm, np.degrees(np.unwrap(track.phase[:, j])), lw=0.9, **style)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import io
 import json
 import logging
 import math
@@ -436,6 +437,46 @@ def cmd_run(args) -> int:
         written = [path.name for path in result.write_files(place.path, args.format)]
     print(f"{spec.name} ({args.solver}): {result.t.size} samples over {result.t[-1]:.6g} s, "
           f"dt = {result.info['dt_s']:.4g} s, wall {result.info.wall_s:.3g} s")
+    for name in written:
+        print(f"  wrote {args.out / name}")
+    return 0
+
+
+def cmd_runup(args) -> int:
+    from gearcheck.compare.presentation.runup_report import write_runup
+    from gearcheck.compare.studies.runup import run_up
+
+    spec = gearcheck.load(args.train)
+    sweep = None
+    if args.against is not None:
+        import pandas as pd
+
+        from gearcheck.train.files import read_bytes
+
+        try:
+            sweep = pd.read_parquet(io.BytesIO(read_bytes(args.against, "sweep table", 1 << 30)))
+        except GearcheckError:
+            raise
+        except Exception as exc:  # pyarrow raises many kinds on a damaged file
+            raise GearcheckError(f"--against {args.against}: not a sweep table ({one_line(exc)})") from None
+        if not {"metric", "solver", "quantity", "mesh", "order", "speed_rpm", "amplitude"} <= set(sweep.columns):
+            raise GearcheckError(f"--against {args.against}: not a sweep table (gearcheck sweep's sweep.parquet)")
+    solvers = tuple(gearcheck.SOLVERS) if args.solver == "both" else (args.solver,)
+    natural = gearcheck.modes(spec).frequencies
+    with OutputDirectory(args.out) as place:
+        bar = ProgressBar(f"run-up {spec.name}")
+        run = run_up(spec, args.start, args.stop, args.duration, solvers, args.quantity or None, args.harmonics,
+                     progress=bar)
+        bar.close()
+        written = write_runup(run, place.path, natural, sweep)
+    costs = ", ".join(f"{s} {run.cpu_s[s]:.3g} s CPU" for s in solvers)
+    print(f"{spec.name}: run-up {args.start:g} -> {args.stop:g} rpm in {args.duration:g} s "
+          f"({run.rate_rpm_s:.4g} rpm/s), {len(run.orders)} orders of {len({q for _, q in run.tracks})} quantities; "
+          f"{costs}")
+    agreement = run.agreement()
+    if agreement:
+        print(f"  lumped and MuJoCo order curves differ by at most {max(agreement.values()):.2g} of each quantity's "
+              "largest order amplitude")
     for name in written:
         print(f"  wrote {args.out / name}")
     return 0
@@ -983,6 +1024,20 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
                  "mesh forces of each stage)"),
         arg("--out", type=PATH, default=Path("out/sweep"), metavar="DIR",
             help="writes sweep.parquet, sweep.json and the figures (default out/sweep)"),
+    ),
+    "runup": Command(
+        cmd_runup, "run the train up through a speed range in both solvers and track the mesh orders (order curves, "
+                   "waterfall; against a stepped sweep's table with --against)",
+        TRAIN,
+        arg("--from", dest="start", type=RPM, required=True, metavar="RPM", help="start speed (steady state there)"),
+        arg("--to", dest="stop", type=RPM, required=True, metavar="RPM", help="end speed"),
+        arg("--duration", type=SECONDS, required=True, metavar="S", help="time of the linear ramp"),
+        arg("--solver", choices=("lumped", "mujoco", "both"), default="both"),
+        arg("--quantity", action="append", metavar="NAME", help="a gated quantity to track (repeatable; default all)"),
+        arg("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics tracked per mesh frequency"),
+        arg("--against", type=PATH, metavar="SWEEP.parquet",
+            help="a stepped sweep's table (gearcheck sweep) to compare the lumped order curves with"),
+        arg("--out", type=PATH, default=Path("out/runup"), metavar="DIR", help="output directory (default out/runup)"),
     ),
     "sensitivity": Command(
         cmd_sensitivity, "derivatives of the steady harmonic response to train-file numbers (closed form, checked by "

@@ -1,0 +1,144 @@
+"""A run-up: the train driven through a linear speed ramp in both solvers, each run turned into order curves.
+
+The input speed rises linearly from ``start_rpm`` to ``stop_rpm`` over ``duration`` (an operating history,
+:mod:`gearcheck.train.history`; the run starts in the steady state at ``start_rpm``), each solver samples its run
+finely enough for the highest mesh harmonic at the top speed, and every gated quantity is order-tracked
+(:func:`~gearcheck.compare.studies.order_tracking.order_track`) against the input shaft's nominal angle at the
+mesh orders: harmonic k of a mesh frequency f_mesh is order k f_mesh / f_in of the input, whatever the speed.  The
+same amplitudes a stepped sweep reads at its speeds (:mod:`gearcheck.compare.studies.sweep`), from one run: the
+order curves of the two solvers are compared with each other, and (:func:`against_sweep_table`) with a sweep.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from gearcheck.compare.studies.order_curves import against_sweep, resonance_speeds
+from gearcheck.compare.studies.order_tracking import (MIN_SAMPLES_PER_CYCLE, OrderTrack, Waterfall, order_track,
+                                                      waterfall)
+from gearcheck.compare.studies.sweep import mesh_groups
+from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.settings import RunSettings
+from gearcheck.train.excitation import Excitation
+from gearcheck.train.history import History, Series
+from gearcheck.train.kinematics import kinematics
+from gearcheck.train.spec import with_history
+
+OVERSAMPLING = 2  # samples a cycle of the highest harmonic at the top speed, over what order tracking needs
+REVS_PER_BLOCK = 1.0  # one input revolution a block: mesh orders lie tens apart, so no leakage between them
+OVERLAP = 0.75
+WATERFALL_BLOCKS = 60  # time blocks of the waterfall over the run
+
+
+@dataclass
+class RunUp:
+    """Order curves of a run-up: ``tracks[(solver, quantity)]`` over ``orders`` ((mesh label, harmonic, order))."""
+
+    train: str
+    start_rpm: float
+    stop_rpm: float
+    duration: float
+    orders: list[tuple[str, int, float]]
+    tracks: dict[tuple[str, str], OrderTrack]
+    units: dict[str, str]
+    waterfalls: dict[str, Waterfall] = field(default_factory=dict)  # solver -> the first quantity's map
+    wall_s: dict[str, float] = field(default_factory=dict)
+    cpu_s: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def rate_rpm_s(self) -> float:
+        return (self.stop_rpm - self.start_rpm) / self.duration
+
+    def table(self) -> pd.DataFrame:
+        """One row per solver, quantity, order and block: speed, amplitude, phase."""
+        rows = []
+        for (solver, quantity), track in self.tracks.items():
+            for label, k, order in self.orders:
+                j = track.column(order)
+                rows.append(pd.DataFrame({
+                    "solver": solver, "quantity": quantity, "mesh": label, "harmonic": k, "order": order,
+                    "speed_rpm": track.speed_rpm, "time_s": track.time_s,
+                    "amplitude": track.amplitude[:, j], "phase_rad": track.phase[:, j], "unit": self.units[quantity]}))
+        return pd.concat(rows, ignore_index=True)
+
+    def agreement(self) -> dict[str, float]:
+        """Per quantity, the largest difference of the two solvers' order curves (complex, block by block) over the
+        largest amplitude of that quantity's orders in the reference's run."""
+        solvers = sorted({s for s, _ in self.tracks})
+        if len(solvers) < 2:
+            return {}
+        out = {}
+        for quantity in sorted({q for _, q in self.tracks}):
+            a, b = (self.tracks[(s, quantity)].complex_amplitude for s in ("lumped", "mujoco"))
+            scale = float(np.max(np.abs(a)))
+            out[quantity] = float(np.max(np.abs(a - b)) / scale) if scale > 0 else 0.0
+        return out
+
+
+def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("lumped", "mujoco"),
+           quantities=None, harmonics: int = 3, progress=None) -> RunUp:
+    """Run ``train`` (a TrainSpec) up from ``start_rpm`` to ``stop_rpm`` over ``duration`` s in each of ``solvers``
+    and order-track ``quantities`` (default: every gated quantity) at the first ``harmonics`` mesh harmonics."""
+    from gearcheck.session import Train
+
+    if not 0 < start_rpm < stop_rpm:
+        raise GearcheckError(f"--from/--to: a run-up needs 0 < from < to, got {start_rpm:g} and {stop_rpm:g} rpm")
+    speed = Series.of_points([[0.0, start_rpm], [duration, stop_rpm]], f"run-up {start_rpm:g}-{stop_rpm:g} rpm")
+    spec = replace(train, operating=with_history(train.operating, History(speed), _fail))
+    kin = kinematics(spec)
+    nominal = Excitation(spec, kin).clock
+    f_in = abs(kin.speeds[spec.input]) / (2 * np.pi)
+    orders = [(label, k, k * f / f_in) for label, f in mesh_groups(spec, kin) for k in range(1, harmonics + 1)]
+    top_hz = max(order for *_, order in orders) * stop_rpm / 60.0
+    output_dt = 1.0 / (OVERSAMPLING * MIN_SAMPLES_PER_CYCLE * top_hz)
+    session = Train(spec)
+    tracks, units, wall, cpu, maps = {}, {}, {}, {}, {}
+    for solver in solvers:
+        started, cpu_started = time.perf_counter(), time.process_time()
+        result = session.side(solver).run(RunSettings(duration=duration, output_dt=output_dt), progress)
+        wall[solver], cpu[solver] = time.perf_counter() - started, time.process_time() - cpu_started
+        angle = f_in * nominal.time(result.t)  # revolutions of the input shaft on the nominal clock
+        names = result.names(compared=True) if quantities is None else list(quantities)
+        maps[solver] = waterfall(result.t, result[names[0]], angle, duration / WATERFALL_BLOCKS, overlap=0.5,
+                                 max_hz=1.1 * top_hz)
+        for name in names:
+            units[name] = result.signal(name).unit
+            tracks[(solver, name)] = order_track(result.t, result[name], angle, [o for *_, o in orders],
+                                                 revs_per_block=REVS_PER_BLOCK, overlap=OVERLAP)
+    return RunUp(spec.name, start_rpm, stop_rpm, duration, orders, tracks, units, maps, wall, cpu)
+
+
+def against_sweep_table(run: RunUp, table: pd.DataFrame, natural_hz, band_rpm: float,
+                        solver: str = "lumped") -> pd.DataFrame:
+    """The run-up's order curves against a stepped sweep's harmonic amplitudes (a sweep table,
+    :mod:`gearcheck.compare.studies.sweep`: rows with metric "harmonic"): per quantity and order, the largest
+    difference over the sweep's largest amplitude of that order, farther than ``band_rpm`` from the speeds at which
+    the order's frequency meets a natural frequency (``natural_hz``; there the run-up's rate shifts and lowers the
+    peak: :mod:`gearcheck.compare.studies.resonance_passage`)."""
+    rows = []
+    harmonic = table[(table["metric"] == "harmonic") & (table["solver"] == solver)]
+    for (s, quantity), track in run.tracks.items():
+        if s != solver:
+            continue
+        for label, k, order in run.orders:
+            lines = harmonic[(harmonic["quantity"] == quantity) & (harmonic["mesh"] == label)
+                             & (harmonic["order"] == k)].sort_values("speed_rpm")
+            if lines.empty:
+                continue
+            resonances = resonance_speeds(order, natural_hz)
+            comparison = against_sweep(track, order, lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy(),
+                                       resonances, band_rpm)
+            scale = float(lines["amplitude"].max())
+            difference = np.abs(comparison.tracked - comparison.steady)
+            rows.append({"quantity": quantity, "mesh": label, "harmonic": k, "order": order,
+                         "speeds_compared": int(comparison.speed_rpm.size), "largest_amplitude": scale,
+                         "worst": float(difference.max() / scale) if difference.size and scale > 0 else float("nan")})
+    return pd.DataFrame(rows)
+
+
+def _fail(field: str, message: str) -> GearcheckError:
+    return GearcheckError(f"{field}: {message}")

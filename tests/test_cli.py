@@ -145,3 +145,41 @@ def test_sensitivity_against_a_parameters_values(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "eccentricity_mm = 2.8 is no valid train" in err and "undercut" in err and err.count("\n") == 1
     assert not (tmp_path / "undercut").exists()
+
+
+def test_sensitivity_family_over_values_and_speeds(tmp_path):
+    """Yang, Chen & Wang's (2018) Figs. 5, 7, 9 as a command: --values over a --speeds range, a family of curves over
+    the mesh frequency, one per value.  At every speed the family's curve at the file's value is the speed map's to
+    round-off, and its derivative is the slope of its own amplitudes across two values 1 % apart (the difference
+    quotient equals the mean of the two derivatives to O(dp^2))."""
+    from gearcheck.compare.studies.sensitivity import sensitivity_map
+    from gearcheck.train.loader import read_train_text
+
+    text, source = read_train_text("demo-3p")
+    path = "stages[0].sun.support.radial_stiffness"
+    k = 1.0e8  # the file's value
+    speeds = [800.0, 1700.0, 2600.0]
+    family = sensitivity_map(text, source, [path], speeds, "stage1.carrier.theta", values=[0.5 * k, 0.505 * k, k])
+    over_speed = sensitivity_map(text, source, [path], speeds, "stage1.carrier.theta")
+    assert len(family) == 3 * len(over_speed)
+    for (rpm, h), rows in family.groupby(["speed_rpm", "harmonic"]):
+        a, b, own = (rows[rows["value"] == v].iloc[0] for v in (0.5 * k, 0.505 * k, k))
+        speed_row = over_speed[(over_speed["speed_rpm"] == rpm) & (over_speed["harmonic"] == h)].iloc[0]
+        for column in ("mesh_frequency_hz", "amplitude", "d_amplitude_d_p"):
+            assert own[column] == pytest.approx(speed_row[column], rel=1e-9, abs=1e-30), (rpm, h, column)
+        slope = (b["amplitude"] - a["amplitude"]) / (b["value"] - a["value"])
+        mean = 0.5 * (a["d_amplitude_d_p"] + b["d_amplitude_d_p"])
+        quotient_round_off = 1e-10 * a["amplitude"] / (b["value"] - a["value"])  # the solves' relative precision
+        assert slope == pytest.approx(mean, rel=1e-3, abs=quotient_round_off), (rpm, h)
+    # the command: over 4 speeds the family alone (a line style per speed would not be read), up to 4 the
+    # against-the-value figure, from 3 both
+    command = ["sensitivity", "demo-3p", "--parameter", path, "--values", "5e7", "1e8"]
+    assert main(command + ["--speeds", "1000:3000:5", "--out", str(tmp_path / "five")]) == 0
+    assert sorted(p.name for p in (tmp_path / "five").glob("*.png")) == ["sensitivity_family.png"]
+    assert (tmp_path / "five" / "sensitivity_family.png").stat().st_size > 10_000
+    assert len(pd.read_csv(tmp_path / "five" / "sensitivity_values.csv")) == 5 * 2 * 3
+    assert main(command + ["--speeds", "1000:3000:3", "--out", str(tmp_path / "three")]) == 0
+    assert sorted(p.name for p in (tmp_path / "three").glob("*.png")) == ["sensitivity_family.png",
+                                                                          "sensitivity_values.png"]
+    assert main(command + ["--speeds", "1000:3000:2", "--out", str(tmp_path / "two")]) == 0
+    assert sorted(p.name for p in (tmp_path / "two").glob("*.png")) == ["sensitivity_values.png"]

@@ -615,6 +615,41 @@ def sensitivity_values(frame, coordinate: str, title: str) -> bytes:
     return _png(fig)
 
 
+def sensitivity_family(frame, coordinate: str, title: str) -> bytes:
+    """PNG of a :func:`~gearcheck.compare.studies.sensitivity.sensitivity_map` table over one parameter's values and
+    a range of speeds: per harmonic of the table (a row of panels each), its amplitude |Q_h| and its sensitivity
+    d|Q_h|/dp over the mesh frequency, a curve per value (Yang, Chen & Wang 2018, Figs. 5, 7, 9: the family of
+    resonant curves as the parameter moves); round-off drawn as zero."""
+    from matplotlib import colormaps
+
+    parameter = frame["parameter"].iloc[0]
+    harmonics = list(dict.fromkeys(frame["harmonic"]))
+    values = sorted(dict.fromkeys(frame["value"]))
+    colours = colormaps["viridis"](np.linspace(0.0, 0.85, len(values)))
+    fig, axes = _figure(len(harmonics), 2, figsize=(11, 0.6 + 2.5 * len(harmonics)), sharex=True, squeeze=False,
+                        layout="constrained")
+    unit = frame["amplitude_unit"].iloc[0]
+    for i, h in enumerate(harmonics):
+        for value, colour in zip(values, colours):
+            r = frame[(frame["harmonic"] == h) & (frame["value"] == value)].sort_values("mesh_frequency_hz")
+            axes[i, 0].semilogy(r["mesh_frequency_hz"], r["amplitude"], color=colour, lw=1.2,
+                                label=f"p = {value:.4g}")
+            slope = r["d_amplitude_d_p"].where(~r["negligible"].astype(bool), 0.0)  # round-off drawn as zero
+            axes[i, 1].plot(r["mesh_frequency_hz"], slope, color=colour, lw=1.2)
+        axes[i, 0].set_ylabel(f"|Q_h|, h = {h} ({unit})", fontsize=8)
+        axes[i, 1].set_ylabel(f"d|Q_h|/dp, h = {h}\n({unit} per unit of p)", fontsize=8)
+        axes[i, 1].axhline(0.0, color="0.5", lw=0.6)
+    axes[0, 0].legend(fontsize=7, ncol=2, title=f"p = {parameter}", title_fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("mesh frequency of the first stage (Hz)")
+    for ax in axes.flat:
+        ax.grid(alpha=0.3)
+    null = bool(frame["negligible"].astype(bool).all())
+    fig.suptitle(title + ("\nthe response does not depend on it: every derivative is round-off (negligible)" if null
+                          else ""), fontsize=9)
+    return _png(fig)
+
+
 def sensitivity_map(frame, coordinate: str, title: str) -> bytes:
     """PNG of a :func:`~gearcheck.compare.studies.sensitivity.sensitivity_map` table: the amplitude of each harmonic of
     ``coordinate`` over the mesh frequency, then per parameter its sensitivity d|Q|/d ln p (solid) and the paper's

@@ -502,9 +502,15 @@ def cmd_sensitivity(args) -> int:
                                                 progress=bar, values=args.values)
             bar.close()
             frame.to_csv(place.path / "sensitivity_values.csv", index=False, float_format="%.10g")
-            write_file(place.path / "sensitivity_values.png", plots.sensitivity_values(
-                frame, coordinate, f"{spec.name}: sensitivity of {coordinate} to {args.parameter[0]}"))
-            written = ["sensitivity_values.csv", "sensitivity_values.png"]
+            written = ["sensitivity_values.csv"]
+            title = f"{spec.name}: sensitivity of {coordinate} to {args.parameter[0]}"
+            if len(speeds) <= VALUES_PLOT_SPEEDS:  # a line style per speed, against the value
+                write_file(place.path / "sensitivity_values.png", plots.sensitivity_values(frame, coordinate, title))
+                written.append("sensitivity_values.png")
+            if len(speeds) >= FAMILY_PLOT_SPEEDS:  # over the mesh frequency, a curve per value
+                write_file(place.path / "sensitivity_family.png", plots.sensitivity_family(
+                    frame[frame["harmonic"].isin(_mesh_harmonics(frame, 3))], coordinate, f"{title}, mesh harmonics"))
+                written.append("sensitivity_family.png")
             if frame["negligible"].all():
                 print(f"{args.parameter[0]}: the response of {coordinate} does not depend on it at these values and "
                       "speeds (every derivative is round-off: negligible)")
@@ -514,10 +520,9 @@ def cmd_sensitivity(args) -> int:
                                                 args.orders, method, progress=bar)
             bar.close()
             frame.to_csv(place.path / "sensitivity_map.csv", index=False, float_format="%.10g")
-            mesh = [h for h in dict.fromkeys(frame["harmonic"]) if h.endswith(", 0)") or "," not in h.strip("(,)")]
             write_file(place.path / "sensitivity_map.png", plots.sensitivity_map(
-                frame[frame["harmonic"].isin(mesh[:3])], coordinate, f"{spec.name}: sensitivity of {coordinate}, "
-                                                                     "mesh harmonics"))
+                frame[frame["harmonic"].isin(_mesh_harmonics(frame, 3))], coordinate,
+                f"{spec.name}: sensitivity of {coordinate}, mesh harmonics"))
             written = ["sensitivity_map.csv", "sensitivity_map.png"]
         else:
             rows = []
@@ -554,6 +559,15 @@ def cmd_sensitivity(args) -> int:
     for name in written:
         print(f"  wrote {args.out / name}")
     return 0
+
+
+VALUES_PLOT_SPEEDS = 4  # sensitivity --values: against the value with a line style per speed up to this many speeds
+FAMILY_PLOT_SPEEDS = 3  # ... and over the mesh frequency with a curve per value from this many
+
+
+def _mesh_harmonics(frame, count: int) -> list[str]:
+    """The first ``count`` pure mesh harmonics of a sensitivity table: (k,) or (k, 0)."""
+    return [h for h in dict.fromkeys(frame["harmonic"]) if h.endswith(", 0)") or "," not in h.strip("(,)")][:count]
 
 
 def _coordinate(spec, name: str) -> int:
@@ -1056,7 +1070,9 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="a map over input speeds (rpm) instead of the train's speed"),
         arg("--values", type=float, nargs="+", metavar="V",
             help="the sensitivity against the one --parameter set to each value (the file's unit), at the train's "
-                 "speed or each of --speeds (Yang, Chen & Wang 2018, Figs. 6, 8, 10)"),
+                 "speed or each of --speeds (Yang, Chen & Wang 2018, Figs. 6, 8, 10: sensitivity_values.png up to "
+                 "4 speeds); over 3 or more --speeds also the family of curves over the mesh frequency, one per value "
+                 "(Figs. 5, 7, 9: sensitivity_family.png)"),
         arg("--out", type=PATH, default=Path("out"), metavar="DIR", help="output directory (default out/)"),
     ),
     "pins": Command(

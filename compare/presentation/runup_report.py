@@ -28,7 +28,8 @@ def write_runup(run: RunUp, out: Path, natural_hz, sweep=None) -> list[str]:
     summary = {"train": run.train, "start_rpm": run.start_rpm, "stop_rpm": run.stop_rpm, "duration_s": run.duration,
                "rate_rpm_per_s": run.rate_rpm_s, "orders": [{"mesh": m, "harmonic": k, "order": o}
                                                            for m, k, o in run.orders],
-               "wall_s": run.wall_s, "cpu_s": run.cpu_s, "solvers_agree": run.agreement()}
+               "wall_s": run.wall_s, "cpu_s": run.cpu_s, "solvers_agree": run.agreement(),
+               "solvers_part_rpm": run.parting()}
     steady: dict[str, dict] = {}
     if sweep is not None:
         band = RESONANCE_BAND * run.stop_rpm

@@ -31,6 +31,7 @@ from gearcheck.train.spec import with_history
 OVERSAMPLING = 2  # samples a cycle of the highest harmonic at the top speed, over what order tracking needs
 REVS_PER_BLOCK = 1.0  # one input revolution a block: mesh orders lie tens apart, so no leakage between them
 OVERLAP = 0.75
+PARTING = 1e-3  # the two solvers' order curves "part" where they differ by more than this of the largest
 WATERFALL_BLOCKS = 60  # time blocks of the waterfall over the run
 
 
@@ -68,14 +69,28 @@ class RunUp:
     def agreement(self) -> dict[str, float]:
         """Per quantity, the largest difference of the two solvers' order curves (complex, block by block) over the
         largest amplitude of that quantity's orders in the reference's run."""
-        solvers = sorted({s for s, _ in self.tracks})
-        if len(solvers) < 2:
+        return {q: float(np.max(d)) if d.size else 0.0 for q, d in self._differences().items()}
+
+    def parting(self, threshold: float = PARTING) -> dict[str, float | None]:
+        """Per quantity, the speed (rpm) of the first block where the two solvers' order curves differ by more than
+        ``threshold`` of the largest amplitude (None: nowhere); where a train's teeth bounce, two runs that agree to
+        round-off before part after an impact (a sensitive dependence that both solvers share)."""
+        out = {}
+        for q, d in self._differences().items():
+            over = np.flatnonzero(d > threshold)
+            out[q] = float(self.tracks[("lumped", q)].speed_rpm[over[0]]) if over.size else None
+        return out
+
+    def _differences(self) -> dict[str, np.ndarray]:
+        """Per quantity, block by block, the largest difference of the two solvers' orders over the largest order
+        amplitude of the reference's run (empty without both solvers)."""
+        if {s for s, _ in self.tracks} != {"lumped", "mujoco"}:
             return {}
         out = {}
         for quantity in sorted({q for _, q in self.tracks}):
             a, b = (self.tracks[(s, quantity)].complex_amplitude for s in ("lumped", "mujoco"))
             scale = float(np.max(np.abs(a)))
-            out[quantity] = float(np.max(np.abs(a - b)) / scale) if scale > 0 else 0.0
+            out[quantity] = np.max(np.abs(a - b), axis=1) / scale if scale > 0 else np.zeros(a.shape[0])
         return out
 
 

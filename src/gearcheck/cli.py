@@ -444,7 +444,7 @@ def cmd_run(args) -> int:
 
 def cmd_runup(args) -> int:
     from gearcheck.compare.presentation.runup_report import write_runup
-    from gearcheck.compare.studies.runup import run_up
+    from gearcheck.compare.studies.runup import PARTING, run_up
 
     spec = gearcheck.load(args.train)
     sweep = None
@@ -477,6 +477,9 @@ def cmd_runup(args) -> int:
     if agreement:
         print(f"  lumped and MuJoCo order curves differ by at most {max(agreement.values()):.2g} of each quantity's "
               "largest order amplitude")
+        for quantity, speed in run.parting().items():
+            if speed is not None:
+                print(f"  {quantity}: the two solvers part (by over {PARTING:g} of its largest) from {speed:.5g} rpm on")
     for name in written:
         print(f"  wrote {args.out / name}")
     return 0

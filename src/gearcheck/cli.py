@@ -479,7 +479,8 @@ def cmd_runup(args) -> int:
               "largest order amplitude")
         for quantity, speed in run.parting().items():
             if speed is not None:
-                print(f"  {quantity}: the two solvers part (by over {PARTING:g} of its largest) from {speed:.5g} rpm on")
+                print(f"  {quantity}: the two solvers part (by over {PARTING:g} of its largest) from {speed:.5g} "
+                      "rpm on")
     for name in written:
         print(f"  wrote {args.out / name}")
     return 0

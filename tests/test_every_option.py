@@ -21,6 +21,8 @@ BASE = {  # each command's arguments that make a quick valid run; OUT stands for
     "calibrate": ["demo-3p", "--fit", "operating.output_torque=100:2000", "--out", "OUT"],
     "sweep": ["demo-3p", "--speeds", "1000,1100", "--solver", "lumped", "--duration", "0.01", "--out", "OUT"],
     "sensitivity": ["demo-3p", "--parameter", "stages[0].sun.mass", "--out", "OUT"],
+    "runup": ["demo-3p", "--from", "1500", "--to", "2000", "--duration", "0.05", "--solver", "lumped", "--quantity",
+              "stage1.planet1.sun.force", "--out", "OUT"],
     "pins": ["rv-reducer", "-o", "OUT/p.png"], "stiffness": ["demo-3p", "-o", "OUT/s.png"],
     "animate": ["demo-3p", "-o", "OUT/a.gif", "--duration", "0.2"], "view": ["demo-3p"],
     "dashboard": ["STORE", "-o", "OUT"], "export": ["demo-3p", "-o", "OUT/m.npz"], "mjcf": ["demo-3p"],

@@ -21,7 +21,8 @@ from gearcheck.compare.studies.order_curves import against_sweep, resonance_spee
 from gearcheck.compare.studies.order_tracking import (MIN_SAMPLES_PER_CYCLE, OrderTrack, Waterfall, order_track,
                                                       waterfall)
 from gearcheck.compare.studies.sweep import mesh_groups
-from gearcheck.shared.errors import GearcheckError
+from gearcheck.shared.errors import GearcheckError, did_you_mean
+from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.history import History, Series
@@ -31,6 +32,7 @@ from gearcheck.train.spec import with_history
 OVERSAMPLING = 2  # samples a cycle of the highest harmonic at the top speed, over what order tracking needs
 REVS_PER_BLOCK = 1.0  # one input revolution a block: mesh orders lie tens apart, so no leakage between them
 OVERLAP = 0.75
+MAX_HARMONICS = 20
 PARTING = 1e-3  # the two solvers' order curves "part" where they differ by more than this of the largest
 WATERFALL_BLOCKS = 60  # time blocks of the waterfall over the run
 
@@ -102,6 +104,12 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
 
     if not 0 < start_rpm < stop_rpm:
         raise GearcheckError(f"--from/--to: a run-up needs 0 < from < to, got {start_rpm:g} and {stop_rpm:g} rpm")
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= MAX_HARMONICS:
+        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to {MAX_HARMONICS}")
+    known = [signal.name for signal in train_signals(train)]
+    for name in quantities or ():
+        if name not in known:
+            raise GearcheckError(f"--quantity {name!r}: not a signal of {train.name}" + did_you_mean(str(name), known))
     speed = Series.of_points([[0.0, start_rpm], [duration, stop_rpm]], f"run-up {start_rpm:g}-{stop_rpm:g} rpm")
     spec = replace(train, operating=with_history(train.operating, History(speed), _fail))
     kin = kinematics(spec)

@@ -70,35 +70,34 @@ def member_motion(mb, sensors: np.ndarray, t: np.ndarray):
     nominal = nominal_places(mb)
     members = list(spec.members.values())
 
-    def read(name: str) -> np.ndarray:
+    def read(name: str) -> np.ndarray:  # a sensor's components as contiguous rows (dim, n_t)
         adr, dim = mb.sensor[name]
-        return sensors[:, adr:adr + dim]
+        return np.ascontiguousarray(sensors[:, adr:adr + dim].T)
 
     def motion(j: int) -> MemberMotion:
         member = members[j]
         label, carrier = member.label, spec.members[spec.stage_of(member.id).carrier].label
-        angle = read(f"{carrier}_angle")[:, 0] + member.angle
-        rate = read(f"{carrier}_angle_rate")[:, 0]
+        angle = read(f"{carrier}_angle")[0] + member.angle
+        rate = read(f"{carrier}_angle_rate")[0]
         c, s = np.cos(angle), np.sin(angle)
 
-        def along(x):  # world (x, y) -> the carrier's axes
-            return np.stack([c * x[:, 0] + s * x[:, 1], -s * x[:, 0] + c * x[:, 1]], axis=-1)
+        def along(x, y):  # world (x, y) -> the carrier's axes, time x 2
+            return np.stack([c * x + s * y, -s * x + c * y], axis=-1)
 
         orbit, orbit_rate = nominal_angle(nominal.orbit[j], t)
         x0, y0, z0 = nominal.place[j]
-        place = np.stack([np.cos(orbit) * x0 - np.sin(orbit) * y0, np.sin(orbit) * x0 + np.cos(orbit) * y0], axis=-1)
-        place_rate = orbit_rate[:, None] * place[:, ::-1] * [-1.0, 1.0]  # w k x p
-        position, velocity = read(f"{label}_pos"), read(f"{label}_linvel")
-        displacement = along(position[:, :2] - place)
-        relative = along(velocity[:, :2] - place_rate) - rate[:, None] * displacement[:, ::-1] * [-1.0, 1.0]
+        place = np.cos(orbit) * x0 - np.sin(orbit) * y0, np.sin(orbit) * x0 + np.cos(orbit) * y0
+        position, velocity, linacc = read(f"{label}_pos"), read(f"{label}_linvel"), read(f"{label}_linacc")
+        displacement = along(position[0] - place[0], position[1] - place[1])
+        relative = (along(velocity[0] + orbit_rate * place[1], velocity[1] - orbit_rate * place[0])  # less w k x p
+                    - rate[:, None] * displacement[:, ::-1] * [-1.0, 1.0])  # less phi' k x d
         xaxis = read(f"{label}_xaxis")
         turned, speed = nominal_angle(nominal.speed[j], t)
-        theta = np.unwrap(np.arctan2(xaxis[:, 1], xaxis[:, 0]) - turned)
+        theta = np.unwrap(np.arctan2(xaxis[1], xaxis[0]) - turned)
         theta -= 2 * np.pi * np.round(theta[0] / (2 * np.pi))
-        omega = read(f"{label}_angvel")[:, 2]
-        linacc = read(f"{label}_linacc")
-        axial = np.stack([linacc[:, 2], position[:, 2] - z0, velocity[:, 2]], axis=-1) if member.axial else None
-        return MemberMotion(angle, along(linacc), read(f"{label}_angacc")[:, 2], displacement, along(velocity),
-                            relative, theta, omega, omega - speed, axial)
+        omega = read(f"{label}_angvel")[2]
+        axial = np.stack([linacc[2], position[2] - z0, velocity[2]], axis=-1) if member.axial else None
+        return MemberMotion(angle, along(linacc[0], linacc[1]), read(f"{label}_angacc")[2], displacement,
+                            along(velocity[0], velocity[1]), relative, theta, omega, omega - speed, axial)
 
     return motion

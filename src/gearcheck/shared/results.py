@@ -325,7 +325,7 @@ def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh
     :func:`bearing_names` order; the static forces of the meshes and bearings are the run's ``static`` values;
     pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in :func:`disc_names` order (an RV reducer's)."""
     signals = train_signals(spec)
-    values = np.empty((len(t), len(signals)))
+    values = np.empty((len(t), len(signals)), order="F")  # written and read a signal at a time
     at = {s.name: j for j, s in enumerate(signals)}
     for j, mid in enumerate(spec.members):  # member by member: small temporaries
         for group in member_columns(mid, motion(j)).values():

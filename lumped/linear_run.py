@@ -7,10 +7,11 @@
 * :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest, or any state), the
   stiffness, meshes and forcing evaluated at each stage's time; :func:`periodic_start`, the state its RK4 map
   returns to after the drive's period, solved exactly (the map is affine);
-* :func:`linear_result` -- what the run reports: every coordinate and its acceleration, and, through
-  the model's map to the train's coordinates, the train's signals the model has (member accelerations
-  in carrier and world axes from :func:`~gearcheck.lumped.member_motion.member_motion`, its meshes'
-  force, transmission error, load factor and stiffness).
+* :func:`linear_result` -- what the run reports: every coordinate, its velocity and its acceleration, and,
+  through the model's map to the train's coordinates, the train's signals the model has (member accelerations,
+  displacements and velocities in carrier and world axes, rotations and angular velocities, from
+  :func:`~gearcheck.lumped.member_motion.member_motion`, its meshes' force, transmission error, load factor and
+  stiffness).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from gearcheck.lumped.time_solver import rk4_step
 from gearcheck.shared import stepping
 from gearcheck.shared.errors import DivergenceError, UnsupportedError
 from gearcheck.shared.modal import ModalResult, modal_result, multiplicities, speed_modal_result
-from gearcheck.shared.results import TimeResult, coordinate_signals, train_signals
+from gearcheck.shared.results import TimeResult, coordinate_signals, member_columns, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
@@ -230,38 +231,37 @@ def linear_result(model, train, t, q, v, qdd, q0, info) -> TimeResult:
     signals, columns = coordinate_signals(model.coordinates, model.descriptions, model.name,
                                           compared=not mapped), []
     for j in range(model.n):
-        columns += [qdd[:, j], q[:, j]]
+        columns += [qdd[:, j], q[:, j], v[:, j]]
     static = {}
     if mapped:
-        named, values, static = _train_signals(model, train, t, q, v, qdd, q0)
+        named, values, static = _train_signals(model, train, t, q, v, qdd, q0, {s.name for s in signals})
         signals, columns = signals + named, columns + values
     return TimeResult(model.name, model.name, np.asarray(t), signals, np.column_stack(columns), 0.0, info,
                       static=static)
 
 
-def _train_signals(model, train, t, q, v, qdd, q0):
-    """The train's signals the model has: a member's angular acceleration when its rotation is one of the
-    model's coordinates, its translational accelerations when both its translations are, and its meshes'."""
+def _train_signals(model, train, t, q, v, qdd, q0, taken=frozenset()):
+    """The train's signals the model has (but those named in ``taken``, its coordinates' own): a member's rotation
+    signals (:func:`~gearcheck.shared.results.member_columns`) when its rotation is one of the model's coordinates,
+    its translation signals when both its translations are, its axial ones when its axial coordinate is, and its
+    meshes'."""
     labels = train.physical_dofs.labels()
     T, mapped = model.to_physical(labels)
     has = dict(zip(labels, mapped))
-    acc, angle = member_motion(train.spec, train.kin, train.physical_dofs, t, q @ T.T, v @ T.T, qdd @ T.T)
+    motion = member_motion(train.spec, train.kin, train.physical_dofs, t, q @ T.T, v @ T.T, qdd @ T.T)
     by_name = {s.name: s for s in train_signals(train.spec)}
     signals, columns = [], []
     for j, (mid, member) in enumerate(train.spec.members.items()):
         u, w, th = (f"{mid}.{d}" for d in member.dofs[:3])
-        if has.get(u) and has.get(w):
-            c, s = np.cos(angle[:, j]), np.sin(angle[:, j])
-            world = (c * acc[:, j, 0] - s * acc[:, j, 1], s * acc[:, j, 0] + c * acc[:, j, 1])
-            for axis, x_world, x_carrier in zip("xy", world, acc[:, j, :2].T):
-                signals += [by_name[f"{mid}.a{axis}.world"], by_name[f"{mid}.a{axis}.carrier"]]
-                columns += [x_world, x_carrier]
-        if has.get(th):
-            signals.append(by_name[f"{mid}.alpha"])
-            columns.append(acc[:, j, 2])
-        if member.axial and has.get(f"{mid}.{AXIAL}"):
-            signals.append(by_name[f"{mid}.az"])
-            columns.append(acc[:, j, 3])
+        wanted = {"translation": has.get(u) and has.get(w), "rotation": has.get(th),
+                  "axial": member.axial and has.get(f"{mid}.{AXIAL}")}
+        if not any(wanted.values()):
+            continue
+        for group, named in member_columns(mid, motion(j)).items():
+            for name, x in named.items() if wanted[group] else ():
+                if name not in taken:
+                    signals.append(by_name[name])
+                    columns.append(x)
     static = {}
     for m in model.meshes:
         row = np.asarray(m.row, dtype=float)

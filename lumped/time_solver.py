@@ -38,7 +38,7 @@ from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
-from gearcheck.shared.results import TimeResult, bearing_names, train_result
+from gearcheck.shared.results import TimeResult, bearing_names, train_result, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS
@@ -202,8 +202,7 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     frequency = top * model.excitation.frequency
     dt = stepping.default_step(limits, frequency) if settings.dt is None else settings.dt
     stepping.check_step(dt, limits, frequency, what)
-    n_steps, every = settings.check_work(dt, len(model.spec.members) * 5 + len(model.spec.meshes) * 4 + 4 * model.n,
-                                         what)
+    n_steps, every = settings.check_work(dt, len(train_signals(model.spec)) + 4 * model.n, what)
     q0, v0 = initial_state(model) if y0 is None else y0
     sys = _System(model)
     static = static_solution(model)
@@ -407,8 +406,8 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     k = sys.contact_stiffness(q, k, e, pairs)
     spec, dofs = model.spec, model.dofs
     q_t, v_t, qdd_t = (q, v, qdd) if model.expansion is None else (x @ model.expansion.T for x in (q, v, qdd))
-    acc, angle = member_motion(spec, model.kin, model.physical_dofs, t, q_t, v_t, qdd_t, model.rotating_frame_terms,
-                               model.excitation.clock)
+    motion = member_motion(spec, model.kin, model.physical_dofs, t, q_t, v_t, qdd_t, model.rotating_frame_terms,
+                           model.excitation.clock)
     rows = {r.name: r for r in model.rows if r.kind == "bearing"}
     bearings = [rows[name] for name in bearing_names(spec)]
     a = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)
@@ -418,5 +417,5 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     static_bearing = [static.row_forces[static.row_names.index(r.name)] for r in bearings]
     contacts = [e for e in model.turning if e.has_contacts]
     pins = np.concatenate([e.pin_forces(t, q, v) for e in contacts], axis=1) if contacts else None
-    return train_result(spec, "lumped", t, acc, angle, delta, force, k, static.mesh_force, static_bearing,
+    return train_result(spec, "lumped", t, motion, delta, force, k, static.mesh_force, static_bearing,
                         bearing_force, settle, info, raw, pins)

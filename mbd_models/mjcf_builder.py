@@ -155,12 +155,14 @@ def _worldbody(spec: TrainSpec, visuals: bool) -> list[str]:
 
 
 def _sensors(spec: TrainSpec) -> list[str]:
-    """Every body's linear and angular acceleration, each carrier's angle and rate, the slides of the members on
-    the stage axes and of those on pins; then what each part reads of itself."""
+    """Every body's linear and angular acceleration, position, x axis (its angle), linear and angular velocity (all
+    in the world's frame), each carrier's angle and rate, the slides of the members on the stage axes and of those
+    on pins; then what each part reads of itself."""
     lines = ["  <sensor>"]
     for member in spec.members.values():
-        lines.append(f'    <framelinacc name="{member.label}_linacc" objtype="body" objname="{member.label}"/>')
-        lines.append(f'    <frameangacc name="{member.label}_angacc" objtype="body" objname="{member.label}"/>')
+        for kind, suffix in (("framelinacc", "linacc"), ("frameangacc", "angacc"), ("framepos", "pos"),
+                             ("framexaxis", "xaxis"), ("framelinvel", "linvel"), ("frameangvel", "angvel")):
+            lines.append(f'    <{kind} name="{member.label}_{suffix}" objtype="body" objname="{member.label}"/>')
     for stage in spec.stages:
         label = spec.members[stage.carrier].label
         lines.append(f'    <jointpos name="{label}_angle" joint="{label}_rz"/>')

@@ -173,7 +173,7 @@ def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: 
     """From rest, MuJoCo's RK4 at the step ``settings.dt`` (default: the twin's own
     :func:`~gearcheck.shared.stepping.transient_step`); the paper's torques (M_h, T_b)
     (:meth:`~gearcheck.train.published_parameters.PaperParameters.torques`) applied as qfrc_applied on
-    theta_h and theta_b, held over each step.  Records qacc of every state (after mj_forward);
+    theta_h and theta_b, held over each step.  Records qpos, qvel and qacc of every state (after mj_forward);
     ``model`` names the 4-DOF model whose kinematics the twin has (for the signals' descriptions)."""
     m = twin.model
     dt = transient_step(twin_modes(twin).frequencies) if settings.dt is None else settings.dt
@@ -185,15 +185,14 @@ def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: 
     ih, ib = twin.dof["theta_h"], twin.dof["theta_b"]
     t = np.arange(steps + 1) * dt
     m_h, t_b = twin.params.torques(t, load)
-    q = np.zeros((steps + 1, 4))
-    a = np.zeros((steps + 1, 4))
+    q, v, a = (np.zeros((steps + 1, 4)) for _ in range(3))
     started = time.perf_counter()
     for i in range(steps + 1):
         d.qfrc_applied[:] = 0.0
         d.qfrc_applied[ih] = m_h[i]
         d.qfrc_applied[ib] = t_b[i]
         mujoco.mj_forward(m, d)
-        q[i], a[i] = d.qpos[idx], d.qacc[idx]
+        q[i], v[i], a[i] = d.qpos[idx], d.qvel[idx], d.qacc[idx]
         if i < steps:
             mujoco.mj_step(m, d)
     if not np.all(np.isfinite(q)):
@@ -202,4 +201,4 @@ def simulate_twin(twin: PublishedTwin, settings: RunSettings, model: str, load: 
     info = RunInfo("mujoco-step", steps, 4, 5 * steps, wall,  # the sampling mj_forward, then mj_step's own and RK4's 3
                    {"method": "mujoco-rk4", "integrator": "RK4", "dt_s": dt, "steps": steps, "y1": twin.y1,
                     "carrier_mass": twin.carrier_mass, "mujoco_version": mujoco.__version__})
-    return four_dof_result(twin.params.source, "mujoco", model, t, q, a, info)
+    return four_dof_result(twin.params.source, "mujoco", model, t, q, v, a, info)

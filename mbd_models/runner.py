@@ -42,7 +42,9 @@ itself (:func:`~gearcheck.mbd_models.static_state.static_state`): a Newton solve
 forward dynamics for the deflections at which every body turns at its nominal speed with the
 deflection pattern turning with its carrier.
 
-Outputs: accelerations from MuJoCo's ``framelinacc``/``frameangacc`` sensors, mesh deflections from
+Outputs: accelerations from MuJoCo's ``framelinacc``/``frameangacc`` sensors, displacements, velocities and
+rotations from its ``framepos``/``framexaxis``/``framelinvel``/``frameangvel`` sensors less the twin's own
+nominal motion (:mod:`gearcheck.mbd_models.member_motion`), mesh deflections from
 its tendon lengths, mesh and bearing forces from its generalized forces
 (:class:`~gearcheck.mbd_models.forces.ForceReader`); an RV reducer's pin forces from its pin tendons and its
 needle bearings' forces from their actuators.
@@ -68,6 +70,7 @@ import numpy as np
 from gearcheck.mbd_models import compiled
 from gearcheck.mbd_models.elements import base as elements
 from gearcheck.mbd_models.forces import ForceReader
+from gearcheck.mbd_models.member_motion import member_motion
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
 from gearcheck.mbd_models.mjcf_text import ROTATION
 from gearcheck.mbd_models.twin import MbdModel
@@ -75,7 +78,7 @@ from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
-from gearcheck.shared.results import TimeResult, train_result
+from gearcheck.shared.results import TimeResult, train_result, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS
@@ -470,7 +473,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     frequency = mb.excitation.frequency * (1.0 if nominal is None else max(1.0, nominal.top(settings.duration)))
     dt = stepping.default_step(mb.limits, frequency) if settings.dt is None else settings.dt
     stepping.check_step(dt, mb.limits, frequency, what)
-    n_steps, every = settings.check_work(dt, m.nsensordata + 3 * 3 * len(spec.members) + 2 * len(spec.meshes), what)
+    n_steps, every = settings.check_work(dt, m.nsensordata + len(train_signals(spec)), what)
     static = static_state(mb)
     if initial_state is None and history is not None and history.start == "rest":
         qpos0, qvel0 = m.qpos0.copy(), np.zeros(m.nv)  # every body at rest at its nominal place, undeformed
@@ -593,14 +596,6 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     def columns(sensor, axis, labels):  # one axis of a sensor of each label, (n_t, labels)
         return S[:, [mb.sensor[f"{label}_{sensor}"][0] + axis for label in labels]]
 
-    members = spec.members.values()
-    carriers = [spec.members[spec.stage_of(mid).carrier].label for mid in spec.members]
-    labels = [member.label for member in members]
-    angle = columns("angle", 0, carriers) + [member.angle for member in members]
-    c, s = np.cos(angle), np.sin(angle)
-    lin_x, lin_y = columns("linacc", 0, labels), columns("linacc", 1, labels)
-    acc = np.stack([c * lin_x + s * lin_y, -s * lin_x + c * lin_y, columns("angacc", 2, labels),
-                    columns("linacc", 2, labels)], axis=-1)  # the world's z is the stages' axis
     delta = columns("deflection", 0, [m.label for m in spec.meshes])
     mesh_force, bearing_force = stepper.reader.forces(stepper.forces[:stepper.j])
     k = (mb.excitation.stiffness(t + STAGE_OFFSETS[0] * info["dt_s"]) if stepper.stiffness is None
@@ -617,7 +612,7 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
         raw["energy_kinetic"] = stepper.energy[:stepper.j, 1]
     pins = [stepper.pins[:stepper.j, at] for at in mb.moving_slices()]
     by_disc = np.concatenate([c.per_disc(f) for c, f in zip(mb.moving_contacts, pins)], axis=1) if pins else None
-    result = train_result(spec, "mujoco", t, acc, angle, delta, mesh_force, k, static.mesh_force,
+    result = train_result(spec, "mujoco", t, member_motion(mb, S, t), delta, mesh_force, k, static.mesh_force,
                           static.bearing_force, bearing_force, settle, info, raw, by_disc)
     for c, forces, at in zip(mb.moving_contacts, pins, mb.moving_slices()):
         result = c.with_signals(result, forces, series, static.pin_force[at])

@@ -10,13 +10,25 @@ A gear train's signals (:func:`train_result`, the same for the lumped solver and
   x, y axes, as a housing-mounted accelerometer sees it (m/s^2);
 * ``MEMBER.ax.carrier``, ``MEMBER.ay.carrier``: the same vector along the axes that turn with the
   member's stage carrier (for planets: radial, tangential);
-* ``MEMBER.alpha``: angular acceleration (rad/s^2, absolute: planar motion);
+* ``MEMBER.alpha``: angular acceleration (rad/s^2, absolute: planar motion); ``MEMBER.az`` along the
+  stage axis (a member that slides axially);
 * ``MESH.force`` (N), ``MESH.dte`` (m, the dynamic transmission error: the mesh deflection along the
   line of action, positive in compression), ``MESH.kv`` (F / F_static) and ``MESH.stiffness`` (N/m);
-* ``PLANET.bearing_radial.force``, ``PLANET.bearing_tangential.force`` (N).
+* ``PLANET.bearing_radial.force``, ``PLANET.bearing_tangential.force`` (N);
+* the members' motion, last (:func:`motion_signals`), every member's, none gated:
+  ``MEMBER.x.world``, ``.y.world``, ``.x.carrier``, ``.y.carrier`` the displacement of its centre from
+  its nominal place (the stage axis, a planet's pin, a disc's eccentric) (m); ``MEMBER.vx.world``,
+  ``.vy.world``, ``.vx.carrier``, ``.vy.carrier`` the inertial velocity of its centre (m/s, nominal
+  motion included, like the accelerations); ``MEMBER.vx.relative``, ``.vy.relative`` the vibration
+  velocity, the rate of the carrier-axes displacement (m/s); ``MEMBER.theta`` the rotation from its
+  nominal angle (rad), ``MEMBER.omega`` its absolute angular velocity and ``MEMBER.omega.relative``
+  the rate of ``theta`` (rad/s); ``MEMBER.z`` and ``MEMBER.vz`` along the stage axis (axial members).
 
 Planets' accelerations, Kv and the stiffness are recorded but not gated: the cross-check sees the
 planets through their meshes and bearings.
+
+A linear model's run (:func:`coordinate_signals`) has ``NAME.acceleration``, ``NAME.velocity`` and
+``NAME`` for each of its own coordinates.
 """
 
 from __future__ import annotations
@@ -25,6 +37,7 @@ import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -37,7 +50,7 @@ from gearcheck.shared.selection import chosen
 @dataclass(frozen=True)
 class Signal:
     name: str
-    kind: str  # acceleration | angular_acceleration | mesh_force | dte | bearing_force | dynamic_factor | ...
+    kind: str  # acceleration | angular_acceleration | velocity | displacement | angle | mesh_force | dte | ...
     unit: str
     description: str
     compared: bool = True  # gated by the cross-check
@@ -208,21 +221,41 @@ def bearing_names(spec) -> list[str]:
 
 
 def coordinate_signals(coordinates, descriptions: dict, model: str, compared: bool = True) -> list[Signal]:
-    """The signals of a model's own coordinates, two per coordinate: ``NAME.acceleration`` (gated when
-    ``compared``) and ``NAME`` itself.  A coordinate whose last part names an angle (theta...) is a
-    rotation (rad), any other a translation (m)."""
+    """The signals of a model's own coordinates, three per coordinate: ``NAME.acceleration`` (gated when
+    ``compared``), ``NAME`` itself and ``NAME.velocity``.  A coordinate whose last part names an angle (theta...)
+    is a rotation (rad), any other a translation (m)."""
     signals = []
     for name in coordinates:
         angular = name.rsplit(".", 1)[-1].startswith("theta")
-        kind, unit = ("angular_acceleration", "rad") if angular else ("acceleration", "m")
+        prefix, unit = ("angular_", "rad") if angular else ("", "m")
         what = descriptions.get(name, name)
-        signals += [Signal(f"{name}.acceleration", kind, f"{unit}/s^2", f"{what}: acceleration ({model})", compared),
-                    Signal(name, "coordinate", unit, what, compared=False)]
+        signals += [Signal(f"{name}.acceleration", f"{prefix}acceleration", f"{unit}/s^2",
+                           f"{what}: acceleration ({model})", compared),
+                    Signal(name, "coordinate", unit, what, compared=False),
+                    Signal(f"{name}.velocity", f"{prefix}velocity", f"{unit}/s", f"{what}: velocity ({model})",
+                           compared=False)]
     return signals
 
 
 def train_signals(spec) -> list[Signal]:
     """The signals of a gear train run, in the order :func:`train_result` holds them."""
+    signals = acceleration_signals(spec)
+    for mesh in spec.meshes:
+        signals += [Signal(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force"),
+                    Signal(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error"),
+                    Signal(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static", False),
+                    Signal(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", False)]
+    signals += [Signal(f"{name}.force", "bearing_force", "N", f"{name} force") for name in bearing_names(spec)]
+    for disc in disc_names(spec):
+        signals += [Signal(f"{disc}.pin_force_max", "pin_force", "N", f"{disc}: largest pin contact force"),
+                    Signal(f"{disc}.pins_loaded", "pin_count", "1", f"{disc}: pins in contact", False)]
+    for mid, member in spec.members.items():
+        signals += motion_signals(mid, member)
+    return signals
+
+
+def acceleration_signals(spec) -> list[Signal]:
+    """Every member's accelerations, the first signals of a train run: the central members' gated."""
     signals = []
     for mid, member in spec.members.items():
         gated = not member.orbits
@@ -235,15 +268,29 @@ def train_signals(spec) -> list[Signal]:
         if member.axial:
             signals.append(Signal(f"{mid}.az", "acceleration", "m/s^2", f"{mid} acceleration along the stage axis",
                                   gated and not member.torsional))
-    for mesh in spec.meshes:
-        signals += [Signal(f"{mesh.id}.force", "mesh_force", "N", f"{mesh.id} mesh force"),
-                    Signal(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error"),
-                    Signal(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static", False),
-                    Signal(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", False)]
-    signals += [Signal(f"{name}.force", "bearing_force", "N", f"{name} force") for name in bearing_names(spec)]
-    for disc in disc_names(spec):
-        signals += [Signal(f"{disc}.pin_force_max", "pin_force", "N", f"{disc}: largest pin contact force"),
-                    Signal(f"{disc}.pins_loaded", "pin_count", "1", f"{disc}: pins in contact", False)]
+    return signals
+
+
+def motion_signals(mid: str, member) -> list[Signal]:
+    """A member's displacements and velocities (module docstring), none gated."""
+    signals = []
+    for frame in ("world", "carrier"):
+        signals += [Signal(f"{mid}.{axis}.{frame}", "displacement", "m",
+                           f"{mid} centre's displacement from its nominal place along {axis} ({frame} frame)", False)
+                    for axis in "xy"]
+    for frame in ("world", "carrier"):
+        signals += [Signal(f"{mid}.v{axis}.{frame}", "velocity", "m/s", f"{mid} velocity along {axis} ({frame} frame)",
+                           False) for axis in "xy"]
+    signals += [Signal(f"{mid}.v{axis}.relative", "velocity", "m/s",
+                       f"{mid} vibration velocity along {axis}: rate of its carrier-frame displacement", False)
+                for axis in "xy"]
+    signals += [Signal(f"{mid}.theta", "angle", "rad", f"{mid} rotation from its nominal angle", False),
+                Signal(f"{mid}.omega", "angular_velocity", "rad/s", f"{mid} angular velocity", False),
+                Signal(f"{mid}.omega.relative", "angular_velocity", "rad/s",
+                       f"{mid} angular velocity less its nominal one: rate of theta", False)]
+    if member.axial:
+        signals += [Signal(f"{mid}.z", "displacement", "m", f"{mid} displacement along the stage axis", False),
+                    Signal(f"{mid}.vz", "velocity", "m/s", f"{mid} velocity along the stage axis", False)]
     return signals
 
 
@@ -252,30 +299,39 @@ def disc_names(spec) -> list[str]:
     return [mid for mid, member in spec.members.items() if member.frame == "eccentric"]
 
 
-def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflection, mesh_force, mesh_stiffness,
-                 static_mesh_force, static_bearing_force, bearing_force, settle_time, info, raw,
-                 pin_force=None) -> TimeResult:
+class MemberMotion(NamedTuple):
+    """One member's motion over a run as a solver reports it to :func:`train_result`: arrays over time, a vector
+    (time x 2) along the axes of the member's carrier, which make the angle ``angle`` with the world's
+    (world = R(angle) carrier); for planets its radial and tangential axes."""
+
+    angle: np.ndarray  # rad, of the carrier's axes
+    acceleration: np.ndarray  # inertial acceleration of the centre, m/s^2 (time x 2)
+    alpha: np.ndarray  # angular acceleration, rad/s^2
+    displacement: np.ndarray  # the centre from its nominal place, m (time x 2)
+    velocity: np.ndarray  # inertial velocity of the centre, m/s (time x 2)
+    relative_velocity: np.ndarray  # d/dt of ``displacement`` (time x 2)
+    theta: np.ndarray  # rotation from the nominal angle, rad
+    omega: np.ndarray  # absolute angular velocity, rad/s
+    omega_relative: np.ndarray  # d/dt of ``theta``
+    axial: np.ndarray | None = None  # along the stage axis: acceleration, displacement, velocity (time x 3)
+
+
+def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh_stiffness, static_mesh_force,
+                 static_bearing_force, bearing_force, settle_time, info, raw, pin_force=None) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
-    acc_carrier: (n_t, n_members, 4) inertial acceleration of each member's centre along its carrier's axes, its
-    angular acceleration and its acceleration along the stage axis (read for members that slide); carrier_angle:
-    (n_t, n_members) angle of those axes (world = R(angle) carrier); mesh arrays (n_t, n_mesh) in ``spec.meshes``
-    order; bearing_force (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and
-    bearings are the run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
-    :func:`disc_names` order (an RV reducer's)."""
+    motion: j -> :class:`MemberMotion` of the j-th member of ``spec.members`` (axial for members that slide),
+    asked once per member; mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force (n_t, n_bearing) in
+    :func:`bearing_names` order; the static forces of the meshes and bearings are the run's ``static`` values;
+    pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in :func:`disc_names` order (an RV reducer's)."""
     signals = train_signals(spec)
-    values = np.empty((len(t), len(signals)))
-    col = 0
-    for j, member in enumerate(spec.members.values()):  # member by member: small temporaries
-        a = acc_carrier[:, j, :]
-        c, s = np.cos(carrier_angle[:, j]), np.sin(carrier_angle[:, j])
-        values[:, col] = c * a[:, 0] - s * a[:, 1]
-        values[:, col + 1] = s * a[:, 0] + c * a[:, 1]
-        values[:, col + 2:col + 5] = a[:, :3]
-        col += 5
-        if member.axial:
-            values[:, col] = a[:, 3]
-            col += 1
+    values = np.empty((len(t), len(signals)), order="F")  # written and read a signal at a time
+    at = {s.name: j for j, s in enumerate(signals)}
+    for j, mid in enumerate(spec.members):  # member by member: small temporaries
+        for group in member_columns(mid, motion(j)).values():
+            for name, x in group.items():
+                values[:, at[name]] = x
+    col = len(acceleration_signals(spec))
     col = _fill(values, col, [mesh_force, mesh_deflection, mesh_force / np.asarray(static_mesh_force), mesh_stiffness])
     col = _fill(values, col, [bearing_force])
     if disc_names(spec):
@@ -283,6 +339,24 @@ def train_result(spec, solver: str, t, acc_carrier, carrier_angle, mesh_deflecti
     static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
     static.update({f"{name}.force": float(f) for name, f in zip(bearing_names(spec), static_bearing_force)})
     return TimeResult(spec.name, solver, np.asarray(t), signals, values, settle_time, info, raw, static)
+
+
+def member_columns(mid: str, m: MemberMotion) -> dict[str, dict[str, np.ndarray]]:
+    """The named signals of member ``mid`` from its motion ``m``, by what they need of it: ``"translation"`` (its
+    centre's accelerations, displacements and velocities along the world's and the carrier's axes),
+    ``"rotation"`` (alpha, theta, omega, omega.relative) and ``"axial"`` (az, z, vz, when ``m`` has them)."""
+    c, s = np.cos(m.angle), np.sin(m.angle)
+    translation = {}
+    for name, vector in (("a{}", m.acceleration), ("{}", m.displacement), ("v{}", m.velocity)):
+        x, y = (f"{mid}.{name.format(axis)}" for axis in "xy")
+        translation[f"{x}.world"] = c * vector[:, 0] - s * vector[:, 1]
+        translation[f"{y}.world"] = s * vector[:, 0] + c * vector[:, 1]
+        translation[f"{x}.carrier"], translation[f"{y}.carrier"] = vector[:, 0], vector[:, 1]
+    translation[f"{mid}.vx.relative"], translation[f"{mid}.vy.relative"] = m.relative_velocity.T
+    rotation = {f"{mid}.alpha": m.alpha, f"{mid}.theta": m.theta, f"{mid}.omega": m.omega,
+                f"{mid}.omega.relative": m.omega_relative}
+    axial = {} if m.axial is None else {f"{mid}.{name}": m.axial[:, k] for k, name in enumerate(("az", "z", "vz"))}
+    return {"translation": translation, "rotation": rotation, "axial": axial}
 
 
 def _fill(values: np.ndarray, start: int, arrays) -> int:

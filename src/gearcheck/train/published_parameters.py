@@ -152,10 +152,10 @@ DESCRIPTIONS = {"y1": "planet-set displacement y1 (Matejic et al. 2021)", "theta
                 "theta_f": "planet angle relative to the carrier", "theta_b": "ring b angle"}
 
 
-def four_dof_result(train: str, solver: str, model: str, t, q, a, info) -> TimeResult:
+def four_dof_result(train: str, solver: str, model: str, t, q, v, a, info) -> TimeResult:
     """The named signals of a 4-DOF run (:func:`gearcheck.shared.results.coordinate_signals`) for
-    q = (y1, theta_h, theta_f, theta_b) with time along axis 0.  The regime is a transient from rest: there
-    is no steady window (settle time 0)."""
-    columns = [x for j in range(len(LABELS)) for x in (a[:, j], q[:, j])]
+    q = (y1, theta_h, theta_f, theta_b), its velocity v and acceleration a, with time along axis 0.  The regime is
+    a transient from rest: there is no steady window (settle time 0)."""
+    columns = [x for j in range(len(LABELS)) for x in (a[:, j], q[:, j], v[:, j])]
     return TimeResult(train, solver, np.asarray(t), coordinate_signals(LABELS, DESCRIPTIONS, model),
                       np.column_stack(columns), 0.0, info)

@@ -68,7 +68,8 @@ def member_motion(spec, kin, dofs, t, q, v, qdd, rotating_frame_terms: bool = Tr
             phi = ecc.phase + nominal_angle(w_h - kin.speeds[carrier], t, clock)[0]
             unit = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
             acc -= ecc.eccentricity * w_h**2 * unit
-            place += ecc.eccentricity * nominal_angle(w_h, t, clock)[1][:, None] * unit[:, ::-1] * [-1.0, 1.0]  # w_H k x e
+            orbit = nominal_angle(w_h, t, clock)[1]
+            place += ecc.eccentricity * orbit[:, None] * unit[:, ::-1] * [-1.0, 1.0]  # w_H k x e
         frame_rate = frame_speed + rate_c
         c, s = np.cos(theta_c), np.sin(theta_c)
         velocity = np.stack([c * place[:, 0] + s * place[:, 1] + du - frame_rate * w,

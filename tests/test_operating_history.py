@@ -225,3 +225,14 @@ def test_the_papers_start_up_drives_its_unheld_mechanism():
     q = np.array([run[c][-1] for c in ("y1", "theta_h", "theta_f", "theta_b")])
     assert abs(rigid[0]) > 1e-3  # y1 moves millimetres in 50 ms: a mechanism, not a vibration
     assert np.max(np.abs(q - rigid) / np.abs(rigid)) < 1e-3  # measured 5.5e-5: the elastic part
+
+
+def test_a_speed_expression_is_its_points():
+    """A speed given as an expression of t (a Fourier series here) runs on straight lines through 8192 samples of it:
+    its nominal angle is the expression's integral to the trapezoids' error, (T/8192)^2/12 times the curvature."""
+    spec = demo('speed_expression = "1500 + 300 * sin(2 * pi * 10 * t)"\nuntil_s = 0.1')
+    clock = build_model(spec).excitation.clock
+    t = np.array([0.013, 0.05, 0.0977])
+    exact = t + 300 / 1500 * (1 - np.cos(2 * np.pi * 10 * t)) / (2 * np.pi * 10)
+    curvature = 300 / 1500 * (2 * np.pi * 10) ** 2
+    assert np.max(np.abs(clock.time(t) - exact)) < (0.1 / 8192) ** 2 / 12 * curvature * 0.1 * 2

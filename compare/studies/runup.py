@@ -20,6 +20,7 @@ import pandas as pd
 from gearcheck.compare.studies.order_curves import against_sweep, resonance_speeds
 from gearcheck.compare.studies.order_tracking import (MIN_SAMPLES_PER_CYCLE, OrderTrack, Waterfall, order_track,
                                                       waterfall)
+from gearcheck.compare.engine.model_pair import SOLVERS
 from gearcheck.compare.studies.sweep import mesh_groups
 from gearcheck.shared.errors import GearcheckError, did_you_mean
 from gearcheck.shared.results import train_signals
@@ -100,8 +101,6 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
            quantities=None, harmonics: int = 3, progress=None) -> RunUp:
     """Run ``train`` (a TrainSpec) up from ``start_rpm`` to ``stop_rpm`` over ``duration`` s in each of ``solvers``
     and order-track ``quantities`` (default: every gated quantity) at the first ``harmonics`` mesh harmonics."""
-    from gearcheck.session import Train
-
     if not 0 < start_rpm < stop_rpm:
         raise GearcheckError(f"--from/--to: a run-up needs 0 < from < to, got {start_rpm:g} and {stop_rpm:g} rpm")
     if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= MAX_HARMONICS:
@@ -118,11 +117,10 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
     orders = [(label, k, k * f / f_in) for label, f in mesh_groups(spec, kin) for k in range(1, harmonics + 1)]
     top_hz = max(order for *_, order in orders) * stop_rpm / 60.0
     output_dt = 1.0 / (OVERSAMPLING * MIN_SAMPLES_PER_CYCLE * top_hz)
-    session = Train(spec)
     tracks, units, wall, cpu, maps = {}, {}, {}, {}, {}
     for solver in solvers:
         started, cpu_started = time.perf_counter(), time.process_time()
-        result = session.side(solver).run(RunSettings(duration=duration, output_dt=output_dt), progress)
+        result = SOLVERS[solver](spec).run(RunSettings(duration=duration, output_dt=output_dt), progress)
         wall[solver], cpu[solver] = time.perf_counter() - started, time.process_time() - cpu_started
         angle = f_in * nominal.time(result.t)  # revolutions of the input shaft on the nominal clock
         names = result.names(compared=True) if quantities is None else list(quantities)

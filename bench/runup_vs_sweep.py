@@ -9,8 +9,8 @@ order, the run-up's order curve against the sweep's harmonic amplitudes where th
 
 * the order is significant (its sweep amplitude above 5 % of its largest) and the speed is farther than 5 % of the
   top speed from every resonance of that order (its frequency at a natural frequency at rest);
-* the teeth stay in contact at that speed in the sweep's steady state (every stage-I mesh force's mean above half
-  its peak-to-peak): where they separate (the backlash), the response depends on its history, and a run-up follows
+* the teeth stay in contact at that speed in the sweep's steady state (every mesh force's mean above half its
+  peak-to-peak): where they separate (the backlash), the response depends on its history, and a run-up follows
   its own branch where each stepped point lands on the one its cold start finds.
 
 It prints the median and 90th percentile of the relative differences there, the share of the range where the teeth
@@ -25,51 +25,21 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 import gearcheck
 from gearcheck.compare.presentation.runup_report import write_runup
-from gearcheck.compare.studies.order_curves import peak, resonance_speeds
-from gearcheck.compare.studies.runup import run_up
+from gearcheck.compare.studies.order_curves import peak
+from gearcheck.compare.studies.runup import contact_kept, run_up, sweep_differences
 
 TRAIN, START, STOP = "hub-drive", 200.0, 2000.0
 QUANTITIES = ("I.planet1.sun.force", "I.carrier.ay.world", "I.ring.ay.world")
-SIGNIFICANT = 0.05
 BAND = 0.05
-
-
-def contact_kept(table: pd.DataFrame) -> pd.Series:
-    """Per sweep speed: whether every stage-I mesh force stays compressive in steady state (mean > p-p / 2)."""
-    forces = table[table["quantity"].str.startswith("I.") & table["quantity"].str.endswith(".force")
-                   & (table["kind"] == "mesh_force") & (table["solver"] == "lumped")]
-    wide = forces.pivot_table(index=["speed_rpm", "quantity"], columns="metric", values="amplitude")
-    kept = (wide["mean"] > 0.5 * wide["peak_to_peak"]).groupby(level="speed_rpm").all()
-    steady = table[table["solver"] == "lumped"].groupby("speed_rpm")["steady"].first() != "none"
-    return kept & steady.reindex(kept.index, fill_value=False)
-
-
-def compare(run, table: pd.DataFrame, natural_hz, kept: pd.Series) -> list[float]:
-    """Relative differences |tracked - steady| / steady at the speeds where the comparison means something."""
-    harmonic = table[(table["metric"] == "harmonic") & (table["solver"] == "lumped")]
-    out = []
-    for (_, quantity), track in run.tracks.items():
-        for label, k, order in run.orders:
-            lines = harmonic[(harmonic["quantity"] == quantity) & (harmonic["mesh"] == label)
-                             & (harmonic["order"] == k)].sort_values("speed_rpm")
-            speed, steady = lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy()
-            resonances = resonance_speeds(order, natural_hz)
-            far = np.min(np.abs(speed[:, None] - resonances[None, :]), axis=1) > BAND * STOP
-            inside = (speed >= track.speed_rpm[0]) & (speed <= track.speed_rpm[-1])
-            use = far & inside & (steady > SIGNIFICANT * steady.max()) & kept.reindex(speed).to_numpy(bool)
-            tracked = np.interp(speed[use], *track.curve(order))
-            out += list(np.abs(tracked - steady[use]) / steady[use])
-    return out
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=181)
-    parser.add_argument("--durations", type=float, nargs="+", default=[1.0, 2.0, 4.0])
+    parser.add_argument("--durations", type=float, nargs="+", default=[1.0, 2.0, 4.0, 8.0])
     parser.add_argument("--out", type=Path, default=Path("out/runup-bench"))
     args = parser.parse_args()
     spec = gearcheck.load(TRAIN)
@@ -96,7 +66,7 @@ def main() -> None:
         started = time.perf_counter()
         run = run_up(spec, START, STOP, duration, ("lumped",), QUANTITIES)
         used = time.perf_counter() - started
-        diffs = compare(run, table, natural, kept)
+        diffs = np.concatenate([d for *_, d in sweep_differences(run, table, natural, BAND * STOP)])
         curve = run.tracks[("lumped", main_order)].curve(next(o for m, k, o in run.orders if m == "I" and k == 1))
         p = peak(*curve, (500.0, 1000.0))
         print(f"| {duration:g} s | {run.rate_rpm_s:.4g} | {used:.1f} | {sweep_wall / used:.1f} | {len(diffs)} | "

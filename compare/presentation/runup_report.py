@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 
 from gearcheck.compare.presentation.order_plots import order_plot, waterfall_plot
-from gearcheck.compare.studies.runup import RunUp, against_sweep_table
+from gearcheck.compare.studies.runup import RunUp, against_sweep_table, contact_kept
 
 RESONANCE_BAND = 0.05  # the sweep comparison leaves out this fraction of the top speed about each resonance speed
 
@@ -34,8 +34,10 @@ def write_runup(run: RunUp, out: Path, natural_hz, sweep=None) -> list[str]:
     if sweep is not None:
         band = RESONANCE_BAND * run.stop_rpm
         compared = against_sweep_table(run, sweep, natural_hz, band)
+        kept = contact_kept(sweep)
         summary["against_sweep"] = {"band_rpm": band, "natural_hz": [float(f) for f in natural_hz],
-                                    "worst": compared.to_dict(orient="records")}
+                                    "speeds_in_contact": int(kept.sum()), "speeds": int(kept.size),
+                                    "orders": compared.to_dict(orient="records")}
         harmonic = sweep[(sweep["metric"] == "harmonic") & (sweep["solver"] == "lumped")]
         for quantity in {q for _, q in run.tracks}:
             steady[quantity] = {}

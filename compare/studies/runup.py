@@ -34,6 +34,7 @@ OVERSAMPLING = 2  # samples a cycle of the highest harmonic at the top speed, ov
 REVS_PER_BLOCK = 1.0  # one input revolution a block: mesh orders lie tens apart, so no leakage between them
 OVERLAP = 0.75
 MAX_HARMONICS = 20
+SIGNIFICANT = 0.05  # a sweep comparison reads an order where it is above this fraction of its largest amplitude
 PARTING = 1e-3  # the two solvers' order curves "part" where they differ by more than this of the largest
 WATERFALL_BLOCKS = 60  # time blocks of the waterfall over the run
 
@@ -133,14 +134,27 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
     return RunUp(spec.name, start_rpm, stop_rpm, duration, orders, tracks, units, maps, wall, cpu)
 
 
-def against_sweep_table(run: RunUp, table: pd.DataFrame, natural_hz, band_rpm: float,
-                        solver: str = "lumped") -> pd.DataFrame:
+def contact_kept(table: pd.DataFrame, solver: str = "lumped") -> pd.Series:
+    """Per speed of a sweep table: whether its steady state was found and every mesh's teeth stay in contact there
+    (each mesh force's mean above half its peak-to-peak).  Where teeth separate (a backlash) the response depends on
+    its history: each stepped point lands on the branch its cold start finds, a run-up follows its own."""
+    rows = table[table["solver"] == solver]
+    forces = rows[(rows["kind"] == "mesh_force") & rows["metric"].isin(("mean", "peak_to_peak"))]
+    wide = forces.pivot_table(index=["speed_rpm", "quantity"], columns="metric", values="amplitude")
+    kept = (wide["mean"] > 0.5 * wide["peak_to_peak"]).groupby(level="speed_rpm").all()
+    steady = rows.groupby("speed_rpm")["steady"].first() != "none"
+    return kept & steady.reindex(kept.index, fill_value=False)
+
+
+def sweep_differences(run: RunUp, table: pd.DataFrame, natural_hz, band_rpm: float, solver: str = "lumped"):
     """The run-up's order curves against a stepped sweep's harmonic amplitudes (a sweep table,
-    :mod:`gearcheck.compare.studies.sweep`: rows with metric "harmonic"): per quantity and order, the largest
-    difference over the sweep's largest amplitude of that order, farther than ``band_rpm`` from the speeds at which
-    the order's frequency meets a natural frequency (``natural_hz``; there the run-up's rate shifts and lowers the
-    peak: :mod:`gearcheck.compare.studies.resonance_passage`)."""
-    rows = []
+    :mod:`gearcheck.compare.studies.sweep`: rows with metric "harmonic"): per quantity and order, (quantity, mesh
+    label, harmonic, order, relative differences |tracked - steady| / steady) at the sweep's speeds where the
+    comparison means something -- the order significant there (above :data:`SIGNIFICANT` of its largest), farther
+    than ``band_rpm`` from the speeds at which its frequency meets a natural frequency (``natural_hz``: there the
+    run-up's rate shifts and lowers the peak, :mod:`gearcheck.compare.studies.resonance_passage`), the teeth in
+    contact (:func:`contact_kept`)."""
+    kept = contact_kept(table, solver)
     harmonic = table[(table["metric"] == "harmonic") & (table["solver"] == solver)]
     for (s, quantity), track in run.tracks.items():
         if s != solver:
@@ -150,15 +164,20 @@ def against_sweep_table(run: RunUp, table: pd.DataFrame, natural_hz, band_rpm: f
                              & (harmonic["order"] == k)].sort_values("speed_rpm")
             if lines.empty:
                 continue
-            resonances = resonance_speeds(order, natural_hz)
-            comparison = against_sweep(track, order, lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy(),
-                                       resonances, band_rpm)
-            scale = float(lines["amplitude"].max())
-            difference = np.abs(comparison.tracked - comparison.steady)
-            rows.append({"quantity": quantity, "mesh": label, "harmonic": k, "order": order,
-                         "speeds_compared": int(comparison.speed_rpm.size), "largest_amplitude": scale,
-                         "worst": float(difference.max() / scale) if difference.size and scale > 0 else float("nan")})
-    return pd.DataFrame(rows)
+            speed, steady = lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy()
+            use = (steady > SIGNIFICANT * steady.max()) & kept.reindex(speed, fill_value=False).to_numpy(bool)
+            comparison = against_sweep(track, order, speed[use], steady[use], resonance_speeds(order, natural_hz),
+                                       band_rpm)
+            yield quantity, label, k, order, np.abs(comparison.relative)
+
+
+def against_sweep_table(run: RunUp, table: pd.DataFrame, natural_hz, band_rpm: float,
+                        solver: str = "lumped") -> pd.DataFrame:
+    """:func:`sweep_differences` per quantity and order: how many speeds compared, the median and the largest."""
+    return pd.DataFrame([{"quantity": q, "mesh": label, "harmonic": k, "order": order, "speeds_compared": int(d.size),
+                          "median": float(np.median(d)) if d.size else None,
+                          "largest": float(d.max()) if d.size else None}
+                         for q, label, k, order, d in sweep_differences(run, table, natural_hz, band_rpm, solver)])
 
 
 def _fail(field: str, message: str) -> GearcheckError:

@@ -25,8 +25,6 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import gearcheck
-from gearcheck.train.loader import PRESET_PACKAGE
-from gearcheck.train.spec import with_profiles
 
 TORQUE = "double-planet-initiation-torque.csv"
 DURATION = 0.3  # s
@@ -41,10 +39,7 @@ def nrmse(a, b) -> float:
 
 def main(out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
-    from importlib import resources
-
-    torque = str(resources.files(PRESET_PACKAGE).joinpath("data", TORQUE))
-    spec = with_profiles(gearcheck.load("double-planet"), torque=torque, load="0:0")
+    spec = gearcheck.load("double-planet", torque_profile=str(gearcheck.preset_data(TORQUE)), load_profile="0:0")
     runs = {}
     for model in ("as-published", "energy-derived"):
         result = gearcheck.crosscheck(spec, model=model, duration=DURATION)

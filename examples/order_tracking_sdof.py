@@ -19,10 +19,8 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearcheck.compare.presentation.order_plots import order_plot, waterfall_plot
-from gearcheck.compare.studies.order_curves import against_sweep, resonance_speeds, sweep_effect
-from gearcheck.compare.studies.order_tracking import order_track, waterfall
-from gearcheck.compare.studies.resonance_passage import passage
+from gearcheck.compare.presentation import order_plot, waterfall_plot
+from gearcheck.compare.studies import against_sweep, order_track, passage, resonance_speeds, sweep_effect, waterfall
 
 F_N, ZETA, ORDER = 100.0, 0.02, 6.0
 START, STOP, RATES = 200.0, 2000.0, (400.0, 200.0, 100.0)  # rpm, rpm, rpm/s

@@ -279,7 +279,8 @@ def test_every_command_of_the_command_line_is_in_the_front_door():
              "run": gearcheck.simulate, "crosscheck": gearcheck.crosscheck, "calibrate": gearcheck.calibrate,
              "sweep": gearcheck.sweep, "sensitivity": gearcheck.sensitivity, "pins": gearcheck.pin_loads,
              "stiffness": gearcheck.Train.stiffness, "animate": gearcheck.Train.animate, "view": gearcheck.Train.view,
-             "dashboard": gearcheck.dashboard, "export": gearcheck.export_model, "mjcf": gearcheck.mjcf}
+             "dashboard": gearcheck.dashboard, "export": gearcheck.export_model, "mjcf": gearcheck.mjcf,
+             "runup": gearcheck.runup}
     assert set(subparsers.choices) == set(front)
     assert all(callable(f) and f.__doc__ for f in front.values())
 

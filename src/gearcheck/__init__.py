@@ -23,6 +23,8 @@ The front door:
 * :func:`harmonic_response`, :func:`sensitivity` -- the steady forced response by harmonic methods and its
   derivatives to the numbers of a train file;
 * :func:`sweep` -- speed sweeps, parameter studies and Monte Carlo, cached, on local processes or Dask;
+* :func:`runup` -- a run-up through a speed ramp in both solvers, its mesh orders tracked; ``load(...,
+  speed_profile=, torque_profile=, load_profile=)`` any operating history, :func:`preset_data` the presets' data;
 * :func:`write_report` -- report.json, report.md, report.html and figures of a cross-check;
 * :func:`describe`, :func:`pin_loads`, :func:`calibrate`, :func:`dashboard` -- what a train derives from its file,
   an RV reducer's static pin loads, a least-squares calibration to measurements, the regression dashboard;
@@ -69,7 +71,9 @@ from gearcheck.api import (  # noqa: E402
                            mode_pairing,
                            modes,
                            pin_loads,
+                           preset_data,
                            presets,
+                           runup,
                            sensitivity,
                            simulate,
                            sweep,
@@ -100,4 +104,5 @@ __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "Gear
            "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",
            "__version__", "allow_data", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "edited",
            "export_model", "harmonic_response", "kinematics", "load", "load_text", "mjcf", "mode_pairing", "modes",
-           "pin_loads", "preset_text", "presets", "sensitivity", "simulate", "sweep", "trust", "write_report"]
+           "pin_loads", "preset_data", "preset_text", "presets", "runup", "sensitivity", "simulate", "sweep", "trust",
+           "write_report"]

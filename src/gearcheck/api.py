@@ -20,11 +20,12 @@ from gearcheck.compare.presentation.dashboard import render
 from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.studies.calibrate import Calibration, FitParameter
 from gearcheck.compare.studies.calibrate import calibrate as fit_train
+from gearcheck.compare.studies.runup import RunUp, run_up
 from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.session import SOLVERS, Train
 from gearcheck.train.loader import load_train, preset_names, read_train_text
-from gearcheck.train.spec import TrainSpec
+from gearcheck.train.spec import TrainSpec, with_profiles
 from gearcheck.train.schema import parse_measurements_file
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
@@ -32,7 +33,7 @@ from gearcheck.shared.results import TimeResult
 
 __all__ = ["SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model",
            "harmonic_response", "load", "mjcf", "mode_pairing", "pin_loads",
-           "modes", "presets", "sensitivity", "simulate", "sweep", "write_report"]
+           "modes", "preset_data", "presets", "runup", "sensitivity", "simulate", "sweep", "write_report"]
 
 
 def presets() -> list[str]:
@@ -40,7 +41,8 @@ def presets() -> list[str]:
     return preset_names()
 
 
-def load(train: str | Path | TrainSpec, speed: float | None = None) -> TrainSpec:
+def load(train: str | Path | TrainSpec, speed: float | None = None, *, speed_profile: str | None = None,
+         torque_profile: str | None = None, load_profile: str | None = None, start: str | None = None) -> TrainSpec:
     """A validated train.
 
     Parameters
@@ -49,13 +51,57 @@ def load(train: str | Path | TrainSpec, speed: float | None = None) -> TrainSpec
         A preset name, the path of a train file (TOML), or a train already loaded.
     speed : float, optional
         Input speed in rpm, replacing the train's.
+    speed_profile, torque_profile, load_profile : str, optional
+        An operating history replacing the train's (:mod:`gearcheck.train.history`): the input speed (rpm) or the
+        input torque (N·m), and the output load (N·m), each a CSV or Parquet table (time, value, units in the
+        header) or points ``"T:V,T:V,..."``, as ``--speed-profile`` and the others take them.
+    start : {"steady", "rest"}, optional
+        Where a history starts (default: at rest from 0 rpm or under a torque, else in the steady state).
 
     Returns
     -------
     TrainSpec
         The train in SI units: members, stages, meshes, couplings, operating point, measurements.
     """
-    return load_train(train, speed)
+    return with_profiles(load_train(train, speed), speed_profile, torque_profile, load_profile, start)
+
+
+def preset_data(name: str) -> Path:
+    """The path of a data file shipped with the presets (``hub-drive-table1.toml``,
+    ``double-planet-initiation-torque.csv``), as a train file or a profile names it."""
+    path = Path(__file__).parent / "train" / "presets" / "data" / name
+    if not path.is_file():
+        raise GearcheckError(f"no preset data file {name!r}; there are: "
+                             + ", ".join(sorted(p.name for p in path.parent.iterdir() if p.is_file())))
+    return path
+
+
+def runup(train, start_rpm: float, stop_rpm: float, duration: float, *, solver: str = "both", quantities=None,
+          harmonics: int = 3, progress=None) -> RunUp:
+    """A run-up through a linear speed ramp, each solver's mesh orders tracked (``gearcheck runup``).
+
+    Parameters
+    ----------
+    train : str, path or TrainSpec
+        The train (its input driven through its shaft; the run starts in the steady state at ``start_rpm``).
+    start_rpm, stop_rpm, duration : float
+        The ramp: from ``start_rpm`` to ``stop_rpm`` in ``duration`` seconds.
+    solver : {"both", "lumped", "mujoco"}
+    quantities : list of str, optional
+        Gated signals to track (default: all).
+    harmonics : int
+        Mesh harmonics per mesh frequency (orders k f_mesh / f_in of the input).
+
+    Returns
+    -------
+    RunUp
+        ``tracks[(solver, quantity)]`` (:class:`~gearcheck.compare.studies.order_tracking.OrderTrack`: amplitude and
+        phase of each order against speed), ``table()``, ``agreement()``, ``parting()``, ``waterfalls``, costs.
+    """
+    solvers = tuple(SOLVERS) if solver == "both" else (solver,)
+    if any(s not in SOLVERS for s in solvers):
+        raise GearcheckError(f"solver={solver!r}: one of both, {', '.join(SOLVERS)}")
+    return run_up(load_train(train), start_rpm, stop_rpm, duration, solvers, quantities, harmonics, progress)
 
 
 def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalResult:

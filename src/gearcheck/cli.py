@@ -421,10 +421,8 @@ def cmd_ste(args) -> int:
 def _profiled(args, train):
     """The train under the command line's operating history (--speed-profile, --torque-profile, --load-profile,
     --start), or as loaded."""
-    from gearcheck.train.spec import with_profiles
-
-    return with_profiles(gearcheck.load(train, args.speed), args.speed_profile, args.torque_profile,
-                         args.load_profile, args.start)
+    return gearcheck.load(train, args.speed, speed_profile=args.speed_profile, torque_profile=args.torque_profile,
+                          load_profile=args.load_profile, start=args.start)
 
 
 def cmd_run(args) -> int:
@@ -444,7 +442,7 @@ def cmd_run(args) -> int:
 
 def cmd_runup(args) -> int:
     from gearcheck.compare.presentation.runup_report import write_runup
-    from gearcheck.compare.studies.runup import PARTING, run_up
+    from gearcheck.compare.studies.runup import PARTING
 
     spec = gearcheck.load(args.train)
     sweep = None
@@ -465,8 +463,8 @@ def cmd_runup(args) -> int:
     natural = gearcheck.modes(spec).frequencies
     with OutputDirectory(args.out) as place:
         bar = ProgressBar(f"run-up {spec.name}")
-        run = run_up(spec, args.start, args.stop, args.duration, solvers, args.quantity or None, args.harmonics,
-                     progress=bar)
+        run = gearcheck.runup(spec, args.start, args.stop, args.duration, solver=args.solver,
+                              quantities=args.quantity or None, harmonics=args.harmonics, progress=bar)
         bar.close()
         written = write_runup(run, place.path, natural, sweep)
     costs = ", ".join(f"{s} {run.cpu_s[s]:.3g} s CPU" for s in solvers)

@@ -9,8 +9,8 @@ order, the run-up's order curve against the sweep's harmonic amplitudes where th
 
 * the order is significant (its sweep amplitude above 5 % of its largest) and the speed is farther than 5 % of the
   top speed from every resonance of that order (its frequency at a natural frequency at rest);
-* the teeth stay in contact at that speed in the sweep's steady state (every mesh force's mean above half its
-  peak-to-peak): where they separate (the backlash), the response depends on its history, and a run-up follows
+* the teeth stay in contact at that speed in the sweep's steady state (every force of a mesh with a backlash has
+  its mean above half its peak-to-peak): where they separate (the backlash), the response depends on its history, and a run-up follows
   its own branch where each stepped point lands on the one its cold start finds.
 
 It prints the median and 90th percentile of the relative differences there, the share of the range where the teeth
@@ -49,7 +49,7 @@ def main() -> None:
                             integration_check=False, workers=1)
     sweep_wall = time.perf_counter() - started
     table = sweep.table.to_pandas()
-    kept = contact_kept(table)
+    kept = contact_kept(table, [m.id for m in spec.meshes if m.backlash > 0])
     print(f"stepped sweep: {args.points} points x 0.5 s, lumped, one worker: {sweep_wall:.1f} s wall (its points "
           f"{sum(sweep.point_wall_s):.1f} s); the teeth separate, or no steady state, at {int((~kept).sum())} of "
           f"{kept.size} speeds")

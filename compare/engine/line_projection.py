@@ -34,13 +34,13 @@ def harmonics(t: np.ndarray, x: np.ndarray, frequencies, fs: float, switches=())
     usable = frequencies < 0.5 * fs
     out = np.full((frequencies.size, x.shape[1]), np.nan + 0j)
     times, sizes = jumps(t, x, switches)
-    smooth = x - _steps(t, times, sizes)
+    smooth = x - step_series(t, times, sizes)
     centred = (smooth - x.mean(axis=0)) * w[:, None]
     f = frequencies[usable]
     out[usable] = 2.0 * (np.exp(-2j * np.pi * np.outer(f, t)) @ centred) / w.sum()
     if times.size:
         h = (t[-1] - t[0]) / (t.size - 1)
-        out[usable] += 2.0 * _hann_tail_transform(t[0], t[-1], times, f) @ sizes / (h * w.sum())
+        out[usable] += 2.0 * hann_tail_transform(t[0], t[-1], times, f) @ sizes / (h * w.sum())
     return out
 
 
@@ -73,7 +73,7 @@ def jumps(t: np.ndarray, x: np.ndarray, switches) -> tuple[np.ndarray, np.ndarra
     return np.array(times), np.array(sizes)
 
 
-def _steps(t: np.ndarray, times: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+def step_series(t: np.ndarray, times: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """The sum of the jumps as step functions, sampled at ``t`` (a sample at a jump holds the value after)."""
     out = np.zeros((t.size, sizes.shape[1]))
     if times.size:
@@ -84,7 +84,7 @@ def _steps(t: np.ndarray, times: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     return out
 
 
-def _hann_tail_transform(ta: float, tb: float, times: np.ndarray, frequencies: np.ndarray) -> np.ndarray:
+def hann_tail_transform(ta: float, tb: float, times: np.ndarray, frequencies: np.ndarray) -> np.ndarray:
     """(lines x jumps) integral over [s, tb] of w(t) e^{-i 2 pi f t}, w the Hann window over [ta, tb],
     for each jump instant s: w = 1/2 - (e^{i W (t - ta)} + e^{-i W (t - ta)}) / 4, W = 2 pi / (tb - ta)."""
     omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)[:, None]

@@ -28,13 +28,14 @@ def write_runup(run: RunUp, out: Path, natural_hz, sweep=None) -> list[str]:
     summary = {"train": run.train, "start_rpm": run.start_rpm, "stop_rpm": run.stop_rpm, "duration_s": run.duration,
                "rate_rpm_per_s": run.rate_rpm_s, "orders": [{"mesh": m, "harmonic": k, "order": o}
                                                            for m, k, o in run.orders],
+               "output_dt_s": run.output_dt, "switching_stiffness": run.switching,
                "wall_s": run.wall_s, "cpu_s": run.cpu_s, "solvers_agree": run.agreement(),
                "solvers_part_rpm": run.parting()}
     steady: dict[str, dict] = {}
     if sweep is not None:
         band = RESONANCE_BAND * run.stop_rpm
         compared = against_sweep_table(run, sweep, natural_hz, band)
-        kept = contact_kept(sweep)
+        kept = contact_kept(sweep, run.backlash)
         summary["against_sweep"] = {"band_rpm": band, "natural_hz": [float(f) for f in natural_hz],
                                     "speeds_in_contact": int(kept.sum()), "speeds": int(kept.size),
                                     "orders": compared.to_dict(orient="records")}

@@ -41,6 +41,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from scipy.interpolate import CubicSpline
 
+from gearcheck.compare.engine.line_projection import hann_tail_transform
 from gearcheck.shared.errors import GearcheckError
 
 MIN_SAMPLES_PER_CYCLE = 8  # cubic spline gain error below 6e-4 (the module's docstring)
@@ -94,11 +95,15 @@ class Waterfall:
 
 
 def order_track(t, signal, angle_rev, orders, *, revs_per_block: float = 8.0, overlap: float = 0.5,
-                samples_per_rev: int | None = None) -> OrderTrack:
+                samples_per_rev: int | None = None, steps=None) -> OrderTrack:
     """The order curves of ``signal`` (samples at times ``t``) against the reference angle ``angle_rev``
     (revolutions of the reference shaft at each sample, strictly increasing) for ``orders`` (per revolution of that
     shaft, > 0, integer or not), by computed order tracking (see the module's docstring).  ``samples_per_rev``:
-    the angle grid (default: the time samples' finest angle step, rounded up to a power of two)."""
+    the angle grid (default: the time samples' finest angle step, rounded up to a power of two).  ``steps``: (angles
+    in revolutions, sizes) of jumps that ``signal`` has had taken out (a switching mesh stiffness makes a force jump
+    between samples, which no interpolation resolves: an error of order the jump over the samples a cycle in every
+    line); each is added back by its exact windowed projection, as
+    :func:`gearcheck.compare.engine.line_projection.harmonics` does in time (Eckhoff 1995)."""
     t, x, theta = _run(t, signal, angle_rev)
     orders = checked_array("orders", orders)
     if np.any(orders <= 0):
@@ -128,11 +133,32 @@ def order_track(t, signal, angle_rev, orders, *, revs_per_block: float = 8.0, ov
     mean = blocks @ w / w.sum()
     c = 2.0 * (blocks @ kernel.T - np.outer(mean, kernel.sum(axis=1))) / w.sum()
     c *= np.exp(-2j * np.pi * np.outer(starts, orders))  # the phase against the absolute angle
+    if steps is not None:
+        c += _step_lines(starts, length / n, orders, *steps)
     time = CubicSpline(theta, t)
     at = sliding_window_view(grid, length)[::hop]
     speed = 60.0 / time.derivative()(at)  # rpm; rev / s = 1 / (dt / dtheta)
     return OrderTrack(orders, speed @ w / w.sum(), np.column_stack([speed.min(axis=1), speed.max(axis=1)]),
                       time(starts + 0.5 * length / n), c, length / n, overlap, n)
+
+
+def _step_lines(starts: np.ndarray, span: float, orders: np.ndarray, angles, sizes) -> np.ndarray:
+    """(blocks, orders) the windowed projections of steps of ``sizes`` at ``angles`` (rev) on the blocks of ``span``
+    revolutions from ``starts``, the window's weighted mean taken out as from the signal: for a step J at a inside a
+    block, 2 J (T_k(a) - T_0(a) F_k / F_0) / F_0 with T_k(a) the integral from a to the block's end of the Hann
+    window times e^{-i 2 pi k theta} and F_k that over the block."""
+    angles, sizes = np.asarray(angles, dtype=float), np.asarray(sizes, dtype=float)
+    out = np.zeros((starts.size, orders.size), dtype=complex)
+    for b, a in enumerate(starts):
+        inside = (angles > a) & (angles < a + span)
+        if not inside.any():
+            continue
+        tail = hann_tail_transform(a, a + span, angles[inside], orders)  # (orders, steps)
+        weight = hann_tail_transform(a, a + span, angles[inside], np.zeros(1)).real[0]  # (steps,)
+        full = hann_tail_transform(a, a + span, np.array([a]), orders)[:, 0]
+        area = 0.5 * span
+        out[b] = 2.0 * ((tail - np.outer(full, weight) / area) @ sizes[inside]) / area
+    return out
 
 
 def waterfall(t, signal, angle_rev, block_s: float, *, overlap: float = 0.5, max_hz: float | None = None) -> Waterfall:

@@ -77,7 +77,7 @@ def preset_data(name: str) -> Path:
 
 
 def runup(train, start_rpm: float, stop_rpm: float, duration: float, *, solver: str = "both", quantities=None,
-          harmonics: int = 3, progress=None) -> RunUp:
+          harmonics: int = 3, output_dt: float | None = None, progress=None) -> RunUp:
     """A run-up through a linear speed ramp, each solver's mesh orders tracked (``gearcheck runup``).
 
     Parameters
@@ -91,6 +91,9 @@ def runup(train, start_rpm: float, stop_rpm: float, duration: float, *, solver: 
         Gated signals to track (default: all).
     harmonics : int
         Mesh harmonics per mesh frequency (orders k f_mesh / f_in of the input).
+    output_dt : float, optional
+        Sampling of the runs in s (default: twice what order tracking needs at the top speed; a train whose mesh
+        stiffness switches is read to its stepped sweep's accuracy only when sampled near the solvers' step).
 
     Returns
     -------
@@ -101,7 +104,8 @@ def runup(train, start_rpm: float, stop_rpm: float, duration: float, *, solver: 
     solvers = tuple(SOLVERS) if solver == "both" else (solver,)
     if any(s not in SOLVERS for s in solvers):
         raise GearcheckError(f"solver={solver!r}: one of both, {', '.join(SOLVERS)}")
-    return run_up(load_train(train), start_rpm, stop_rpm, duration, solvers, quantities, harmonics, progress)
+    return run_up(load_train(train), start_rpm, stop_rpm, duration, solvers, quantities, harmonics, progress,
+                  output_dt)
 
 
 def modes(train, solver: str = "lumped", speed: float | None = None) -> ModalResult:

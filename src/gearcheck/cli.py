@@ -464,7 +464,8 @@ def cmd_runup(args) -> int:
     with OutputDirectory(args.out) as place:
         bar = ProgressBar(f"run-up {spec.name}")
         run = gearcheck.runup(spec, args.start, args.stop, args.duration, solver=args.solver,
-                              quantities=args.quantity or None, harmonics=args.harmonics, progress=bar)
+                              quantities=args.quantity or None, harmonics=args.harmonics, output_dt=args.output_dt,
+                              progress=bar)
         bar.close()
         written = write_runup(run, place.path, natural, sweep)
     costs = ", ".join(f"{s} {run.cpu_s[s]:.3g} s CPU" for s in solvers)
@@ -1051,6 +1052,9 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--solver", choices=("lumped", "mujoco", "both"), default="both"),
         arg("--quantity", action="append", metavar="NAME", help="a gated quantity to track (repeatable; default all)"),
         arg("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics tracked per mesh frequency"),
+        arg("--output-dt", type=SECONDS, metavar="S",
+            help="sampling of the runs (default: twice what the orders need; near the step for a train whose mesh "
+                 "stiffness switches, to read its orders to a stepped sweep's accuracy)"),
         arg("--against", type=PATH, metavar="SWEEP.parquet",
             help="a stepped sweep's table (gearcheck sweep) to compare the lumped order curves with"),
         arg("--out", type=PATH, default=Path("out/runup"), metavar="DIR", help="output directory (default out/runup)"),

@@ -126,12 +126,13 @@ class Excitation:
             k[..., r, :pairs.size], e[..., r, :pairs.size] = pairs(xi[..., r])
         return k, e
 
-    def switch_times(self, t0: float, t1: float) -> np.ndarray:
-        """Sorted times in (t0, t1) at which some mesh's stiffness jumps (its model's ``breaks``) or, under a
-        history, the speed's or a torque's slope does (their points)."""
+    def switch_times(self, t0: float, t1: float, mesh: int | None = None) -> np.ndarray:
+        """Sorted times in (t0, t1) at which some mesh's stiffness (or that of the mesh of index ``mesh`` alone)
+        jumps (its model's ``breaks``) or, under a history, the speed's or a torque's slope does (their points)."""
         times = []
         a0, a1 = (float(x) for x in self.nominal_time(np.array([t0, t1])))
-        for f, phase, model in zip(self.frequency, self.phase, self.models):
+        chosen = range(len(self.models)) if mesh is None else [mesh]
+        for f, phase, model in (zip(self.frequency[chosen], self.phase[chosen], [self.models[j] for j in chosen])):
             for b in model.breaks:
                 if f > 0:  # xi = f Lambda(t) - phase = n + b
                     n = np.arange(math.floor(f * a0 - phase - b), math.ceil(f * a1 - phase - b) + 1)

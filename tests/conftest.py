@@ -46,3 +46,36 @@ def browser(tmp_path):
         return [line for line in stderr.splitlines() if ":CONSOLE" in line or "Uncaught" in line]
 
     return SimpleNamespace(browse=browse, console=console)
+
+
+# The smoke subset (`pytest -m smoke`): a contributor's check in under a minute that touches every layer -- the
+# train description, both solvers' modes and time runs, a cross-check, an operating history, order tracking, the
+# command line's bad input, the generated files.  Listed here, in one place (tests/test_smoke.py checks each exists).
+SMOKE = (
+    "tests/test_kinematics.py::test_demo_ratio_is_one_plus_zr_over_zs",
+    "tests/test_kinematics.py::test_mesh_frequency_and_planet_phases",
+    "tests/test_modal.py::test_single_mesh_frequency_is_sqrt_k_over_m_eq",
+    "tests/test_modal.py::test_mode_multiplicities_for_equally_spaced_planets[3]",
+    "tests/test_mbd_modes.py::test_frequencies_and_types_match_lumped[demo-3p]",
+    "tests/test_time_solver.py::test_rk4_converges_at_fourth_order_to_dop853",
+    "tests/test_crosscheck.py::test_demo_presets_pass_with_default_tolerances",
+    "tests/test_operating_history.py::test_clock_closed_forms",
+    "tests/test_operating_history.py::test_constant_speed_is_the_limit_to_the_bit",
+    "tests/test_operating_history.py::test_run_up_in_both_solvers",
+    "tests/test_order_tracking.py::test_two_non_integer_orders_are_separated_with_a_bounded_error",
+    "tests/test_front_door.py::test_simulate_returns_named_signals_with_pandas_export",
+    "tests/test_bad_input.py::test_the_line_names_the_file",
+    "tests/test_xml.py::test_xml_is_up_to_date_and_loads[demo-3p]",
+    "tests/test_readme.py::test_generated_references_match_the_code",
+    "tests/test_schemas.py::test_the_shipped_schemas_are_current",
+)
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "smoke: the contributor's subset (pytest -m smoke), listed in conftest.SMOKE")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.nodeid in SMOKE:
+            item.add_marker(pytest.mark.smoke)

@@ -10,8 +10,8 @@ order, the run-up's order curve against the sweep's harmonic amplitudes where th
 * the order is significant (its sweep amplitude above 5 % of its largest) and the speed is farther than 5 % of the
   top speed from every resonance of that order (its frequency at a natural frequency at rest);
 * the teeth stay in contact at that speed in the sweep's steady state (every force of a mesh with a backlash has
-  its mean above half its peak-to-peak): where they separate (the backlash), the response depends on its history, and a run-up follows
-  its own branch where each stepped point lands on the one its cold start finds.
+  its mean above half its peak-to-peak): where they separate (the backlash), the response depends on its history,
+  and a run-up follows its own branch where each stepped point lands on the one its cold start finds.
 
 It prints the median and 90th percentile of the relative differences there, the share of the range where the teeth
 separate, and the main resonance's peak (speed and amplitude) in the sweep and in each run-up: the sweep-rate
@@ -27,13 +27,12 @@ from pathlib import Path
 import numpy as np
 
 import gearcheck
-from gearcheck.compare.presentation.runup_report import write_runup
+from gearcheck.compare.presentation.runup_report import RESONANCE_BAND, write_runup
 from gearcheck.compare.studies.order_curves import peak
-from gearcheck.compare.studies.runup import contact_kept, run_up, sweep_differences
+from gearcheck.compare.studies.runup import contact_kept, run_up, sweep_differences, sweep_line
 
 TRAIN, START, STOP = "hub-drive", 200.0, 2000.0
 QUANTITIES = ("I.planet1.sun.force", "I.carrier.ay.world", "I.ring.ay.world")
-BAND = 0.05
 
 
 def main() -> None:
@@ -54,9 +53,7 @@ def main() -> None:
           f"{sum(sweep.point_wall_s):.1f} s); the teeth separate, or no steady state, at {int((~kept).sum())} of "
           f"{kept.size} speeds")
     main_order = QUANTITIES[0]
-    speeds, amps = (table[(table["metric"] == "harmonic") & (table["quantity"] == main_order) & (table["mesh"] == "I")
-                          & (table["order"] == 1) & (table["solver"] == "lumped")]
-                    .sort_values("speed_rpm")[["speed_rpm", "amplitude"]].to_numpy().T)
+    speeds, amps = sweep_line(table, "lumped", main_order, "I", 1)
     top = peak(speeds, amps, (500.0, 1000.0))
     print(f"main resonance ({main_order}, I x1) in the sweep: {top.amplitude:.4g} N at {top.speed_rpm:.5g} rpm")
     print("| run-up | rate (rpm/s) | wall (s) | sweep / run-up | compared | median diff. | 90th pct. | "
@@ -66,7 +63,7 @@ def main() -> None:
         started = time.perf_counter()
         run = run_up(spec, START, STOP, duration, ("lumped",), QUANTITIES)
         used = time.perf_counter() - started
-        diffs = np.concatenate([d for *_, d in sweep_differences(run, table, natural, BAND * STOP)])
+        diffs = np.concatenate([d for *_, d in sweep_differences(run, table, natural, RESONANCE_BAND * STOP)])
         curve = run.tracks[("lumped", main_order)].curve(next(o for m, k, o in run.orders if m == "I" and k == 1))
         p = peak(*curve, (500.0, 1000.0))
         print(f"| {duration:g} s | {run.rate_rpm_s:.4g} | {used:.1f} | {sweep_wall / used:.1f} | {len(diffs)} | "

@@ -90,9 +90,9 @@ def with_schedule(model):
     clock = model.excitation.clock
     if clock is None:
         return model
-    for e in model.turning:
-        raise UnsupportedError(f"{model.spec.name}: an operating history with {e.words} is not supported yet (its "
-                               "rows turn with the nominal time at the reference speed)")
+    if model.turning:
+        raise UnsupportedError(f"{model.spec.name}: an operating history with {model.turning[0].words} is not "
+                               "supported yet (its rows turn with the nominal time at the reference speed)")
     drag = model.F_static - model.F_centripetal
     schedule = FrameSchedule(clock, model.G, model.K_centripetal, model.K_circulatory, model.K_euler,
                              model.F_centripetal, drag, model.F_inertia)

@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 
 from gearcheck.compare.presentation.order_plots import order_plot, waterfall_plot
-from gearcheck.compare.studies.runup import RunUp, against_sweep_table, contact_kept
+from gearcheck.compare.studies.runup import RunUp, against_sweep_table, contact_kept, sweep_line
 
 RESONANCE_BAND = 0.05  # the sweep comparison leaves out this fraction of the top speed about each resonance speed
 
@@ -39,14 +39,9 @@ def write_runup(run: RunUp, out: Path, natural_hz, sweep=None) -> list[str]:
         summary["against_sweep"] = {"band_rpm": band, "natural_hz": [float(f) for f in natural_hz],
                                     "speeds_in_contact": int(kept.sum()), "speeds": int(kept.size),
                                     "orders": compared.to_dict(orient="records")}
-        harmonic = sweep[(sweep["metric"] == "harmonic") & (sweep["solver"] == "lumped")]
         for quantity in {q for _, q in run.tracks}:
-            steady[quantity] = {}
-            for label, k, order in run.orders:
-                lines = harmonic[(harmonic["quantity"] == quantity) & (harmonic["mesh"] == label)
-                                 & (harmonic["order"] == k)].sort_values("speed_rpm")
-                if not lines.empty:
-                    steady[quantity][order] = (lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy())
+            lines = {order: sweep_line(sweep, "lumped", quantity, label, k) for label, k, order in run.orders}
+            steady[quantity] = {order: line for order, line in lines.items() if line[0].size}
     for quantity in sorted({q for _, q in run.tracks}):
         tracks = {solver: track for (solver, q), track in run.tracks.items() if q == quantity}
         name = f"order_{quantity}.png"

@@ -22,7 +22,7 @@ from gearcheck.compare.studies.order_tracking import (MIN_SAMPLES_PER_CYCLE, Ord
                                                       waterfall)
 from gearcheck.compare.engine.line_projection import jumps, step_series
 from gearcheck.compare.engine.model_pair import SOLVERS
-from gearcheck.compare.studies.sweep import mesh_groups
+from gearcheck.compare.studies.sweep import check_harmonics, mesh_groups
 from gearcheck.shared.errors import GearcheckError, did_you_mean
 from gearcheck.shared.results import train_signals
 from gearcheck.shared.settings import RunSettings
@@ -34,7 +34,6 @@ from gearcheck.train.spec import with_history
 OVERSAMPLING = 2  # samples a cycle of the highest harmonic at the top speed, over what order tracking needs
 REVS_PER_BLOCK = 1.0  # one input revolution a block: mesh orders lie tens apart, so no leakage between them
 OVERLAP = 0.75
-MAX_HARMONICS = 20
 SIGNIFICANT = 0.05  # a sweep comparison reads an order where it is above this fraction of its largest amplitude
 PARTING = 1e-3  # the two solvers' order curves "part" where they differ by more than this of the largest
 WATERFALL_BLOCKS = 60  # time blocks of the waterfall over the run
@@ -116,8 +115,7 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
     1e-5 s).  :attr:`RunUp.switching` says whether a train's stiffness switches."""
     if not 0 < start_rpm < stop_rpm:
         raise GearcheckError(f"--from/--to: a run-up needs 0 < from < to, got {start_rpm:g} and {stop_rpm:g} rpm")
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= MAX_HARMONICS:
-        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to {MAX_HARMONICS}")
+    check_harmonics(harmonics)
     known = [signal.name for signal in train_signals(train)]
     for name in quantities or ():
         if name not in known:
@@ -158,6 +156,14 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
                  output_dt, wall, cpu)
 
 
+def sweep_line(table: pd.DataFrame, solver: str, quantity: str, mesh: str, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """(speeds in rpm, amplitudes) of harmonic ``k`` of ``mesh``'s frequency of ``quantity`` in a sweep table,
+    by speed."""
+    lines = table[(table["metric"] == "harmonic") & (table["solver"] == solver) & (table["quantity"] == quantity)
+                  & (table["mesh"] == mesh) & (table["order"] == k)].sort_values("speed_rpm")
+    return lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy()
+
+
 def contact_kept(table: pd.DataFrame, backlash, solver: str = "lumped") -> pd.Series:
     """Per speed of a sweep table: whether its steady state was found and the teeth of every mesh with a backlash
     (``backlash``: their ids) stay in contact there (each mesh force's mean above half its peak-to-peak).  Where
@@ -183,16 +189,13 @@ def sweep_differences(run: RunUp, table: pd.DataFrame, natural_hz, band_rpm: flo
     run-up's rate shifts and lowers the peak, :mod:`gearcheck.compare.studies.resonance_passage`), the teeth in
     contact (:func:`contact_kept`)."""
     kept = contact_kept(table, run.backlash, solver)
-    harmonic = table[(table["metric"] == "harmonic") & (table["solver"] == solver)]
     for (s, quantity), track in run.tracks.items():
         if s != solver:
             continue
         for label, k, order in run.orders:
-            lines = harmonic[(harmonic["quantity"] == quantity) & (harmonic["mesh"] == label)
-                             & (harmonic["order"] == k)].sort_values("speed_rpm")
-            if lines.empty:
+            speed, steady = sweep_line(table, solver, quantity, label, k)
+            if not speed.size:
                 continue
-            speed, steady = lines["speed_rpm"].to_numpy(), lines["amplitude"].to_numpy()
             use = (steady > SIGNIFICANT * steady.max()) & kept.reindex(speed, fill_value=False).to_numpy(bool)
             if not use.any():
                 yield quantity, label, k, order, np.zeros(0)

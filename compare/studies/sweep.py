@@ -88,6 +88,7 @@ HARMONICS = 3
 STATISTICS = ("mean", "rms", "peak_to_peak")
 MAX_POINTS = 100_000  # each point carries its edited train file (some 10 kB): 1 GB of points at most
 MAX_REFINE = 64
+MAX_HARMONICS = 20
 
 KEY = "gearcheck.point"  # a point table's metadata: the point's key (Point.key), checked when read from the cache
 POINT_SCHEMA = pa.schema([
@@ -287,12 +288,17 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
     return SweepPlan(base.name, points, [f.path for f in list(grid) + list(laws)], settings)
 
 
+def check_harmonics(harmonics) -> None:
+    """Refuse a number of mesh harmonics per mesh frequency outside 1 to :data:`MAX_HARMONICS`."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= MAX_HARMONICS:
+        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to {MAX_HARMONICS}")
+
+
 def _check_run_options(duration, harmonics, integration_check, refine) -> None:
     """Refuse a setting of every point's runs that is out of its range (the integration check: not a bool)."""
     if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
         raise GearcheckError(f"duration={duration!r}: needs a positive number of seconds")
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 20:
-        raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to 20")
+    check_harmonics(harmonics)
     if not isinstance(integration_check, bool):
         raise GearcheckError(f"integration_check={integration_check!r}: needs True or False")
     if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:

@@ -196,7 +196,8 @@ class Excitation:
         t = np.asarray(t, dtype=float)
         e = np.zeros(t.shape + (len(self.mesh_ids),))
         de = np.zeros_like(e)
-        angle, scale = self.nominal_time(t), self.speed_scale(t)  # the angles turn at lambda times their speeds
+        angle = self.nominal_time(t)  # the angles turn at lambda times their speeds
+        scale = 1.0 if self.clock is None else self.clock.scale(t)
         for i, h, amp, phi in self._ste:
             arg = 2 * np.pi * h * (self.frequency[i] * angle - self.phase[i]) + phi
             e[..., i] += amp * np.cos(arg)

@@ -21,6 +21,7 @@ import numpy as np
 
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.train.expression import Expression
+from gearcheck.train.history_file import read_history_table
 
 START = ("steady", "rest")
 CLOCK_STEPS = 4096  # RK4 steps of the rigid train's speed over a torque history (Hermite-interpolated between)
@@ -233,8 +234,6 @@ def check_duration(history: History | None, duration: float, what: str) -> None:
 def parse_history(raw: dict, source: str, locate, fail) -> History:
     """The :class:`History` of a schema-checked ``operating.history`` table; ``locate(name)`` the path of a file it
     names, ``fail(field, message)`` the error for a field."""
-    from gearcheck.train.history_file import read_history_table
-
     def series(name: str, quantity: str) -> Series | None:
         given = [key for key in (f"{name}_points", f"{name}_file", f"{name}_expression") if raw[key] is not None]
         if len(given) > 1:

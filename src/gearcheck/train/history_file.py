@@ -52,7 +52,7 @@ def _factor(name: str, units: dict, label: str, what: str) -> float:
 def _csv(text: str, label: str):
     lines = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
     names = None
-    if lines and not _numbers(lines[0]):
+    if lines and not number_row(lines[0]):
         names = [x.strip() for x in lines[0].split(",")]
         lines = lines[1:]
         if len(names) != 2:
@@ -86,7 +86,8 @@ def _parquet(data: bytes, label: str):
     return names, columns
 
 
-def _numbers(line: str) -> bool:
+def number_row(line: str) -> bool:
+    """Whether a CSV line is numbers (not a header)."""
     try:
         [float(x) for x in line.split(",")]
         return True

@@ -22,6 +22,7 @@ from gearcheck.train.expression import Expression
 from gearcheck.train.cycloid import CycloidGeometry, cycloid_problem, min_curvature_radius, palmgren_stiffness
 from gearcheck.train.files import read_text, read_toml
 from gearcheck.train.history import History, parse_history
+from gearcheck.train.history_file import number_row
 from gearcheck.train.geometry import (Gear, MeshGeometry, gear_problem, helix_problem, idealised_mesh_geometry,
                                       mesh_geometry, mesh_problem)
 from gearcheck.train.mesh_stiffness import MODELS
@@ -634,7 +635,7 @@ def _torque_profile(name: str, source: str, fail):
         lines = read_text(path, "torque profile").splitlines()
     except GearcheckError as exc:
         raise fail("operating.torque_csv", str(exc)) from None
-    if lines and not _numbers(lines[0]):
+    if lines and not number_row(lines[0]):
         lines = lines[1:]  # a header line
     try:
         data = np.loadtxt(lines, delimiter=",", ndmin=2)
@@ -645,14 +646,6 @@ def _torque_profile(name: str, source: str, fail):
     if not np.all(np.isfinite(data)) or np.any(np.diff(data[:, 0]) <= 0):
         raise fail("operating.torque_csv", f"{path}: times must increase strictly and all values be finite")
     return tuple(data[:, 0]), tuple(data[:, 1])
-
-
-def _numbers(line: str) -> bool:
-    try:
-        [float(x) for x in line.split(",")]
-        return True
-    except ValueError:
-        return False
 
 
 def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) -> Gear:

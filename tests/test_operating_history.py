@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+import gearcheck
 from gearcheck.cli import main
 from gearcheck.lumped.assembly import build_model
 from gearcheck.lumped.time_solver import simulate
@@ -160,18 +161,32 @@ def test_bad_history_one_line(tmp_path, capsys, history, fragment):
 
 BAD_OPTIONS = [
     (["--speed-profile", "0:1500,x"], "--speed-profile '0:1500,x'"),
+    (["--torque-profile", "0:1e300"], "--torque-profile: values must be within ±1e+09 N·m, got 1e+300"),
+    (["--speed-profile", "0:1500,1e9:1600"], "--speed-profile: times must be <= 10000 s"),
     (["--start", "rest"], "--start applies to an operating history"),
     (["--torque-profile", "0:0,0.01:1"], "turn backwards"),
     (["--torque-profile", "0:500,0.005:500"], "ends at 0.005 s"),
 ]
 
 
-@pytest.mark.parametrize("options, fragment", BAD_OPTIONS, ids=["points", "start", "backwards", "too-long"])
+@pytest.mark.parametrize("options, fragment", BAD_OPTIONS,
+                         ids=["points", "torque-huge", "time-huge", "start", "backwards", "too-long"])
 def test_bad_profile_options_one_line(tmp_path, capsys, options, fragment):
     assert main(["run", "demo-3p", "--duration", "0.01", "--out", str(tmp_path / "out"), *options]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and fragment in err[0], err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_table_file_says_its_own_name_and_the_unit_it_does_not_know(tmp_path, capsys):
+    table = tmp_path / "speed.csv"
+    table.write_text("time_s,speed_furlong\n0,1\n1,2\n")
+    assert main(["run", "demo-3p", "--speed-profile", str(table), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (f"gearcheck: error: --speed-profile: {str(table)!r}: column 'speed_furlong': unknown speed unit "
+                   "(use rpm, rad_s, hz)")
+    with pytest.raises(gearcheck.GearcheckError, match=r"^operating.history.start: 'soon': one of steady, rest$"):
+        gearcheck.load("demo-3p", speed_profile="0:1500,1:2000", start="soon")
 
 
 def test_speed_history_needs_the_input_shaft(tmp_path, capsys):

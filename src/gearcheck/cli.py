@@ -43,7 +43,7 @@ from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
 from gearcheck.shared.trust import granted
 from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
 from gearcheck.train.files import report_folders, train_list
-from gearcheck.train.history import START
+from gearcheck.train.schema import HISTORY_START
 
 
 FULL = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}  # a disk full, a quota, a read-only file system
@@ -878,7 +878,7 @@ PROFILES = (  # an operating history from the command line (gearcheck.train.hist
     arg("--torque-profile", metavar="FILE|T:NM,...",
         help="input torque over time instead (N·m; the speed follows from the rigid train, the input shaft unused)"),
     arg("--load-profile", metavar="FILE|T:NM,...", help="output load torque over time (N·m, opposing rotation)"),
-    arg("--start", choices=START,
+    arg("--start", choices=HISTORY_START,
         help="start of a profile run: steady state at its initial speed, or at rest (default: rest from 0 rpm or a "
              "torque, else steady)"),
 )

@@ -22,8 +22,9 @@ import numpy as np
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.train.expression import Expression
 from gearcheck.train.history_file import read_history_table
+from gearcheck.train.schema import HISTORY_START, LIMITS
+from gearcheck.shared.units import MAX_RPM
 
-START = ("steady", "rest")
 CLOCK_STEPS = 4096  # RK4 steps of the rigid train's speed over a torque history (Hermite-interpolated between)
 MAX_POINTS = 1_000_000  # a history's points: a minute sampled at 16 kHz
 
@@ -244,15 +245,18 @@ def parse_history(raw: dict, source: str, locate, fail) -> History:
         label = f"--{name}-profile" if source == "command line" else f"{source}: operating.history.{key}"
         try:
             if key.endswith("_points"):
-                return Series.of_points(raw[key], label)
-            if key.endswith("_expression"):
+                series = Series.of_points(raw[key], label)
+            elif key.endswith("_expression"):
                 if raw["until_s"] is None:
                     raise GearcheckError("an expression needs operating.history.until_s, where the history ends")
-                return Series.of_expression(raw[key], label)
-            table = read_history_table(locate(raw[key]), quantity, f"{label} = {raw[key]!r}")
-            return Series.of_points(table, f"{label} = {raw[key]!r}")
-        except GearcheckError as exc:
-            raise fail(f"operating.history.{key}", str(exc).removeprefix(label).removeprefix(": ")) from None
+                series = Series.of_expression(raw[key], label)
+            else:
+                table = read_history_table(locate(raw[key]), quantity, f"{label} = {raw[key]!r}")
+                series = Series.of_points(table, f"{label} = {raw[key]!r}")
+            _check_bounds(series, quantity, raw["until_s"])
+            return series
+        except GearcheckError as exc:  # said of the field: the label's place, then the file's name if any
+            raise fail(f"operating.history.{key}", str(exc).removeprefix(label).lstrip(" =:")) from None
 
     speed, torque, load = series("speed", "speed"), series("torque", "torque"), series("load", "torque")
     if (speed is None) == (torque is None):
@@ -262,9 +266,27 @@ def parse_history(raw: dict, source: str, locate, fail) -> History:
         raise fail("operating.history.speed", "the input speed must stay >= 0 rpm (turn the train the other way "
                                               "round in the train file instead)")
     initial = None if speed is None else float(speed(0.0))
+    if raw["start"] is not None and raw["start"] not in HISTORY_START:
+        raise fail("operating.history.start", f"{raw['start']!r}: one of {', '.join(HISTORY_START)}")
     start = raw["start"] or ("rest" if torque is not None or initial == 0.0 else "steady")
     if start == "rest" and initial:
         raise fail("operating.history.start", f"rest, but the speed history starts at {initial:g} rpm")
     if start == "steady" and initial == 0.0:
         raise fail("operating.history.start", "steady, but the speed history starts at 0 rpm: start = \"rest\"")
     return History(speed, torque, load, start, raw["until_s"])
+
+
+def _check_bounds(series: Series, quantity: str, until: float | None) -> None:
+    """A history's times within the train file's bound on a time, its values within that on a speed (rpm) or a
+    torque (N·m) (:data:`gearcheck.train.schema.LIMITS` says why); an expression's sampled over its span."""
+    limit, unit = (MAX_RPM, "rpm") if quantity == "speed" else (LIMITS["torque"][0], "N·m")
+    if series.times is not None:
+        times, values = np.asarray(series.times), np.asarray(series.values)
+    else:
+        times = np.linspace(0.0, until, 1001)
+        values = series(times)
+    if times[-1] > LIMITS["time"][0]:
+        raise GearcheckError(f"{series.label}: times must be <= {LIMITS['time'][0]:g} s, got {times[-1]:g}")
+    if np.max(np.abs(values)) > limit:
+        raise GearcheckError(f"{series.label}: values must be within ±{limit:g} {unit}, got "
+                             f"{values[np.argmax(np.abs(values))]:g}")

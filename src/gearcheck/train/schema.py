@@ -17,7 +17,6 @@ from typing import Any
 
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import TrainFileError, did_you_mean, shown
-from gearcheck.train.history import START
 from gearcheck.shared.units import MAX_RPM, RAD_S_PER_RPM, SUFFIXES
 
 REQUIRED = object()
@@ -609,6 +608,8 @@ def _points(what: str, unit: str, maximum: float) -> ListOf:
                         "held", None, 1, unit=f"s, {unit}", max_length=1_000_000)
 
 
+HISTORY_START = ("steady", "rest")  # where an operating history starts
+
 HISTORY = Table(
     {
         "speed_points": _points("input speed", "rpm", bound("speed", RAD_S_PER_RPM) / RAD_S_PER_RPM),
@@ -624,7 +625,7 @@ HISTORY = Table(
         "load_expression": Text("output load torque in N·m as an expression of t in s", None),
         "start": Text("steady: from the steady state at the initial speed; rest: everything at rest, undeformed "
                       "(default: rest when the history starts at 0 rpm or from a torque, else steady)", None,
-                      START),
+                      HISTORY_START),
         "until_s": Positive("where a history given by expressions ends", "s", None, bound("time")),
     },
     "operating history: a prescribed input speed (through the input shaft) or input torque (the speed follows "

@@ -1,16 +1,23 @@
-"""Benchmark of the sweep engine (not a test): a hub-drive speed sweep on 1 and 2 local worker processes and on a
-Dask LocalCluster of 2 single-threaded worker processes, no cache.
+"""Benchmark of the sweep engine (not a test): a hub-drive speed sweep on local worker processes and on a Dask
+LocalCluster, and what each of its savings gains.
 
-Prints, per backend, the wall time, the wall time per point, the speed-up and parallel efficiency against one
-worker, and the time the full target sweep would take at that rate: 181 points (200 to 2000 rpm in 10 rpm
-steps), 0.5 s simulated each, both solvers, in at most 3 minutes on 2 cores.  It also checks that every
-backend gave the same table, byte for byte.  Run it small:
+The target grid is 181 speeds, 200 to 2000 rpm in 10 rpm steps, both solvers, the sweep's defaults (0.5 s for a
+point from the static state, speed continuation, the integration check on the subset), in at most 3 minutes on
+2 cores.  Two parts, side by side in one run:
 
-    OPENBLAS_NUM_THREADS=1 python bench/bench_sweep.py --points 6 --duration 0.1
+* backends (``--workers``, ``--no-dask``): the default sweep on 1 and 2 local processes and on a Dask
+  LocalCluster of 2 single-threaded workers, no cache: wall time, per point, speed-up and parallel efficiency,
+  and that every backend gave the same table, byte for byte;
+* gains (``--gains``): the same speeds under each setting that led to the default, each saving on its own --
+  every point from the static state with every point checked (the engine before continuation), then the checked
+  subset, then continuation without checks, then both -- CPU seconds per point and the ratio to the first.
 
-and in full with ``--points 181``.  The points are spread evenly over the target's speed range, so a small run
-samples the same mix of slow and fast points; the per-point rate extrapolates linearly (pool and cluster start-up
-included, so a small run understates the scaling).
+``--span A:B`` runs only the grid's speeds from A to B rpm (the same 10 rpm steps, so a point continues from its
+neighbour as in the full sweep), and the full sweep's wall time is extrapolated from the CPU per point.  Quick:
+
+    OPENBLAS_NUM_THREADS=1 python bench/bench_sweep.py --span 1000:1100 --no-dask --gains
+
+and in full without ``--span``.
 """
 
 from __future__ import annotations
@@ -24,6 +31,12 @@ import numpy as np
 from gearcheck.compare.studies.sweep import sweep
 
 TARGET_POINTS, TARGET_S = 181, 180.0
+GAINS = {  # label: (continuation, integration check)
+    "from rest, all checked (before)": (False, "all"),
+    "from rest, subset checked": (False, "subset"),
+    "continued, none checked": (True, "none"),
+    "continued, subset checked (default)": (True, "subset"),
+}
 
 
 def warm() -> None:
@@ -34,28 +47,17 @@ def warm() -> None:
     engine.run_point(engine.plan_sweep("demo-3p", speeds=[1000.0], duration=0.01).points[0])
 
 
-def mujoco_floor(train: str, speed: float, duration: float) -> float:
-    """CPU seconds of the MuJoCo twin's run of one point (compiled step loop, the model already built)."""
-    from gearcheck.train.loader import load_train
-    from gearcheck.mbd_models.side import MujocoSide
-    from gearcheck.shared.settings import RunSettings
-
-    side = MujocoSide(load_train(train, speed))
-    side.run(RunSettings(0.001))  # the model built and the kernel loaded outside the timing
-    started = time.process_time()
-    side.run(RunSettings(duration))
-    return time.process_time() - started
-
-
-def timed(label, count, speeds, args, **backend):
+def timed(label, count, speeds, args, continuation=True, check="subset", **backend):
     started = time.perf_counter()
     result = sweep(args.train, speeds=speeds, solvers=args.solver, duration=args.duration, cache=None,
-                   integration_check=args.integration_check, **backend)
+                   integration_check=check, continuation=continuation, **backend)
     wall = time.perf_counter() - started
+    frame = result.to_pandas().query("metric == 'rms'").drop_duplicates(["point", "solver"])
     return {"label": label, "workers": count, "wall": wall, "per_point": wall / len(speeds),
             "busy": sum(result.point_wall_s) / (count * wall), "load": os.getloadavg()[0],
             "cpu": sum(result.point_cpu_s) / len(speeds), "cores": sum(result.point_cpu_s) / wall,
-            "bytes": result.parquet()}
+            "continued": float(np.mean(frame["start"] == "continued")),
+            "checked": float(np.mean(frame["checked"] != "no")), "bytes": result.parquet()}
 
 
 def main(argv=None):
@@ -64,19 +66,23 @@ def main(argv=None):
     p.add_argument("--points", type=int, default=TARGET_POINTS, help="speeds from --low to --high (default 181)")
     p.add_argument("--low", type=float, default=200.0)
     p.add_argument("--high", type=float, default=2000.0)
-    p.add_argument("--duration", type=float, default=0.5, help="simulated s per point and solver (default 0.5)")
+    p.add_argument("--span", metavar="A:B", help="run only the grid's speeds from A to B rpm")
+    p.add_argument("--duration", type=float, default=0.5, help="simulated s of a point from rest (default 0.5)")
     p.add_argument("--solver", default="both", choices=("both", "lumped", "mujoco"))
     p.add_argument("--workers", default="1,2", help="local process counts (default 1,2)")
     p.add_argument("--no-dask", action="store_true", help="leave the Dask LocalCluster out")
-    p.add_argument("--integration-check", action="store_true",
-                   help="run each solver's integration check too (the sweep's default; the target counts each "
-                        "solver once per point)")
+    p.add_argument("--gains", action="store_true", help="also run each saving on its own (on the most workers)")
     args = p.parse_args(argv)
-    speeds = np.linspace(args.low, args.high, args.points).tolist() if args.points > 1 else [args.low]
-    print(f"{args.train}: {args.points} points from {speeds[0]:g} to {speeds[-1]:g} rpm, {args.duration:g} s each, "
-          f"solver {args.solver}, integration check {'on' if args.integration_check else 'off'}")
-    rows = [timed(f"processes ({n})" if n > 1 else "in-process (1)", n, speeds, args, workers=n)
-            for n in (int(w) for w in args.workers.split(","))]
+    grid = np.linspace(args.low, args.high, args.points) if args.points > 1 else np.array([args.low])
+    if args.span:
+        a, b = (float(x) for x in args.span.split(":"))
+        grid = grid[(grid >= a - 1e-9) & (grid <= b + 1e-9)]
+    speeds = grid.tolist()
+    print(f"{args.train}: {len(speeds)} of the {args.points} grid points from {speeds[0]:g} to {speeds[-1]:g} rpm, "
+          f"solver {args.solver}, {args.duration:g} s from rest; {os.cpu_count()} cores, load "
+          f"{os.getloadavg()[0]:.1f} before")
+    counts = [int(w) for w in args.workers.split(",")]
+    rows = [timed(f"processes ({n})" if n > 1 else "in-process (1)", n, speeds, args, workers=n) for n in counts]
     if not args.no_dask:
         from distributed import Client, LocalCluster
 
@@ -89,30 +95,35 @@ def main(argv=None):
                               scheduler=client))
     base = rows[0]["per_point"] * rows[0]["workers"]
     print(f"\n{'backend':<48} {'workers':>7} {'wall [s]':>9} {'s/point':>8} {'speed-up':>8} {'efficiency':>10} "
-          f"{'busy':>5} {'CPU s/point':>11} {'cores used':>10} {'load':>5} {'181 points [s]':>14}")
+          f"{'busy':>5} {'CPU s/point':>11} {'cores used':>10} {'load':>5}")
     for r in rows:
         speedup = base / r["per_point"]
         print(f"{r['label']:<48} {r['workers']:>7} {r['wall']:>9.2f} {r['per_point']:>8.3f} {speedup:>8.2f} "
               f"{speedup / r['workers']:>10.2f} {r['busy']:>5.2f} {r['cpu']:>11.3f} {r['cores']:>10.2f} "
-              f"{r['load']:>5.1f} {r['per_point'] * TARGET_POINTS:>14.1f}")
-    print("busy: the share of the workers' time spent inside points (1: the engine leaves no worker idle); CPU "
-          "s/point: the CPU time of a point in its worker (the same work on every backend); cores used: the workers' "
-          "CPU time over the wall time; load: the 1-minute load average after the run, on "
-          f"{os.cpu_count()} cores (above the worker count, other processes share the cores, and the speed-up "
-          "measures them too)")
-    print(f"\nCPU time per point (one worker): {rows[0]['cpu']:.3f} s; on 2 idle cores the {TARGET_POINTS}-point sweep "
-          f"would take {rows[0]['cpu'] * TARGET_POINTS / 2:.0f} s at that rate")
-    floor = mujoco_floor(args.train, 0.5 * (speeds[0] + speeds[-1]), args.duration)
-    print(f"MuJoCo's share (one run at {0.5 * (speeds[0] + speeds[-1]):g} rpm, in this process): {floor:.3f} s CPU; "
-          f"{TARGET_POINTS} runs on 2 cores take {floor * TARGET_POINTS / 2:.0f} s of MuJoCo alone")
-    same = all(r["bytes"] == rows[0]["bytes"] for r in rows)
-    print(f"tables identical across backends: {'yes' if same else 'NO'}")
-    best = min(r["per_point"] * TARGET_POINTS for r in rows if r["workers"] <= 2)
-    full = args.duration == 0.5 and args.solver == "both" and args.train == "hub-drive" and not args.integration_check
-    verdict = ("met" if best <= TARGET_S else "not met") if full else "not judged"
-    print(f"target: {TARGET_POINTS} points, 0.5 s each, both solvers, <= {TARGET_S:.0f} s on 2 cores; "
-          f"{'this run' if full else 'this run (NOT the target settings: --duration 0.5 --solver both, no check)'} "
-          f"extrapolates to {best:.0f} s on 2 workers: {verdict}")
+              f"{r['load']:>5.1f}")
+    print("busy: the share of the workers' time spent inside points; CPU s/point: the CPU time of a point in its "
+          "worker (the same work on every backend); cores used: the workers' CPU time over the wall time; load: "
+          "the 1-minute load average after the run")
+    print(f"tables identical across backends: {'yes' if all(r['bytes'] == rows[0]['bytes'] for r in rows) else 'NO'}")
+    print(f"continued points: {rows[0]['continued']:.0%}; checked points: {rows[0]['checked']:.0%}")
+    if args.gains:
+        most = max(counts)
+        gains = [timed(label, most, speeds, args, continuation, check, workers=most)
+                 for label, (continuation, check) in GAINS.items()]
+        print(f"\n{'setting':<40} {'CPU s/point':>11} {'gain':>6} {'wall [s]':>9} {'continued':>9} {'checked':>8} "
+              f"{'load':>5}")
+        for g in gains:
+            print(f"{g['label']:<40} {g['cpu']:>11.3f} {gains[0]['cpu'] / g['cpu']:>6.2f} {g['wall']:>9.2f} "
+                  f"{g['continued']:>9.0%} {g['checked']:>8.0%} {g['load']:>5.1f}")
+    full = len(speeds) == TARGET_POINTS and args.points == TARGET_POINTS and args.train == "hub-drive" and \
+        args.solver == "both" and args.duration == 0.5
+    two = [r for r in rows if r["workers"] == 2]
+    if two:
+        measured = min(r["wall"] for r in two)
+        estimate = measured if full else rows[0]["cpu"] * TARGET_POINTS / 2
+        how = "measured" if full else f"extrapolated from {rows[0]['cpu']:.3f} CPU s/point on 2 idle cores"
+        print(f"\ntarget: {TARGET_POINTS} points, both solvers, the defaults, <= {TARGET_S:.0f} s on 2 cores: "
+              f"{estimate:.0f} s ({how}): {'met' if estimate <= TARGET_S else 'not met'}")
 
 
 if __name__ == "__main__":

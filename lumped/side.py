@@ -25,8 +25,9 @@ from gearcheck.lumped.periodic_steady_state import periodic_steady_state
 from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
 from gearcheck.shared import stepping
-from gearcheck.shared.modal import ModalResult, slowest_decaying_mode
+from gearcheck.shared.modal import ModalResult, damped_modes, slowest_decaying_mode
 from gearcheck.shared.results import TimeResult
+from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.side import Side
 from gearcheck.shared.units import rad_s_to_rpm
@@ -67,6 +68,12 @@ class LumpedSide(Side):
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate(self.model, settings, method=self.method, progress=progress)
 
+    def run_from(self, settings: RunSettings, state: RunState | None = None) -> tuple[TimeResult, RunState]:
+        """From the deflections q and their rates v of ``state`` (the model's own coordinates)."""
+        y0 = None if state is None else (state.coordinates[0], state.rates[0])
+        result, (q, v) = simulate(self.model, settings, method=self.method, y0=y0, return_state=True)
+        return result, RunState(float(result.t[-1]), (q,), (v,))
+
     def stable_step(self) -> float:
         return stable_step(self.model)
 
@@ -82,6 +89,11 @@ class LumpedSide(Side):
     def slowest_mode(self) -> tuple[float, float]:
         m = self.model
         return slowest_decaying_mode(m.M, m.C + m.G, m.K_mean + m.K_frame)
+
+    def resonances(self) -> tuple[np.ndarray, np.ndarray]:
+        """(natural frequencies in Hz, damping ratios) of the damped, rotating model at mean mesh stiffness."""
+        m = self.model
+        return damped_modes(m.M, m.C + m.G, m.K_mean + m.K_frame)
 
     def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
         steady = periodic_steady_state(self.model, dt=settings.dt)

@@ -181,14 +181,15 @@ def mechanical_energy(model, q, v) -> np.ndarray:
 
 
 def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e-8, atol: float = 1e-14, y0=None,
-             progress=None) -> TimeResult:
+             progress=None, return_state: bool = False) -> TimeResult:
     """Integrate ``model`` as ``settings`` ask.
 
     method: "rk4" (compiled steps, :mod:`gearcheck.lumped.compiled_steps`), "rk4-stages" (the same RK4 stage by
     stage in Python: the reference the compiled steps are tested against) or
     one of scipy's adaptive methods, whose largest step is then ``settings.dt``.
     The step defaults to :func:`default_step` and is checked against the stability limit.
-    y0: optional (q, v) instead of the static start.  progress: callable(fraction).
+    y0: optional (q, v) instead of the static start, at ``settings.start`` (which needs it).  progress:
+    callable(fraction).  return_state: return (result, (q, v)), the state after the last step.
     """
     if method not in ("rk4", "rk4-stages") + ADAPTIVE_METHODS:
         raise SolverError(f"unknown method {method!r}: use rk4, rk4-stages or one of {', '.join(ADAPTIVE_METHODS)}")
@@ -198,6 +199,7 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     top = 1.0 if nominal is None else max(1.0, nominal.top(settings.duration))
     if nominal is not None:
         check_duration(model.spec.operating.history, settings.duration, what)
+    settings.check_start(y0, model.spec.operating.history, what)
     limits = step_limits(model, top)
     frequency = top * model.excitation.frequency
     dt = stepping.default_step(limits, frequency) if settings.dt is None else settings.dt
@@ -214,10 +216,10 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
     started = clock.perf_counter()
     if method in ("rk4", "rk4-stages"):
         t_out, q_out, v_out, sub_steps, located = _rk4(sys, q0, v0, dt, n_steps, every, progress, runaway,
-                                                       method == "rk4-stages")
+                                                       method == "rk4-stages", settings.start)
         engine, stages, calls = "numba-rk4" if method == "rk4" else "python-rk4", 4, 4 * sub_steps
     else:
-        t_out, q_out, v_out, calls = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol)
+        t_out, q_out, v_out, calls = _adaptive(sys, q0, v0, dt, n_steps, every, method, rtol, atol, settings.start)
         runaway(t_out, q_out)
         engine, stages, located = f"scipy-{method}", None, None
     wall = clock.perf_counter() - started
@@ -226,19 +228,20 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
         "rhs_evaluations": calls, "wall_time_s": wall,  # sub-steps and located events included
         "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms,
         "contact_events_located": located})
-    return _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
+    result = _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
+    return (result, (q_out[-1].copy(), v_out[-1].copy())) if return_state else result
 
 
-def _chunk(sys, h, start, stop) -> Chunk:
-    """The (sub-)steps of steps start..stop-1 and their drive at their stage times
+def _chunk(sys, h, start, stop, t0: float = 0.0) -> Chunk:
+    """The (sub-)steps of steps start..stop-1 (step i from t0 + i h) and their drive at their stage times
     (:class:`~gearcheck.lumped.compiled_steps.Chunk`): a step inside which a mesh stiffness jumps is split there
     (:func:`~gearcheck.shared.stepping.split_steps`)."""
     steps = np.arange(start, stop)
     lengths = np.full(steps.size, h)
-    sample = (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
-    begins = steps * h
+    sample = t0 + (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
+    begins = t0 + steps * h
     ends = np.ones(steps.size, dtype=bool)
-    split = stepping.split_steps(h, start, stop, sys.exc.switch_times(start * h, stop * h))
+    split = stepping.split_steps(h, start, stop, sys.exc.switch_times(t0 + start * h, t0 + stop * h), t0)
     if split:
         counts = np.ones(steps.size, dtype=int)
         for i, inner in split.items():
@@ -249,7 +252,7 @@ def _chunk(sys, h, start, stop) -> Chunk:
         ends = np.zeros(row.size, dtype=bool)
         ends[first + counts - 1] = True
         for i, inner in split.items():
-            a, length = stepping.sub_steps(i * h, h, inner)
+            a, length = stepping.sub_steps(t0 + i * h, h, inner)
             r = first[i - start] + np.arange(a.size)
             begins[r], lengths[r] = a, length
             sample[r] = a[:, None] + length[:, None] * np.array(STAGE_OFFSETS)[None, :]
@@ -265,8 +268,8 @@ def _chunk_steps(sys) -> int:
     return int(max(64, min(CHUNK, CHUNK_BYTES // per_step)))
 
 
-def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False):
-    """Fixed-step RK4 over n_steps, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
+def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, t0: float = 0.0):
+    """Fixed-step RK4 over n_steps from t0, sampling every ``every`` steps; ``runaway(t, q)`` checks each chunk's
     samples and its last state for divergence.  The compiled steps (:func:`~gearcheck.lumped.compiled_steps.
     rk4_steps`), or with ``stage_by_stage`` :func:`rk4_step` on :meth:`_System.acceleration` in Python.  Returns the
     samples' (t, q, v) and the sub-steps taken (steps split at stiffness jumps count each of theirs)."""
@@ -275,20 +278,20 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False):
     t_out = np.empty(n_out)
     q_out = np.empty((n_out, n))
     v_out = np.empty((n_out, n))
-    t_out[0], q_out[0], v_out[0] = 0.0, q, v
+    t_out[0], q_out[0], v_out[0] = t0, q, v
     q, v = q.copy(), v.copy()
     j, sub_steps = 1, 0
     located = np.zeros(1, dtype=np.int64)
     chunk = _chunk_steps(sys)
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
-        steps = _chunk(sys, h, start, stop)
+        steps = _chunk(sys, h, start, stop, t0)
         sub_steps += steps.lengths.size
         out = Output(start, every, q_out[j:], v_out[j:])
         steps_of = _python_steps if stage_by_stage else sys.compiled_steps
         written = steps_of(sys, q, v, steps, out, located) if stage_by_stage else steps_of(q, v, steps, out, located)
-        t_out[j:j + written] = h * (every * (start // every + 1 + np.arange(written)))
-        runaway(np.append(t_out[j:j + written], stop * h), np.vstack([q_out[j:j + written], q[None]]))
+        t_out[j:j + written] = t0 + h * (every * (start // every + 1 + np.arange(written)))
+        runaway(np.append(t_out[j:j + written], t0 + stop * h), np.vstack([q_out[j:j + written], q[None]]))
         j += written
         if progress is not None:
             progress(stop / n_steps)
@@ -383,15 +386,15 @@ def rk4_step(acceleration, q, v, h):
     return q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol):
+def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol, t0: float = 0.0):
     n = q0.size
 
     def rhs(t, y):
         k, e, de, tin, tout, pairs = sys.drive(t)
         return np.concatenate([y[n:], sys.acceleration(y[:n], y[n:], k, e, de, tin, tout, t, pairs)])
 
-    t_eval = h * np.arange(0, n_steps + 1, every)
-    sol = solve_ivp(rhs, (0.0, n_steps * h), np.concatenate([q0, v0]), method=method, t_eval=t_eval,
+    t_eval = t0 + h * np.arange(0, n_steps + 1, every)
+    sol = solve_ivp(rhs, (t0, t0 + n_steps * h), np.concatenate([q0, v0]), method=method, t_eval=t_eval,
                     max_step=h * every, rtol=rtol, atol=atol)
     if not sol.success:
         raise DivergenceError(float(sol.t[-1]) if sol.t.size else 0.0, sol.message)

@@ -129,7 +129,7 @@ def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = TOL
 
     def period_map(z: np.ndarray) -> np.ndarray:
         y = z * scale / w + offset
-        result, (qpos, qvel) = simulate_mujoco(mb, RunSettings(period, dt=h, output_dt=period),
+        result, (qpos, qvel, _) = simulate_mujoco(mb, RunSettings(period, dt=h, output_dt=period),
                                                initial_state=(y[:nq], y[nq:]), engine=engine, return_state=True)
         runs.append(result.info)
         return (np.concatenate([qpos - advance, qvel]) - offset) * w / scale

@@ -162,9 +162,10 @@ class _Stepper:
     the others), then the state advanced by RK4's weights.  Samples go into preallocated rows: sensordata, the
     force reader's generalized forces, and optionally the stiffness used and MuJoCo's energy."""
 
-    def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool):
+    def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool,
+                 t0: float = 0.0):
         m = mb.model
-        self.mb, self.m, self.d, self.h = mb, m, d, h
+        self.mb, self.m, self.d, self.h, self.t0 = mb, m, d, h, t0
         self.n_mesh = len(mb.mesh_tendon)
         self.drive = _Drive(mb)
         self.correction = DampingCorrection(mb, d)
@@ -272,7 +273,7 @@ class _Stepper:
             if step not in split:
                 self.step(self.h, [None if x is None else x[i] for x in values], sample)
                 continue
-            starts, lengths = stepping.sub_steps(step * self.h, self.h, split[step])
+            starts, lengths = stepping.sub_steps(self.t0 + step * self.h, self.h, split[step])
             for n, (rows, length) in enumerate(zip(zip(*(_rows(x) for x in self.drive.steps(starts, lengths))),
                                                    lengths)):
                 self.step(length, rows, sample and n == 0)
@@ -367,8 +368,9 @@ class _CompiledStepper(_Stepper):
     drive of a chunk of steps (and of its split steps' sub-steps) computed here in arrays, then every step in C.
     Not for the "bodies" stiffness clock (its stiffness models are Python functions of the bodies' angles)."""
 
-    def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool):
-        super().__init__(mb, d, h, n_samples, bodies, energy)
+    def __init__(self, mb: MbdModel, d: mujoco.MjData, h: float, n_samples: int, bodies: bool, energy: bool,
+                 t0: float = 0.0):
+        super().__init__(mb, d, h, n_samples, bodies, energy, t0)
         m, n, tc, reader = self.m, self.n_mesh, mb.turning, self.reader
         lib = compiled.library()
         self.c = (lib.forward, lib.forward_skip, lib.integrate_pos, lib.passive, lib.kinematics, lib.com_pos, lib.jac)
@@ -414,7 +416,7 @@ class _CompiledStepper(_Stepper):
         first, count = np.zeros(rows, dtype=np.int64), np.zeros(rows, dtype=np.int64)
         starts, lengths = [], []
         for step in sorted(split):
-            a, length = stepping.sub_steps(step * self.h, self.h, split[step])
+            a, length = stepping.sub_steps(self.t0 + step * self.h, self.h, split[step])
             first[step - start], count[step - start] = len(lengths), len(length)
             starts += list(a)
             lengths += list(length)
@@ -455,8 +457,9 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     potential energy in ``raw``.  engine: "compiled" (the step loop in C,
     :mod:`gearcheck.mbd_models.compiled`; the same steps, equal to round-off), "python" (the loop in Python),
     or "auto" (compiled wherever :func:`compiled_unsupported` allows, else Python); the result's ``info``
-    (:class:`~gearcheck.shared.run_info.RunInfo`) says which ran.  return_state: return (result, (qpos, qvel)),
-    the state after the last step.
+    (:class:`~gearcheck.shared.run_info.RunInfo`) says which ran.  return_state: return (result, (qpos, qvel,
+    act)), the state after the last step.  A run from ``settings.start`` > 0 goes on from the ``initial_state``
+    (qpos, qvel, act) of a run that ended there (act, the input servo's reference angle, then carries on from it).
     """
     if stiffness_clock not in ("nominal", "bodies"):
         raise SolverError(f"stiffness_clock must be 'nominal' or 'bodies', not {stiffness_clock!r}")
@@ -470,6 +473,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     what = f"MuJoCo model of {spec.name}"
     nominal, history = mb.excitation.clock, spec.operating.history
     check_duration(history, settings.duration, what)
+    settings.check_start(initial_state, history, what)
+    t0 = settings.start
     frequency = mb.excitation.frequency * (1.0 if nominal is None else max(1.0, nominal.top(settings.duration)))
     dt = stepping.default_step(mb.limits, frequency) if settings.dt is None else settings.dt
     stepping.check_step(dt, mb.limits, frequency, what)
@@ -481,7 +486,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         start = static if spec.operating.ramp == 0 else static_state(mb, 0.0)
         qpos0, qvel0 = start.qpos, start.qvel
     else:
-        qpos0, qvel0 = (np.asarray(x, dtype=float) for x in initial_state)
+        qpos0, qvel0, *act0 = (np.asarray(x, dtype=float) for x in initial_state)
 
     d = mujoco.MjData(m)
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy(), m.opt.enableflags,
@@ -491,8 +496,10 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     if record_energy:
         m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     d.qpos[:], d.qvel[:] = qpos0, qvel0
+    if initial_state is not None and act0:
+        d.act[:] = act0[0]
     kind = _CompiledStepper if use_compiled else _Stepper
-    stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy)
+    stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy, t0)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
     sub_steps = n_steps
     try:
@@ -501,19 +508,20 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
             stop = min(start + CHUNK, n_steps)
             j0 = stepper.j
             split = ({} if stiffness_clock == "bodies"
-                     else stepping.split_steps(dt, start, stop, mb.excitation.switch_times(start * dt, stop * dt)))
+                     else stepping.split_steps(dt, start, stop,
+                                               mb.excitation.switch_times(t0 + start * dt, t0 + stop * dt), t0))
             sub_steps += sum(inner.size for inner in split.values())
-            stepper.run(start, stop, every, stepper.drive.steps(dt * np.arange(start, stop), dt), split)
-            _check_divergence(stepper, j0, stop * dt, every * dt, scale, what)
+            stepper.run(start, stop, every, stepper.drive.steps(t0 + dt * np.arange(start, stop), dt), split)
+            _check_divergence(stepper, j0, t0, stop * dt, every * dt, scale, what)
             if progress is not None:
                 progress(stop / n_steps)
-        stepper.finish(n_steps * dt)
+        stepper.finish(t0 + n_steps * dt)
         wall = clock.perf_counter() - started
     finally:
         m.tendon_stiffness[:], m.tendon_lengthspring[:], m.wrap_prm[:] = saved[0], saved[1], saved[2]
         m.opt.enableflags, m.opt.timestep, m.opt.integrator = saved[3], saved[4], saved[5]
         m.tendon_damping[:] = saved[6]
-    t = dt * every * np.arange(stepper.j)
+    t = t0 + dt * every * np.arange(stepper.j)
     loop = "compiled" if use_compiled else "python"
     sub_steps += 2 * stepper.located  # a located event takes its step again in two parts
     info = RunInfo(f"mujoco-{loop}", n_steps, 4, 4 * sub_steps, wall, {  # mj_forward at each of RK4's stages
@@ -524,7 +532,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         "forward_evaluations": 4 * sub_steps, "engine": loop,  # sub-steps and located events included
         "contact_events_located": stepper.located})
     result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
-    return (result, (d.qpos.copy(), d.qvel.copy())) if return_state else result
+    return (result, (d.qpos.copy(), d.qvel.copy(), d.act.copy())) if return_state else result
 
 
 def simulate_mujoco_many(twins, settings, threads: int | None = None, **options) -> list[TimeResult]:
@@ -556,13 +564,15 @@ def simulate_mujoco_many(twins, settings, threads: int | None = None, **options)
         return [job.result() for job in jobs]
 
 
-def _check_divergence(stepper: _Stepper, j0: int, t_now: float, interval: float, scale: float, what: str) -> None:
-    """Samples j0.. of the stepper and its current state, against :mod:`gearcheck.shared.divergence`."""
+def _check_divergence(stepper: _Stepper, j0: int, t0: float, elapsed: float, interval: float, scale: float,
+                      what: str) -> None:
+    """Samples j0.. of the stepper (the first at t0) and its current state ``elapsed`` after t0, against
+    :mod:`gearcheck.shared.divergence`."""
     mb, d, j = stepper.mb, stepper.d, stepper.j
     columns = [mb.sensor[f"{m.label}_deflection"][0] for m in mb.spec.meshes]
     state = d.ten_length[:len(mb.mesh_tendon)] if np.all(np.isfinite(d.qpos)) else np.full(len(columns), np.nan)
     deflection = np.vstack([stepper.sensors[j0:j][:, columns], state[None]])
-    divergence.check(np.append(interval * np.arange(j0, j), t_now), deflection, scale, what)
+    divergence.check(t0 + np.append(interval * np.arange(j0, j), elapsed), deflection, scale, what)
 
 
 def _body_clock(mb: MbdModel):

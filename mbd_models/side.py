@@ -21,6 +21,7 @@ from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
+from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.side import Side
 
@@ -59,6 +60,13 @@ class MujocoSide(Side):
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
         return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock)
+
+    def run_from(self, settings: RunSettings, state: RunState | None = None) -> tuple[TimeResult, RunState]:
+        """From the joints' positions, the input servo's reference angle and the joints' velocities of ``state``."""
+        initial = None if state is None else (state.coordinates[0], state.rates[0], state.coordinates[1])
+        result, (qpos, qvel, act) = simulate_mujoco(self.model, settings, stiffness_clock=self.stiffness_clock,
+                                                    initial_state=initial, return_state=True)
+        return result, RunState(float(result.t[-1]), (qpos, act), (qvel,))
 
     def stable_step(self) -> float:
         return stepping.stable_step(self.model.limits)

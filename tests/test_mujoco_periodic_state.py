@@ -47,7 +47,7 @@ def test_double_planet_periodic_state_is_a_fixed_point(double_planet):
     is within its tolerance (1e-8), and a run from the state returns to it after T_M, its hinges advanced by their
     nominal speeds times T_M, to the tolerance in the residual's unit: the first guess's (the static state's) largest
     deviation from the nominal motion."""
-    mb, shot, (run, (qpos, qvel)), _ = double_planet
+    mb, shot, (run, (qpos, qvel, _)), _ = double_planet
     assert shot.method == "anderson" and shot.residual <= TOLERANCE and shot.runs <= 20
     assert shot.period == pytest.approx(0.05, rel=1e-12) and shot.steps * shot.dt == pytest.approx(shot.period)
     assert (shot.info.steps, run.info["steps"]) == (shot.runs * shot.steps, shot.steps)
@@ -79,7 +79,7 @@ def test_demo_3p_shot_in_two_runs():
     after T_M, so Anderson acceleration converges in 2 runs (residual 5.8e-13), the run from the state is periodic,
     and its mesh forces agree with the lumped periodic run's to 1e-4 of their swing (measured 3.8e-6: 0.029 N of
     7625 N)."""
-    mb, shot, (run, (qpos, qvel)), lumped = both_shot("demo-3p")
+    mb, shot, (run, (qpos, qvel, _)), lumped = both_shot("demo-3p")
     assert shot.period == pytest.approx(62 * common_period(mb.excitation), rel=1e-12)
     assert shot.residual < 1e-9 and shot.runs <= 3
     deflection = np.max(np.abs(shot.qpos))

@@ -290,11 +290,11 @@ def test_ctrl_c_in_the_command_leaves_the_cache_and_no_table(tmp_path, capsys, m
     calls = []
     original = sw.run_point
 
-    def interrupted_second(point):
+    def interrupted_second(point, before=None):
         calls.append(point.index)
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return original(point)
+        return original(point, before)
 
     monkeypatch.setattr(sw, "run_point", interrupted_second)
     out = tmp_path / "sweep"

@@ -60,6 +60,7 @@ import pyarrow.parquet as pq
 import tomli_w
 from threadpoolctl import threadpool_limits
 
+from gearcheck.compare.studies import continuation as continued
 from gearcheck.compare.studies import point_backends as backends
 from gearcheck.compare.engine.align import steady_state
 from gearcheck.compare.studies.calibrate import FitParameter
@@ -81,7 +82,7 @@ from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import richardson_factor
 from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
 
-FORMAT = 2  # of the table; part of every point's key
+FORMAT = 3  # of the table; part of every point's key
 SOLVERS = ("lumped", "mujoco")
 DURATION = 0.5  # s simulated per point and solver
 HARMONICS = 3
@@ -89,6 +90,8 @@ STATISTICS = ("mean", "rms", "peak_to_peak")
 MAX_POINTS = 100_000  # each point carries its edited train file (some 10 kB): 1 GB of points at most
 MAX_REFINE = 64
 MAX_HARMONICS = 20
+CHECKS = ("subset", "all", "none")  # which points get the integration check
+CHECK_EVERY = 8  # the subset: every CHECK_EVERY-th point, and every point with a line in a mode's half-power band
 
 KEY = "gearcheck.point"  # a point table's metadata: the point's key (Point.key), checked when read from the cache
 POINT_SCHEMA = pa.schema([
@@ -96,7 +99,8 @@ POINT_SCHEMA = pa.schema([
     ("metric", pa.string()), ("mesh", pa.string()), ("order", pa.int64()), ("frequency_hz", pa.float64()),
     ("amplitude", pa.float64()), ("phase_rad", pa.float64()), ("resolved", pa.bool_()),
     ("integration_error", pa.float64()), ("steady", pa.string()),
-    ("steady_start_s", pa.float64()), ("dt_s", pa.float64()), ("error", pa.string()),
+    ("steady_start_s", pa.float64()), ("dt_s", pa.float64()), ("start", pa.string()), ("checked", pa.string()),
+    ("error", pa.string()),
 ])
 """The columns :func:`run_point` gives (what the cache holds per point)."""
 
@@ -117,10 +121,15 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
     "phase_rad": ("rad", "phase of the harmonic, cos(2 pi f t + phase), t from the run's start"),
     "resolved": ("", "the steady window separates the line from its neighbours and from DC"),
     "integration_error": ("unit", "estimate of the integration error of amplitude: its change on doubling the "
-                                  "step (null without the check)"),
-    "steady": ("", "detected, decayed or none (then the second half of the run)"),
+                                  "step (null where the point was not checked)"),
+    "steady": ("", "detected, decayed or none (then the second half of the run); continued: the start's "
+                   "mismatch decayed (see start)"),
     "steady_start_s": ("s", "start of the steady window"),
     "dt_s": ("s", "the solver's step"),
+    "start": ("", "cold (from the static state), continued (from the previous speed's final state) or 'cold: "
+                  "continuation did not settle'"),
+    "checked": ("", "why the point's integration error was estimated: all, every Nth (every Nth speed), "
+                    "resonance (a line in the half-power band of a mode), or no"),
     "error": ("", "why a solver failed at this point (metric failed)"),
     "key": ("", "SHA-256 of the point's inputs: its cache file's name"),
 }
@@ -227,17 +236,22 @@ class Point:
     values: tuple = ()  # ((field path, value), ...) of the swept fields
     seed: int | None = None
     extra: str = ""  # digest of files the train reads (a torque CSV)
-    check: bool = True  # each run's integration check (a second run at 2 h or h / 2)
+    check: str = "subset"  # which points run an integration check (a second run at 2 h or h / 2): CHECKS
     refine: int = 1  # each solver's default step divided by this
+    after: str = ""  # the key of the point whose final state this one goes on from ("": the static state)
+    after_rpm: float | None = None  # that point's speed
+    place: int = 0  # its place among its parameter set's speeds (every CHECK_EVERY-th is in the checked subset)
 
     @property
     def key(self) -> str:
         """SHA-256 of the point's canonical inputs: the edited train file's text and the files it reads, not
-        where it lies nor the point's index (the same run in two sweeps shares it)."""
+        where it lies, and the key of the point it goes on from, not its index (the same run in two sweeps shares
+        it)."""
         data = {"format": FORMAT, "gearcheck": version(), "train": self.text,
                 "speed_rpm": self.speed_rpm, "solvers": list(self.solvers), "duration_s": self.duration,
                 "harmonics": self.harmonics, "files": self.extra, "integration_check": self.check,
-                "refine": self.refine}
+                "refine": self.refine, "after": self.after, "after_rpm": self.after_rpm, "place": self.place,
+                "checked_every": CHECK_EVERY if self.check == "subset" else None}
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
 
 
@@ -251,17 +265,21 @@ class SweepPlan:
 
 def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
                solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS,
-               integration_check: bool = True, refine: int = 1) -> SweepPlan:
+               integration_check: bool | str = "subset", refine: int = 1, continuation: bool = True) -> SweepPlan:
     """The points of a sweep, validated before anything runs (every edited train file loads, every speed is
     one the train can turn at).  ``fields``: {path: [values]} (a grid over all of them); ``distributions``:
     {path: "normal(mean, sd)" or Distribution} with ``samples`` draws seeded ``seed``; ``speeds`` in rpm
-    (None: the file's); ``integration_check``: run each solver a second time for its integration error;
-    ``refine``: each solver's default step divided by it.  Parameter sets are the outer loop, speeds the inner."""
+    (None: the file's); ``integration_check``: which points run each solver a second time for its integration
+    error, "subset" (every ``CHECK_EVERY``-th point and every point with a line near a natural frequency), "all"
+    (True) or "none" (False); ``refine``: each solver's default step divided by it; ``continuation``: each point
+    at the speed after its neighbour's goes on from that one's final state
+    (:mod:`gearcheck.compare.studies.continuation`); ``duration`` is then the longest a point runs.  Parameter
+    sets are the outer loop, speeds the inner."""
     if isinstance(train, TrainSpec):
         raise GearcheckError("a sweep needs the train file (a preset name or a path), not a loaded TrainSpec: "
                              "it edits the file's numbers and hashes its text")
     solvers = _solvers(solvers)
-    _check_run_options(duration, harmonics, integration_check, refine)
+    integration_check = _check_run_options(duration, harmonics, integration_check, refine, continuation)
     text, source = read_train_text(train)
     base = load_text(text, source)
     document = tomllib.loads(text)
@@ -279,8 +297,11 @@ def plan_sweep(train, *, speeds=None, fields=None, distributions=None, samples: 
     common = dict(source=source, solvers=solvers, duration=float(duration), harmonics=harmonics, seed=drawn,
                   extra=_files_digest(document, source), check=integration_check, refine=refine)
     points = _points(document, base, sets, speeds, "distributions" if laws else "fields", common)
+    if continuation:
+        points = continued.link(points)
     settings = {"train": base.name, "source": source, "solvers": list(solvers), "duration_s": float(duration),
                 "harmonics": harmonics, "integration_check": integration_check, "refine": refine,
+                "continuation": continuation,
                 "speeds_rpm": speeds,
                 "grid": {f.path: [float(v) for v in vs] for f, vs in grid.items()},
                 "distributions": {f.path: str(d) for f, d in laws.items()},
@@ -294,15 +315,21 @@ def check_harmonics(harmonics) -> None:
         raise GearcheckError(f"harmonics={harmonics!r}: needs an integer from 1 to {MAX_HARMONICS}")
 
 
-def _check_run_options(duration, harmonics, integration_check, refine) -> None:
-    """Refuse a setting of every point's runs that is out of its range (the integration check: not a bool)."""
+def _check_run_options(duration, harmonics, integration_check, refine, continuation) -> str:
+    """Refuse a setting of every point's runs that is out of its range; the integration check as one of
+    :data:`CHECKS` (True: "all", False: "none")."""
     if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not (0 < duration < math.inf):
         raise GearcheckError(f"duration={duration!r}: needs a positive number of seconds")
     check_harmonics(harmonics)
-    if not isinstance(integration_check, bool):
-        raise GearcheckError(f"integration_check={integration_check!r}: needs True or False")
+    if isinstance(integration_check, bool):
+        integration_check = "all" if integration_check else "none"
+    if integration_check not in CHECKS:
+        raise GearcheckError(f"integration_check={integration_check!r}: needs {', '.join(CHECKS)} (or True, False)")
     if isinstance(refine, bool) or not isinstance(refine, int) or not 1 <= refine <= MAX_REFINE:
         raise GearcheckError(f"refine={refine!r}: needs an integer from 1 to {MAX_REFINE}")
+    if not isinstance(continuation, bool):
+        raise GearcheckError(f"continuation={continuation!r}: needs True or False")
+    return integration_check
 
 
 def _varied_fields(document: dict, fields, distributions, samples) -> tuple[dict, dict]:
@@ -354,8 +381,8 @@ def _points(document: dict, base, sets: list[dict], speeds, argument: str, commo
         canonical, spec = _edited_train(document, common["source"], base, values, what)
         if speeds and (i == 0 or values):  # bounds and pitch-line speed grow with the speed: the ends decide
             _check_speed_ends(spec, speeds, where)
-        for speed in speeds or [None]:
-            points.append(Point(index=len(points), text=canonical, speed_rpm=speed, sample=i,
+        for place, speed in enumerate(speeds or [None]):
+            points.append(Point(index=len(points), text=canonical, speed_rpm=speed, sample=i, place=place,
                                 values=tuple((f.path, float(v)) for f, v in values.items()), **common))
     return points
 
@@ -453,16 +480,32 @@ class _Rows:
         return pa.table(self.columns, schema=POINT_SCHEMA)
 
 
-def run_point(point: Point) -> tuple[bytes, float, float]:
-    """Run ``point``: (its table as Parquet bytes, wall time in s, CPU time of this process in s).  A solver that
-    fails on the point (it diverges, or refuses a step) gives one row ``metric = "failed"`` with the reason; the
-    others still run.  The point runs on one BLAS thread: the cores go to the workers, and a point's numbers are
-    then the same to the last bit whichever backend runs it (a multi-threaded BLAS sums in another order)."""
+def run_chain(chain: continued.Chain, each=None) -> list[tuple[str, bytes, float, float]]:
+    """Run the points of ``chain`` in order, each going on from the one before
+    (:mod:`gearcheck.compare.studies.continuation`): (key, table as Parquet bytes, wall time in s, CPU time of this
+    process in s) of each, also given to ``each`` as it ends (a run in this process stores it at once).  A solver
+    that fails on a point (it diverges, or refuses a step) gives one row ``metric = "failed"`` with the reason; the
+    others still run, and the next point starts that solver from the static state.  The points run on one BLAS
+    thread: the cores go to the workers, and a point's numbers are then the same to the last bit whichever backend
+    runs it (a multi-threaded BLAS sums in another order)."""
+    done, before = [], chain.before
+    for point in chain.points:
+        data, wall, cpu = run_point(point, before if point.after else None)
+        done.append((point.key, data, wall, cpu))
+        if each is not None:
+            each(chain, done[-1:])
+        before = data
+    return done
+
+
+def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, float]:
+    """Run ``point`` (from ``before``, its predecessor's table, where it goes on from one): (its table as Parquet
+    bytes, wall time in s, CPU time of this process in s); see :func:`run_chain`."""
     with threadpool_limits(limits=1):
-        return _run_point(point)
+        return _run_point(point, before)
 
 
-def _run_point(point: Point) -> tuple[bytes, float, float]:
+def _run_point(point: Point, before: bytes | None) -> tuple[bytes, float, float]:
     started, cpu = time.perf_counter(), time.process_time()
     spec = load_train(load_text(point.text, point.source), point.speed_rpm)
     lumped = LumpedSide(spec)
@@ -475,32 +518,100 @@ def _run_point(point: Point) -> tuple[bytes, float, float]:
             rows.add(solver="lumped", quantity=f"mode{k}", kind=kind, unit="Hz", metric="natural_frequency",
                      order=k, frequency_hz=float(f))
     lines = [(label, k, k * f) for label, f in mesh_groups(spec, model.kin) for k in range(1, point.harmonics + 1)]
+    checked = _checked(point, [f for _, _, f in lines], *lumped.resonances())
+    states = {}
     for solver in point.solvers:
         side = lumped if solver == "lumped" else MujocoSide(spec)
         try:
-            result = side.run(RunSettings(point.duration, dt=side.default_step() / point.refine))
-            check = (side.run(RunSettings(point.duration, dt=check_step(side, result.info["dt_s"])))
-                     if point.check else None)
+            run = _steady_run(side, point, plan, lines, before)
+            check = _check_run(side, point, run) if checked != "no" else None
         except SolverError as exc:
             rows.add(solver=solver, quantity="", metric="failed", error=str(exc))
             continue
-        reduce_run(result, plan, lines, rows, solver, check, model.excitation.switch_times)
+        reduce_run(run.result, plan, lines, rows, solver, run.steady, check, model.excitation.switch_times,
+                   {"start": run.start, "checked": checked})
+        states[solver] = continued.kept(run.state, run.rho, run.shapes)
+    metadata = {KEY: point.key, continued.STATE: json.dumps(states, sort_keys=True)}
     sink = io.BytesIO()
-    pq.write_table(rows.table().replace_schema_metadata({KEY: point.key}), sink, compression="zstd")
+    pq.write_table(rows.table().replace_schema_metadata(metadata), sink, compression="zstd")
     return sink.getvalue(), time.perf_counter() - started, time.process_time() - cpu
 
 
-def reduce_run(result, plan, lines, rows: _Rows, solver: str, check=None, switch_times=None) -> None:
+def _checked(point: Point, lines: list[float], natural: np.ndarray, damping: np.ndarray) -> str:
+    """Why ``point`` runs its integration check ("no": it does not): the sweep's ``check`` setting, and in the
+    subset, its place among the speeds (every :data:`CHECK_EVERY`-th) or a line in the half-power band of a mode
+    of the damped model (|f - f_n| <= zeta_n f_n, ``natural`` and ``damping``), where the response is amplified and
+    most sensitive to the step."""
+    if point.check != "subset":
+        return "all" if point.check == "all" else "no"
+    if point.place % CHECK_EVERY == 0:
+        return f"every {CHECK_EVERY}th"
+    if any(np.any(np.abs(f - natural) <= damping * natural) for f in lines):
+        return "resonance"
+    return "no"
+
+
+@dataclass
+class _SteadyRun:
+    """A point's run of one solver: the run, where its steady window starts and how it was found (the
+    ``steady`` column), how it started (``start``), the state it ended in, its start's mismatch rho (continued
+    runs), its mesh forces' steady waveforms, and the state it started from with its step (for the integration
+    check)."""
+
+    result: object
+    steady: tuple[float, str]
+    start: str
+    state: object
+    rho: float | None
+    shapes: dict
+    initial: object
+    dt: float
+
+
+def _steady_run(side, point: Point, plan, lines, before) -> _SteadyRun:
+    """The point's run of ``side``: continued from ``before`` where the point goes on from its neighbour and that
+    settles, else from the static state over the point's duration, its steady window found by the plan's rule."""
+    dt = side.default_step() / point.refine
+    groups = plan.steady_groups(_signal_names(plan.spec))
+    state, rho, shapes = continued.carried(before, side.solver)
+    start = "cold"
+    if state is not None:
+        initial = state.at_speed(point.speed_rpm / point.after_rpm)
+        found = continued.run_continued(side, dt, initial, rho, continued.window_length(plan, lines), groups,
+                                        shapes, point.duration)
+        if found is not None:
+            result, at, rho, final, shapes = found
+            return _SteadyRun(result, (at, "continued"), "continued", final, rho, shapes, initial, dt)
+        start = "cold: continuation did not settle"
+    result, final = side.run_from(RunSettings(point.duration, dt=dt))
+    series = [(np.stack([result[n] for n in forces], axis=1), cycle) for forces, cycle in groups]
+    at, how = steady_state(result.t, series, plan.settle) if series else (None, None)
+    if at is None:
+        at, how = 0.5 * result.t[-1], "none"
+    return _SteadyRun(result, (at, how), start, final, None, continued.waveforms(result, groups, at), None, dt)
+
+
+def _signal_names(spec) -> list[str]:
+    return [s.name for s in train_signals(spec) if s.compared]
+
+
+def _check_run(side, point: Point, run: _SteadyRun):
+    """The integration check of ``run``: the same run from the same state at the step 2 h (or h / 2)."""
+    h = check_step(side, run.dt)
+    if run.initial is None:
+        return side.run(RunSettings(point.duration, dt=h))
+    return side.run_from(RunSettings(run.result.t[-1] - run.initial.t, dt=h, start=run.initial.t), run.initial)[0]
+
+
+def reduce_run(result, plan, lines, rows: _Rows, solver: str, steady: tuple[float, str], check=None,
+               switch_times=None, columns=None) -> None:
     """The steady window of ``result`` reduced to statistics and mesh harmonics (rows of ``rows``), each with its
     integration error estimate from ``check``, the same run at 2 h or h / 2 (None: no estimate).  ``switch_times(t0,
     t1)``: the instants where the mesh stiffness jumps, which the harmonics are corrected for
-    (:func:`gearcheck.compare.engine.line_projection.harmonics`)."""
-    t = result.t
+    (:func:`gearcheck.compare.engine.line_projection.harmonics`).  ``steady``: (start, how) of the window;
+    ``columns``: more columns of every row."""
+    start, how = steady
     names = result.names(compared=True)
-    groups = [(np.stack([result[n] for n in forces], axis=1), cycle) for forces, cycle in plan.steady_groups(names)]
-    start, how = steady_state(t, groups, plan.settle) if groups else (None, None)
-    if start is None:
-        start, how = 0.5 * t[-1], "none"
     freqs = np.array([f for _, _, f in lines])
     stats, full, fs, span = _window(result, names, start, freqs, switch_times)
     resolved = [bool(f < 0.45 * fs and f * span >= 2.0 and all(abs(f - g) * span >= 2.0 for g in freqs if g != f))
@@ -514,7 +625,7 @@ def reduce_run(result, plan, lines, rows: _Rows, solver: str, check=None, switch
         check_stats, check_full, _, _ = _window(check, names, start, freqs, switch_times)
         stat_error = {m: factor * np.abs(stats[m] - check_stats[m]) for m in STATISTICS}
         line_error = factor * np.abs(full - check_full)
-    common = {"solver": solver, "steady": how, "steady_start_s": float(start), "dt_s": dt}
+    common = {"solver": solver, "steady": how, "steady_start_s": float(start), "dt_s": dt, **(columns or {})}
     for j, name in enumerate(names):
         s = result.signal(name)
         info = {"quantity": name, "kind": s.kind, "unit": s.unit, **common}
@@ -558,12 +669,12 @@ class Execution:
 
 def execute(points, *, workers: int | None = None, scheduler=None, executor=None, cache=None,
             progress=None) -> Execution:
-    """Run every point not in ``cache`` (a folder, or None) through the chosen backend; see the module doc.
+    """Run every point not in ``cache`` (a folder, or None) through the chosen backend, a chain of points
+    (:func:`gearcheck.compare.studies.continuation.chains`) a unit of work; see the module doc.
     ``workers``: processes (default: the cores this process may use; 1 runs in this process);
     ``executor``: any :class:`concurrent.futures.Executor` (left running); ``scheduler``: a Dask scheduler's
     address or a ``distributed.Client``.  ``progress`` is called with the fraction of points done."""
     unique = list(dict.fromkeys(p.key for p in points))
-    todo = {p.key: p for p in points}
     tables: dict[str, bytes] = {}
     cache = None if cache is None else Path(cache)
     if cache is not None:
@@ -575,39 +686,37 @@ def execute(points, *, workers: int | None = None, scheduler=None, executor=None
             if _readable(data, key):
                 tables[key] = data
     cached = len(tables)
-    pending = [todo[k] for k in unique if k not in tables]
-    done = [cached]
+    pending = continued.chains(list({p.key: p for p in points}.values()), tables)
     walls: list[float] = []
     cpus: list[float] = []
 
-    def finished(point: Point, result: tuple[bytes, float, float]) -> None:
-        key, (data, wall, cpu) = point.key, result
-        if cache is not None:
-            _store(cache / f"{key}.parquet", data)
-        tables[key] = data
-        walls.append(wall)
-        cpus.append(cpu)
-        done[0] += 1
+    def finished(chain: continued.Chain, results: list) -> None:
+        for key, data, wall, cpu in results:
+            if cache is not None:
+                _store(cache / f"{key}.parquet", data)
+            tables[key] = data
+            walls.append(wall)
+            cpus.append(cpu)
         if progress is not None:
-            progress(done[0] / len(unique))
+            progress(len(tables) / len(unique))
 
     if progress is not None and unique:
-        progress(done[0] / len(unique))
+        progress(len(tables) / len(unique))
     workers = _workers(workers)
     if scheduler is not None:
         backend = "dask"
-        backends.run_dask(run_point, pending, scheduler, finished)
+        backends.run_dask(run_chain, pending, scheduler, finished)
     elif executor is not None:
         backend = type(executor).__name__
-        backends.run_futures(executor, run_point, pending, finished)
+        backends.run_futures(executor, run_chain, pending, finished)
     elif workers == 1 or len(pending) <= 1:
         backend = "in-process"
-        for p in pending:
-            finished(p, run_point(p))
+        for chain in pending:
+            run_chain(chain, finished)
     else:
         backend = f"processes ({min(workers, len(pending))})"
-        backends.run_pool(run_point, pending, min(workers, len(pending)), finished)
-    return Execution(tables, len(pending), cached, walls, cpus, backend)
+        backends.run_pool(run_chain, pending, min(workers, len(pending)), finished)
+    return Execution(tables, len(tables) - cached, cached, walls, cpus, backend)
 
 
 def _workers(workers) -> int:
@@ -816,14 +925,14 @@ def _plain(value):
 
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
-          solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS, integration_check: bool = True,
-          refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None,
-          progress=None) -> SweepResult:
+          solvers=SOLVERS, duration: float = DURATION, harmonics: int = HARMONICS,
+          integration_check: bool | str = "subset", refine: int = 1, continuation: bool = True,
+          workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None) -> SweepResult:
     """Plan, run (resuming from ``cache``) and assemble a sweep; see :func:`plan_sweep` and :func:`execute`."""
     started = time.perf_counter()
     plan = plan_sweep(train, speeds=speeds, fields=fields, distributions=distributions, samples=samples,
                       seed=seed, solvers=solvers, duration=duration, harmonics=harmonics,
-                      integration_check=integration_check, refine=refine)
+                      integration_check=integration_check, refine=refine, continuation=continuation)
     if cache is not None:
         check_place(Path(cache), "cache=")
     if scheduler is not None and executor is not None:

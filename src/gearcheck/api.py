@@ -208,8 +208,9 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
 
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
-          solver: str = "both", duration: float = 0.5, harmonics: int = 3, integration_check: bool = True,
-          refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None):
+          solver: str = "both", duration: float = 0.5, harmonics: int = 3, integration_check: bool | str = "subset",
+          refine: int = 1, continuation: bool = True, workers: int | None = None, scheduler=None, executor=None,
+          cache=None, progress=None):
     """A speed sweep, a parameter study or a Monte Carlo: many runs of one train, reduced to one table.
 
     Each point (a train file with swept fields edited, at one speed) runs each solver and reduces the
@@ -238,15 +239,20 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
         Monte Carlo seed.
     solver : {"both", "lumped", "mujoco"}
     duration : float
-        Simulated time of each run in s.
+        Simulated time of a run from the static state in s, and the longest a continued point runs.
     harmonics : int
         Mesh harmonics per mesh frequency.
-    integration_check : bool
-        Run each solver a second time, at twice its step, for the integration error estimates (default); False
-        saves a third of the work per point and leaves the estimates empty.
+    integration_check : {"subset", "all", "none"} or bool
+        Which points run each solver a second time, at twice its step, for the integration error estimates:
+        "subset" (default) every 8th speed and every point with a line in the half-power band of a mode (the
+        table's ``checked`` column says which and why), "all" (True), or "none" (False).
     refine : int
         Each solver's default step divided by this (1 to 64): for lines whose integration error estimate is
         too large to read them.
+    continuation : bool
+        Start each point from the final state of the point at the neighbouring speed (default), so that it
+        settles in a fraction of a run from the static state; where it does not settle the point runs from the
+        static state and its table says so (:mod:`gearcheck.compare.studies.continuation`).
     workers : int, optional
         Local processes (default: the cores available; 1 runs in this process).
     scheduler : str or distributed.Client, optional
@@ -266,7 +272,8 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
     """
     return Train(train).sweep(speeds=speeds, fields=fields, distributions=distributions, samples=samples, seed=seed,
                               solver=solver, duration=duration, harmonics=harmonics,
-                              integration_check=integration_check, refine=refine, workers=workers,
+                              integration_check=integration_check, refine=refine, continuation=continuation,
+                              workers=workers,
                               scheduler=scheduler, executor=executor, cache=cache, progress=progress)
 
 

@@ -766,7 +766,8 @@ def cmd_sweep(args) -> int:
         result = gearcheck.sweep(args.train, speeds=speeds, fields=fields, distributions=distributions,
                                  samples=args.samples, seed=args.seed, solver=args.solver, duration=args.duration,
                                  harmonics=args.harmonics, integration_check=args.integration_check,
-                                 refine=args.refine, workers=args.workers, scheduler=args.scheduler,
+                                 refine=args.refine, continuation=args.continuation, workers=args.workers,
+                                 scheduler=args.scheduler,
                                  cache=cache, progress=bar)
         bar.close()
         written = result.write_files(place.path, args.quantity)
@@ -1022,11 +1023,18 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--samples", type=int, metavar="N", help="Monte Carlo draws (default 32)"),
         arg("--seed", type=int, default=0, metavar="S", help="Monte Carlo seed (default 0)"),
         arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both"),
-        arg("--duration", type=SECONDS, default=0.5, metavar="S", help="simulated time per run (default 0.5 s)"),
+        arg("--duration", type=SECONDS, default=0.5, metavar="S",
+            help="simulated time of a run from the static state, the longest a continued point runs (default 0.5 s)"),
         arg("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics per mesh frequency (default 3)"),
-        arg("--no-integration-check", dest="integration_check", action="store_false",
-            help="run each solver once per point, without the second run at twice the step that estimates each "
-                 "line's integration error (about 1.5 times faster; every line then counts)"),
+        arg("--integration-check", choices=("subset", "all", "none"), default="subset",
+            help="which points run each solver a second time at twice the step, for each line's integration error: "
+                 "every 8th speed and every point with a line in the half-power band of a mode (subset, the "
+                 "default), all, or none"),
+        arg("--no-integration-check", dest="integration_check", action="store_const", const="none",
+            help="the same as --integration-check none (every line then counts)"),
+        arg("--no-continuation", dest="continuation", action="store_false",
+            help="start every point from the static state, not from the final state of the point at the "
+                 "neighbouring speed"),
         arg("--refine", type=int, default=1, metavar="N",
             help="divide each solver's default step by N (default 1), for lines whose integration error estimate is "
                  "too large to read them; the work grows N times"),

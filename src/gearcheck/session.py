@@ -140,9 +140,9 @@ class Train:
 
     @shows_progress
     def sweep(self, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,
-              solver: str = "both", duration: float = 0.5, harmonics: int = 3, integration_check: bool = True,
-              refine: int = 1, workers: int | None = None, scheduler=None, executor=None, cache=None,
-              progress=None):
+              solver: str = "both", duration: float = 0.5, harmonics: int = 3,
+              integration_check: bool | str = "subset", refine: int = 1, continuation: bool = True,
+              workers: int | None = None, scheduler=None, executor=None, cache=None, progress=None):
         """A speed sweep, parameter study or Monte Carlo of the train file (each point builds its own models, in
         its own process); ``speeds`` default to the session's.  See :func:`gearcheck.sweep`."""
         from gearcheck.compare.studies.sweep import sweep
@@ -153,7 +153,8 @@ class Train:
         require_mesh_cycle(self.spec if speeds is None else self.spec.with_operating(input_speed=1.0), "a sweep")
         return sweep(self.source, speeds=speeds, fields=fields, distributions=distributions, samples=samples,
                      seed=seed, solvers=solver, duration=duration, harmonics=harmonics,
-                     integration_check=integration_check, refine=refine, workers=workers, scheduler=scheduler,
+                     integration_check=integration_check, refine=refine, continuation=continuation,
+                     workers=workers, scheduler=scheduler,
                      executor=executor, cache=cache, progress=progress)
 
     def animate(self, path, mode: int | None = None, solver: str = "mujoco", **options) -> Path:

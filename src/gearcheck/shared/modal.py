@@ -128,11 +128,20 @@ def settling_time(M: np.ndarray, D: np.ndarray, K: np.ndarray, fraction: float) 
 
 def slowest_decaying_mode(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[float, float]:
     """(natural frequency in Hz, damping ratio) of the elastic mode of M q'' + D q' + K q = 0 whose free
-    vibration decays slowest (the one :func:`settling_time` waits for): s = -zeta w +- i w sqrt(1 - zeta^2)."""
+    vibration decays slowest (the one :func:`settling_time` waits for)."""
+    f, zeta = damped_modes(M, D, K)
+    slowest = np.argmin(zeta * f)
+    return float(f[slowest]), float(zeta[slowest])
+
+
+def damped_modes(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(natural frequencies |s| / 2 pi in Hz, damping ratios -Re s / |s|) of the elastic modes of
+    M q'' + D q' + K q = 0, s = -zeta w +- i w sqrt(1 - zeta^2) (one of each pair; an overdamped mode's two real
+    roots each), lowest first."""
     s, _ = quadratic_eigenvalues(M, D, K)
-    s = s[np.abs(s) ** 2 > RIGID_TOLERANCE * np.max(np.abs(s)) ** 2]
-    slowest = s[np.argmin(-s.real)]
-    return float(abs(slowest) / (2 * math.pi)), float(-slowest.real / abs(slowest))
+    s = s[(np.abs(s) ** 2 > RIGID_TOLERANCE * np.max(np.abs(s)) ** 2) & (s.imag >= 0)]
+    order = np.argsort(np.abs(s))
+    return np.abs(s[order]) / (2 * math.pi), -s[order].real / np.abs(s[order])
 
 
 def frequency_groups(frequencies: np.ndarray) -> list[list[int]]:

@@ -1,6 +1,7 @@
 """What a time run is asked for, validated once for every solver.
 
-``duration`` (s) is the simulated time; ``dt`` the fixed step (None: the solver's default from its
+``duration`` (s) is the simulated time, from ``start`` (s, the time of the first sample: a run that goes on from
+where another ended, its state given; 0 otherwise); ``dt`` the fixed step (None: the solver's default from its
 own highest natural frequency, :mod:`gearcheck.shared.stepping`); ``output_dt`` the sampling of the
 result (None: every step); ``settle`` the start of the steady window (None: the larger of the load
 ramp and half the duration).  Every solver turns a step into the same sample grid
@@ -33,6 +34,7 @@ class RunSettings:
     dt: float | None = None
     output_dt: float | None = None
     settle: float | None = None
+    start: float = 0.0
 
     def __post_init__(self):
         _positive("duration", self.duration, False)
@@ -44,6 +46,18 @@ class RunSettings:
         if self.settle is not None and not (isinstance(self.settle, (int, float)) and 0 <= self.settle
                                             and math.isfinite(self.settle)):
             raise SolverError(f"settle must be a number of seconds >= 0, got {self.settle!r}")
+        if isinstance(self.start, bool) or not isinstance(self.start, (int, float)) or not (
+                0 <= self.start < math.inf):
+            raise SolverError(f"start must be a number of seconds >= 0, got {self.start!r}")
+
+    def check_start(self, state, history, what: str) -> None:
+        """Refuse a run from ``start`` > 0 without the ``state`` it goes on from (a solver's own start is the
+        state at t = 0), or of a train with an operating ``history`` (which starts at 0); ``what`` names the model."""
+        if self.start and state is None:
+            raise SolverError(f"the {what} runs from start={self.start:g} s only from a state it is given (the run "
+                              "it goes on from)")
+        if self.start and history is not None:
+            raise SolverError(f"the {what} runs its operating history from t = 0, not from start={self.start:g} s")
 
     def grid(self, dt: float) -> tuple[int, int]:
         """(steps, steps between samples) for the step ``dt``: the run ends on a sample at or just after
@@ -72,5 +86,6 @@ class RunSettings:
         return n_steps, every
 
     def settle_time(self, ramp: float) -> float:
-        """Start of the steady window: ``settle``, or the larger of the load ramp and half the duration."""
-        return max(ramp, 0.5 * self.duration) if self.settle is None else self.settle
+        """Start of the steady window: ``settle``, or the larger of the load ramp and half the duration after
+        ``start``."""
+        return max(ramp, self.start + 0.5 * self.duration) if self.settle is None else self.settle

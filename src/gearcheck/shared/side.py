@@ -13,6 +13,7 @@ from abc import ABC, abstractmethod
 from gearcheck.shared.errors import UnsupportedError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
+from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
 
@@ -89,6 +90,11 @@ class Side(ABC):
         the same run from the same state at the step ``check_step(h)`` (its integration check), and how the state
         was found, in words.  Default: unsupported."""
         raise UnsupportedError(f"{self.solver} cannot start on its periodic steady state (run_periodic)")
+
+    def run_from(self, settings: RunSettings, state: RunState | None = None) -> tuple[TimeResult, RunState]:
+        """A run from ``state`` at ``settings.start`` (None: from its own start at 0), and the state it ends in, for
+        the next run to go on from (:mod:`gearcheck.shared.run_state`).  Default: unsupported."""
+        raise UnsupportedError(f"{self.solver} cannot go on from another run's state (run_from)")
 
     def operating(self) -> dict:
         """The operating point a report of its runs states.  Default: the train's input speed and output torque (the

@@ -33,17 +33,18 @@ on the same side by every mesh, whatever the round-off in its phase (planets wit
 phases stay identical, so the symmetry that mesh phasing relies on survives)."""
 
 
-def split_steps(h: float, start: int, stop: int, switches) -> dict[int, np.ndarray]:
-    """The steps among start..stop-1 (step i spans [i h, (i + 1) h]) inside which the drive jumps, each with
-    the times of its jumps: both solvers end a sub-step there, so a rectangular mesh stiffness is constant
-    over every (sub-)step and RK4 keeps its fourth order (a jump inside a step, seen as the step's mean,
+def split_steps(h: float, start: int, stop: int, switches, origin: float = 0.0) -> dict[int, np.ndarray]:
+    """The steps among start..stop-1 (step i spans [origin + i h, origin + (i + 1) h]) inside which the drive jumps,
+    each with the times of its jumps: both solvers end a sub-step there, so a rectangular mesh stiffness is
+    constant over every (sub-)step and RK4 keeps its fourth order (a jump inside a step, seen as the step's mean,
     costs an error of the order of h).  A jump within ``STAGE_OFFSETS[0]`` h of a step boundary is left
     to the stage sampling, which sees it on the same side in every mesh; jumps that close together are
     one."""
     switches = np.asarray(switches, dtype=float)
+    since = switches - origin
     tol = STAGE_OFFSETS[0] * h
-    index = np.floor(switches / h).astype(int)
-    inside = ((switches - index * h) > tol) & (((index + 1) * h - switches) > tol) & (index >= start) & (index < stop)
+    index = np.floor(since / h).astype(int)
+    inside = ((since - index * h) > tol) & (((index + 1) * h - since) > tol) & (index >= start) & (index < stop)
     out: dict[int, np.ndarray] = {}
     for i, t in zip(index[inside], switches[inside]):
         times = out.get(int(i))

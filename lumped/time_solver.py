@@ -228,7 +228,8 @@ def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e
         "rhs_evaluations": calls, "wall_time_s": wall,  # sub-steps and located events included
         "rtol": rtol if method != "rk4" else None, "rotating_frame_terms": model.rotating_frame_terms,
         "contact_events_located": located})
-    result = _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info)
+    result = _result(model, sys, t_out, q_out, v_out, static, settings.settle_time(model.spec.operating.ramp), info,
+                     settings.signals)
     return (result, (q_out[-1].copy(), v_out[-1].copy())) if return_state else result
 
 
@@ -401,7 +402,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol, t0: float = 0.
     return sol.t, sol.y[:n].T, sol.y[n:].T, int(sol.nfev)
 
 
-def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
+def _result(model, sys, t, q, v, static, settle, info, wanted=None) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
     k, e, de, tin, tout, pairs = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
     qdd = sys.acceleration(q, v, k, e, de, tin[:, None], tout[:, None], t, pairs)
@@ -421,4 +422,4 @@ def _result(model, sys, t, q, v, static, settle, info) -> TimeResult:
     contacts = [e for e in model.turning if e.has_contacts]
     pins = np.concatenate([e.pin_forces(t, q, v) for e in contacts], axis=1) if contacts else None
     return train_result(spec, "lumped", t, motion, delta, force, k, static.mesh_force, static_bearing,
-                        bearing_force, settle, info, raw, pins)
+                        bearing_force, settle, info, raw, pins, wanted)

@@ -531,7 +531,7 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         "static_newton_iterations": static.iterations, "static_residual": static.residual,
         "forward_evaluations": 4 * sub_steps, "engine": loop,  # sub-steps and located events included
         "contact_events_located": stepper.located})
-    result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info)
+    result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info, settings.signals)
     return (result, (d.qpos.copy(), d.qvel.copy(), d.act.copy())) if return_state else result
 
 
@@ -596,7 +596,7 @@ def _body_stiffness(mb: MbdModel, info, qpos) -> np.ndarray:
 # --------------------------------------------------------------------------- result
 
 
-def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, info) -> TimeResult:
+def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, info, wanted=None) -> TimeResult:
     spec, S = mb.spec, stepper.sensors[:stepper.j]
 
     def series(name):
@@ -623,7 +623,7 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     pins = [stepper.pins[:stepper.j, at] for at in mb.moving_slices()]
     by_disc = np.concatenate([c.per_disc(f) for c, f in zip(mb.moving_contacts, pins)], axis=1) if pins else None
     result = train_result(spec, "mujoco", t, member_motion(mb, S, t), delta, mesh_force, k, static.mesh_force,
-                          static.bearing_force, bearing_force, settle, info, raw, by_disc)
+                          static.bearing_force, bearing_force, settle, info, raw, by_disc, wanted)
     for c, forces, at in zip(mb.moving_contacts, pins, mb.moving_slices()):
         result = c.with_signals(result, forces, series, static.pin_force[at])
     return result

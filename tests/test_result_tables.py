@@ -1,5 +1,6 @@
 """Results as tables other tools read: a cross-check as a tidy frame (one row per quantity, side and metric), a
-time result as an xarray Dataset with units, and a mistyped signal or quantity name answered with the closest."""
+time result as an xarray Dataset with units, a mistyped signal or quantity name answered with the closest, and a
+run that keeps only the signals asked."""
 
 from __future__ import annotations
 
@@ -8,6 +9,11 @@ import pytest
 from tqdm import tqdm
 
 import gearcheck
+from gearcheck.lumped.side import LumpedSide
+from gearcheck.mbd_models.side import MujocoSide
+from gearcheck.shared.errors import SolverError
+from gearcheck.shared.settings import RunSettings
+from gearcheck.train.loader import load_train
 
 
 @pytest.fixture(scope="module")
@@ -67,3 +73,18 @@ def test_progress_true_draws_a_bar_and_closes_it(capsys):
     with pytest.raises(gearcheck.GearcheckError):  # a refused call leaves no bar open
         gearcheck.Train("demo-3p").simulate(duration=-1.0, progress=True)
     assert "simulate demo-3p:" in capsys.readouterr().err and not list(tqdm._instances)
+
+
+@pytest.mark.parametrize("side", [LumpedSide, MujocoSide])
+def test_a_run_keeps_only_the_signals_asked_each_as_the_full_run_has_it(side):
+    spec = load_train("demo-3p")
+    runner = side(spec)
+    full = runner.run(RunSettings(0.002))
+    kept = ("stage1.ring.ay.world", "stage1.planet1.sun.force", "stage1.carrier.alpha")
+    some = runner.run(RunSettings(0.002, signals=kept))
+    assert some.names() == [n for n in full.names() if n in kept] and some.values.shape == (full.t.size, 3)
+    for name in kept:
+        assert np.array_equal(some[name], full[name])
+    assert set(some.static) == {"stage1.planet1.sun.force"}
+    with pytest.raises(SolverError, match="signals: demo-3p has no signal 'stage1.ring.jerk'"):
+        runner.run(RunSettings(0.002, signals=("stage1.ring.jerk",)))

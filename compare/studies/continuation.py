@@ -171,19 +171,19 @@ def joined(results: list[TimeResult]) -> TimeResult:
     return TimeResult(first.train, first.solver, t, first.signals, values, first.settle_time, first.info)
 
 
-def run_continued(side, dt: float, state: RunState, rho_guess: float | None, window: float, groups,
-                  before: dict, longest: float):
-    """The continued run of ``side`` at the step ``dt`` from ``state`` (already at the point's speed): (run, its
-    steady start, rho, the state it ended in, its waveforms), or None where it does not settle within ``longest``
-    s.  ``window``: how long the steady window must be; ``groups``: the plan's steady-state groups; ``before``: the
-    neighbour's waveforms."""
+def run_continued(side, settings: RunSettings, state: RunState, rho_guess: float | None, window: float, groups,
+                  before: dict):
+    """The continued run of ``side`` from ``state`` (already at the point's speed), at the step and with the signals
+    of ``settings``: (run, its steady start, rho, the state it ended in, its waveforms), or None where it does not
+    settle within ``settings.duration``.  ``window``: how long the steady window must be; ``groups``: the plan's
+    steady-state groups; ``before``: the neighbour's waveforms."""
     t0 = state.t
     target = settle_after(side, rho_guess) + window
     results, now = [], state
     while True:
-        if target > longest:
+        if target > settings.duration:
             return None
-        result, now = side.run_from(RunSettings(target - (now.t - t0), dt=dt, start=now.t), now)
+        result, now = side.run_from(dataclasses.replace(settings, duration=target - (now.t - t0), start=now.t), now)
         results.append(result)
         run = joined(results)
         shapes = waveforms(run, groups, t0 + min(settle_after(side, rho_guess), now.t - t0 - window))

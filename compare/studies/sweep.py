@@ -77,7 +77,8 @@ from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory, check_place
-from gearcheck.shared.results import train_signals, unit_schema
+from gearcheck.shared.results import TimeResult, train_signals, unit_schema
+from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import richardson_factor
 from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
@@ -558,13 +559,13 @@ class _SteadyRun:
     runs), its mesh forces' steady waveforms, and the state it started from with its step (for the integration
     check)."""
 
-    result: object
+    result: TimeResult
     steady: tuple[float, str]
     start: str
-    state: object
+    state: RunState
     rho: float | None
     shapes: dict
-    initial: object
+    initial: RunState | None
     dt: float
 
 
@@ -572,22 +573,22 @@ def _steady_run(side, point: Point, plan, lines, before) -> _SteadyRun:
     """The point's run of ``side``: continued from ``before`` where the point goes on from its neighbour and that
     settles, else from the static state over the point's duration, its steady window found by the plan's rule."""
     dt = side.default_step() / point.refine
-    groups = plan.steady_groups(_signal_names(plan.spec))
+    names = tuple(_signal_names(plan.spec))
+    groups = plan.steady_groups(names)
     state, rho, shapes = continued.carried(before, side.solver)
     start = "cold"
-    if state is not None:
+    if state is not None and shapes is not None and point.speed_rpm and point.after_rpm:
         initial = state.at_speed(point.speed_rpm / point.after_rpm)
-        found = continued.run_continued(side, dt, initial, rho, continued.window_length(plan, lines), groups,
-                                        shapes, point.duration)
+        found = continued.run_continued(side, RunSettings(point.duration, dt=dt, signals=names), initial, rho,
+                                        continued.window_length(plan, lines), groups, shapes)
         if found is not None:
             result, at, rho, final, shapes = found
             return _SteadyRun(result, (at, "continued"), "continued", final, rho, shapes, initial, dt)
         start = "cold: continuation did not settle"
-    result, final = side.run_from(RunSettings(point.duration, dt=dt))
+    result, final = side.run_from(RunSettings(point.duration, dt=dt, signals=names))
     series = [(np.stack([result[n] for n in forces], axis=1), cycle) for forces, cycle in groups]
-    at, how = steady_state(result.t, series, plan.settle) if series else (None, None)
-    if at is None:
-        at, how = 0.5 * result.t[-1], "none"
+    found_at, found_how = steady_state(result.t, series, plan.settle) if series else (None, None)
+    at, how = (found_at, found_how) if found_at is not None and found_how else (0.5 * result.t[-1], "none")
     return _SteadyRun(result, (at, how), start, final, None, continued.waveforms(result, groups, at), None, dt)
 
 
@@ -598,9 +599,11 @@ def _signal_names(spec) -> list[str]:
 def _check_run(side, point: Point, run: _SteadyRun):
     """The integration check of ``run``: the same run from the same state at the step 2 h (or h / 2)."""
     h = check_step(side, run.dt)
+    names = tuple(run.result.names())
     if run.initial is None:
-        return side.run(RunSettings(point.duration, dt=h))
-    return side.run_from(RunSettings(run.result.t[-1] - run.initial.t, dt=h, start=run.initial.t), run.initial)[0]
+        return side.run(RunSettings(point.duration, dt=h, signals=names))
+    return side.run_from(RunSettings(run.result.t[-1] - run.initial.t, dt=h, start=run.initial.t, signals=names),
+                         run.initial)[0]
 
 
 def reduce_run(result, plan, lines, rows: _Rows, solver: str, steady: tuple[float, str], check=None,

@@ -256,18 +256,19 @@ def train_signals(spec) -> list[Signal]:
 
 def acceleration_signals(spec) -> list[Signal]:
     """Every member's accelerations, the first signals of a train run: the central members' gated."""
-    signals = []
-    for mid, member in spec.members.items():
-        gated = not member.orbits
-        for frame in ("world", "carrier"):
-            for axis in "xy":  # a torsional member's: held at zero, reported and not compared
-                signals.append(Signal(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2",
-                                      f"{mid} acceleration along {axis} ({frame} frame)",
-                                      gated and not member.torsional))
-        signals.append(Signal(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", gated))
-        if member.axial:
-            signals.append(Signal(f"{mid}.az", "acceleration", "m/s^2", f"{mid} acceleration along the stage axis",
-                                  gated and not member.torsional))
+    return [s for mid, member in spec.members.items() for s in member_accelerations(mid, member)]
+
+
+def member_accelerations(mid: str, member) -> list[Signal]:
+    """A member's accelerations, gated for a central member."""
+    gated = not member.orbits
+    signals = [Signal(f"{mid}.a{axis}.{frame}", "acceleration", "m/s^2", f"{mid} acceleration along {axis} ({frame} "
+                      "frame)", gated and not member.torsional)  # a torsional member's: zero, reported, not compared
+               for frame in ("world", "carrier") for axis in "xy"]
+    signals.append(Signal(f"{mid}.alpha", "angular_acceleration", "rad/s^2", f"{mid} angular acceleration", gated))
+    if member.axial:
+        signals.append(Signal(f"{mid}.az", "acceleration", "m/s^2", f"{mid} acceleration along the stage axis",
+                              gated and not member.torsional))
     return signals
 
 
@@ -317,27 +318,44 @@ class MemberMotion(NamedTuple):
 
 
 def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh_stiffness, static_mesh_force,
-                 static_bearing_force, bearing_force, settle_time, info, raw, pin_force=None) -> TimeResult:
+                 static_bearing_force, bearing_force, settle_time, info, raw, pin_force=None,
+                 wanted=None) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
     motion: j -> :class:`MemberMotion` of the j-th member of ``spec.members`` (axial for members that slide),
-    asked once per member; mesh arrays (n_t, n_mesh) in ``spec.meshes`` order; bearing_force (n_t, n_bearing) in
-    :func:`bearing_names` order; the static forces of the meshes and bearings are the run's ``static`` values;
-    pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in :func:`disc_names` order (an RV reducer's)."""
-    signals = train_signals(spec)
+    asked once per member, and only of members with a signal kept; mesh arrays (n_t, n_mesh) in ``spec.meshes``
+    order; bearing_force (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and
+    bearings are the run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
+    :func:`disc_names` order (an RV reducer's).  ``wanted``: the names of the signals to keep (None: all), in
+    :func:`train_signals`' order."""
+    signals = [s for s in train_signals(spec) if wanted is None or s.name in wanted]
+    if wanted is not None and len(signals) != len(set(wanted)):
+        missing = sorted(set(wanted) - {s.name for s in signals})
+        raise SolverError(f"signals: {spec.name} has no signal {missing[0]!r}")
     values = np.empty((len(t), len(signals)), order="F")  # written and read a signal at a time
     at = {s.name: j for j, s in enumerate(signals)}
-    for j, mid in enumerate(spec.members):  # member by member: small temporaries
-        for group in member_columns(mid, motion(j)).values():
-            for name, x in group.items():
+
+    def put(columns: dict) -> None:
+        for name, x in columns.items():
+            if name in at:
                 values[:, at[name]] = x
-    col = len(acceleration_signals(spec))
-    col = _fill(values, col, [mesh_force, mesh_deflection, mesh_force / np.asarray(static_mesh_force), mesh_stiffness])
-    col = _fill(values, col, [bearing_force])
-    if disc_names(spec):
-        _fill(values, col, [pin_force.max(axis=-1), (pin_force > 0).sum(axis=-1)])
-    static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)}
-    static.update({f"{name}.force": float(f) for name, f in zip(bearing_names(spec), static_bearing_force)})
+
+    for j, (mid, member) in enumerate(spec.members.items()):  # member by member: small temporaries
+        own = member_accelerations(mid, member) + motion_signals(mid, member)
+        if any(s.name in at for s in own):
+            for group in member_columns(mid, motion(j)).values():
+                put(group)
+    for i, mesh in enumerate(spec.meshes):
+        put({f"{mesh.id}.force": mesh_force[:, i], f"{mesh.id}.dte": mesh_deflection[:, i],
+             f"{mesh.id}.kv": mesh_force[:, i] / static_mesh_force[i], f"{mesh.id}.stiffness": mesh_stiffness[:, i]})
+    put({f"{name}.force": bearing_force[:, i] for i, name in enumerate(bearing_names(spec))})
+    for i, disc in enumerate(disc_names(spec)):
+        put({f"{disc}.pin_force_max": pin_force[:, i].max(axis=-1), f"{disc}.pins_loaded": (pin_force[:, i] > 0).sum(
+            axis=-1)})
+    static = {f"{mesh.id}.force": float(f) for mesh, f in zip(spec.meshes, static_mesh_force)
+              if f"{mesh.id}.force" in at}
+    static.update({f"{name}.force": float(f) for name, f in zip(bearing_names(spec), static_bearing_force)
+                   if f"{name}.force" in at})
     return TimeResult(spec.name, solver, np.asarray(t), signals, values, settle_time, info, raw, static)
 
 
@@ -357,12 +375,3 @@ def member_columns(mid: str, m: MemberMotion) -> dict[str, dict[str, np.ndarray]
                 f"{mid}.omega.relative": m.omega_relative}
     axial = {} if m.axial is None else {f"{mid}.{name}": m.axial[:, k] for k, name in enumerate(("az", "z", "vz"))}
     return {"translation": translation, "rotation": rotation, "axial": axial}
-
-
-def _fill(values: np.ndarray, start: int, arrays) -> int:
-    """Write ``arrays`` a, b, ... (time x n each) into the columns of ``values`` from ``start`` on, interleaved
-    a_0, b_0, ..., a_1, b_1, ... (a block of columns per mesh); returns the column after them."""
-    stop = start + sum(x.shape[1] for x in arrays)
-    for k, x in enumerate(arrays):
-        values[:, start + k:stop:len(arrays)] = x
-    return stop

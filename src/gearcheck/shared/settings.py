@@ -4,7 +4,8 @@
 where another ended, its state given; 0 otherwise); ``dt`` the fixed step (None: the solver's default from its
 own highest natural frequency, :mod:`gearcheck.shared.stepping`); ``output_dt`` the sampling of the
 result (None: every step); ``settle`` the start of the steady window (None: the larger of the load
-ramp and half the duration).  Every solver turns a step into the same sample grid
+ramp and half the duration); ``signals`` the names of the signals the result keeps (None: every one; a sweep keeps
+those it reduces, and its runs then build no others).  Every solver turns a step into the same sample grid
 (:meth:`RunSettings.grid`), so two runs at one step share their sample times exactly.
 """
 
@@ -35,6 +36,7 @@ class RunSettings:
     output_dt: float | None = None
     settle: float | None = None
     start: float = 0.0
+    signals: tuple[str, ...] | None = None
 
     def __post_init__(self):
         _positive("duration", self.duration, False)
@@ -49,6 +51,9 @@ class RunSettings:
         if isinstance(self.start, bool) or not isinstance(self.start, (int, float)) or not (
                 0 <= self.start < math.inf):
             raise SolverError(f"start must be a number of seconds >= 0, got {self.start!r}")
+        if self.signals is not None and not (isinstance(self.signals, tuple) and self.signals
+                                             and all(isinstance(n, str) for n in self.signals)):
+            raise SolverError(f"signals must be a tuple of signal names, got {self.signals!r}")
 
     def check_start(self, state, history, what: str) -> None:
         """Refuse a run from ``start`` > 0 without the ``state`` it goes on from (a solver's own start is the

@@ -141,3 +141,19 @@ def test_the_checked_subset_is_every_eighth_speed_and_every_line_in_a_resonance_
     assert reasons == {"every 8th", "resonance", "no"}  # the speeds cross a resonance band
     with pytest.raises(GearcheckError, match="integration_check='some': needs subset, all, none"):
         sw.plan_sweep("demo-3p", speeds=[1000.0], integration_check="some")
+
+
+def test_a_translation_along_the_worlds_axes_is_unresolved_where_its_carrier_sidebands_are():
+    """demo-3p's response is periodic in the carrier's frame; along the world's axes its lines sit at k f_mesh +/-
+    f_carrier, which a window shorter than 2 / f_carrier cannot separate: those lines are flagged, the carrier
+    frame's are not, and the sweep's headline quantities are the carrier frame's."""
+    result = sw.sweep("demo-3p", speeds=[1500.0], solvers=("lumped",), duration=0.1, workers=1,
+                      integration_check="none")
+    frame = result.to_pandas()
+    lines = frame[frame["metric"] == "harmonic"]
+    window = 0.1 - float(frame.loc[frame["metric"] == "rms", "steady_start_s"].iloc[0])
+    f_carrier = abs(LumpedSide(load_train("demo-3p", 1500.0)).model.kin.speeds["stage1.carrier"]) / (2 * np.pi)
+    assert window * f_carrier < 2
+    assert not lines.loc[lines["quantity"] == "stage1.ring.ay.world", "resolved"].any()
+    assert lines.loc[lines["quantity"] == "stage1.ring.ay.carrier", "resolved"].any()
+    assert all(q.endswith(".ay.carrier") or q.endswith(".force") for q in result.headline())

@@ -52,9 +52,11 @@ def test_a_speed_sweep_gives_one_tidy_table(tmp_path):
     assert list(dict.fromkeys(harmonic["quantity"])) == gated
     for speed in SPEEDS:  # the lines are the mesh harmonics at that speed
         f_mesh = kinematics(gearcheck.load("demo-3p", speed)).mesh_frequency["stage1.planet1.sun"]
-        rows = harmonic[(harmonic["speed_rpm"] == speed) & (harmonic["quantity"] == gated[0])]
+        rows = harmonic[(harmonic["speed_rpm"] == speed) & (harmonic["quantity"] == "stage1.sun.ax.carrier")]
         assert rows["frequency_hz"].to_numpy() == pytest.approx([f_mesh, 2 * f_mesh, 3 * f_mesh], rel=1e-12)
         assert set(rows["mesh"]) == {"stage1"} and rows["resolved"].all()
+        world = harmonic[(harmonic["speed_rpm"] == speed) & (harmonic["quantity"] == "stage1.sun.ax.world")]
+        assert not world["resolved"].any()  # 0.03 s cannot tell k f_mesh from k f_mesh +/- f_carrier
     modes = frame[(frame["metric"] == "natural_frequency") & (frame["point"] == 1)]
     assert modes["frequency_hz"].min() == pytest.approx(gearcheck.modes("demo-3p", speed=1500.0).frequencies[0])
     assert (frame.loc[frame["metric"] == "rms", "steady"] != "none").all()
@@ -221,7 +223,7 @@ def test_the_sweep_command_writes_table_plots_and_summary(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "demo-3p: 3 points (3 run, 0 from the cache" in printed and "largest harmonic stage1 x" in printed
     names = sorted(p.name for p in out.iterdir())
-    assert "sweep.parquet" in names and "sweep.json" in names and "order_stage1.ring.ay.world.png" in names
+    assert "sweep.parquet" in names and "sweep.json" in names and "order_stage1.ring.ay.carrier.png" in names
     before = {p.name: p.read_bytes() for p in out.iterdir() if p.suffix in (".parquet", ".png")}
     assert len(list((tmp_path / "sweep.cache").glob("*.parquet"))) == 3
     assert main(argv) == 0

@@ -2,41 +2,49 @@
 
 A *point* is one train file (the user's, with swept fields edited in its own units), one input speed, the
 solvers to run and the run settings.  :func:`run_point` runs each solver on it (the same sides the cross-check
-runs, :class:`~gearcheck.lumped.side.LumpedSide` and :class:`~gearcheck.mbd_models.side.MujocoSide`), each
-twice as the cross-check does, at its step and at its check step (2 h, or h / 2), finds the steady window by
-the cross-check's rule
+runs, :class:`~gearcheck.lumped.side.LumpedSide` and :class:`~gearcheck.mbd_models.side.MujocoSide`), from the
+final state of the point at the neighbouring speed where the sweep continues (:mod:`gearcheck.compare.studies.
+continuation`: its steady window starts once that start's mismatch has died away; ``start`` says how each point
+started), else from the static state with the steady window found by the cross-check's rule
 (:func:`gearcheck.compare.engine.align.steady_state` over the plan's mesh-force groups; without a steady state the
-second half, flagged ``steady = "none"``) and reduces it to a tidy table, one row per (solver, quantity,
-metric, mesh, order):
+second half, flagged ``steady = "none"``); on the checked points (``checked``: every ``CHECK_EVERY``-th speed and
+every point with a line in a mode's half-power band, or all) it runs each solver again from the same state at its
+check step (2 h, or h / 2).  It reduces the window to a tidy table, one row per (solver, quantity, metric, mesh,
+order), from the gated signals alone (the runs build no others):
 
 * ``mean``, ``rms``, ``peak_to_peak`` of every quantity the cross-check gates, over the steady window;
 * ``harmonic``: amplitude and phase of each of them at the mesh harmonics k f_mesh, k = 1..``harmonics``, of
   every distinct mesh frequency of the train (``mesh`` names its stages, e.g. ``I``), by the Hann-windowed
   projection the cross-check's spectra use, A = 2 |sum w x e^{-i 2 pi f t}| / sum w, phase of cos(2 pi f t +
   phase) with t the run's own time; ``resolved`` is False where the window cannot separate the line from
-  its neighbours or from DC (T |f - f'| < 2, the Hann main lobe).  The lines are projected with the jumps of
-  a switching mesh stiffness taken out (:func:`gearcheck.compare.engine.line_projection.harmonics`): a plain sum
-  aliases them onto the lines, by the same amount in both solvers, which then agree on a wrong number -- the
-  cross-check of two solvers cannot see an error they share.  ``integration_error`` estimates the error of
-  a statistic or line by its change on doubling the step (|X_h - X_2h|, or 2 |X_h - X_h/2|; for a line the
-  change of its complex amplitude), which bounds it for any order p >= 1 in the asymptotic range: the
-  solvers are fourth order, but what is read from their samples is not (a peak-to-peak between samples, a
-  line with the jumps projected out), and against runs at h / 8 on demo-3p the lines' errors were 0.3 to
-  0.8 of their change, where Richardson's fourth-order rule (a fifteenth of it) would have put them 4 to 12
-  times too low; a line whose estimate exceeds a tenth of it (:mod:`gearcheck.compare.studies.sweep_lines`) is
+  its neighbours or from DC (T |f - f'| < 2, the Hann main lobe), and for a translation along the world's axes
+  from its carrier sidebands (T f_carrier < 2: the response is periodic in the carrier's frame, and turned into
+  the world's its lines move to k f_mesh +/- f_carrier; measured on hub-drive at 1080 rpm, I.sun.ay.world's first
+  stage I line read 5.0 and 6.5 m/s^2 over 0.19 s and 0.07 s windows and 0.013 m/s^2 over 1.2 s).  The lines
+  are projected with the jumps of a switching mesh stiffness taken out
+  (:func:`gearcheck.compare.engine.line_projection.harmonics`): a plain sum aliases them onto the lines, by the same
+  amount in both solvers, which then agree on a wrong number -- the cross-check of two solvers cannot see an error
+  they share. ``integration_error`` estimates the error of a statistic or line by its change on doubling the step
+  (|X_h - X_2h|, or 2 |X_h - X_h/2|; for a line the change of its complex amplitude), which bounds it for any order p
+  >= 1 in the asymptotic range: the solvers are fourth order, but what is read from their samples is not (a peak-to-
+  peak between samples, a line with the jumps projected out), and against runs at h / 8 on demo-3p the lines' errors
+  were 0.3 to 0.8 of their change, where Richardson's fourth-order rule (a fifteenth of it) would have put them 4 to
+  12 times too low; a line whose estimate exceeds a tenth of it (:mod:`gearcheck.compare.studies.sweep_lines`) is
   left out of the peaks and drawn faint in the plots;
 * ``natural_frequency``: the reference lumped model's gyroscopic natural frequencies at the point's speed
   (Cooley & Parker 2012), one row per elastic mode, so order plots overlay them (``solver`` "lumped").
 
 The engine (:func:`execute`) hashes each point's canonical inputs (:attr:`Point.key`: the edited train file's
-canonical TOML text and the digest of a torque CSV it reads, speed, solvers, settings, gearcheck's version),
-skips points whose ``KEY.parquet`` already lies in the cache folder (an interrupted sweep resumes; a changed
-input is a new key), runs the others through a :class:`concurrent.futures.Executor` (processes by default;
-in-process for one worker) or on a Dask distributed cluster (``scheduler``: an address or a
-``distributed.Client``; :mod:`gearcheck.compare.studies.point_backends`), writes each finished point into the cache
-at once (whole or not at all), and concatenates the points in index order with their inputs as columns
-(``point``, ``sample``, ``seed``, ``speed_rpm``, each swept field, ``key``).  The table has a fixed schema and no
-time stamps, so the same inputs give a byte-identical Parquet file.
+canonical TOML text and the digest of a torque CSV it reads, speed, solvers, settings, gearcheck's version, and the
+key of the point it continues from), skips points whose ``KEY.parquet`` already lies in the cache folder (an
+interrupted sweep resumes; a changed input is a new key), runs the others, a chain of continued points a unit of
+work (the chains are the plan's, not the workers', so the table is the same on every backend), through a
+:class:`concurrent.futures.Executor` (processes by default; in-process for one worker) or on a Dask distributed
+cluster (``scheduler``: an address or a ``distributed.Client``; :mod:`gearcheck.compare.studies.point_backends`),
+writes each finished point into the cache (at once in this process, as their chain ends from workers; whole or not
+at all), and concatenates the points in index order with their inputs as columns (``point``, ``sample``, ``seed``,
+``speed_rpm``, each swept field, ``key``). The table has a fixed schema and no time stamps, so the same inputs give
+a byte-identical Parquet file.
 """
 
 from __future__ import annotations
@@ -120,7 +128,8 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
     "frequency_hz": ("Hz", "k f_mesh at this speed, or the natural frequency"),
     "amplitude": ("unit", "the statistic, or the harmonic's amplitude"),
     "phase_rad": ("rad", "phase of the harmonic, cos(2 pi f t + phase), t from the run's start"),
-    "resolved": ("", "the steady window separates the line from its neighbours and from DC"),
+    "resolved": ("", "the steady window separates the line from its neighbours and from DC (and, for a translation "
+                     "along the world's axes, from its carrier sidebands k f_mesh +/- f_carrier)"),
     "integration_error": ("unit", "estimate of the integration error of amplitude: its change on doubling the "
                                   "step (null where the point was not checked)"),
     "steady": ("", "detected, decayed or none (then the second half of the run); continued: the start's "
@@ -635,10 +644,22 @@ def reduce_run(result, plan, lines, rows: _Rows, solver: str, steady: tuple[floa
         for metric in STATISTICS:
             rows.add(**info, metric=metric, order=0, amplitude=float(stats[metric][j]),
                      integration_error=_number(stat_error[metric][j]))
+        apart = span * _sideband_spacing(plan, s) >= 2.0
         for (label, k, f), value, error, ok in zip(lines, full[:, j], line_error[:, j], resolved):
             rows.add(**info, metric="harmonic", mesh=label, order=k, frequency_hz=float(f),
                      amplitude=float(abs(value)), phase_rad=float(np.angle(value)) if np.isfinite(value) else np.nan,
-                     resolved=ok, integration_error=_number(error))
+                     resolved=ok and apart, integration_error=_number(error))
+
+
+def _sideband_spacing(plan, signal) -> float:
+    """How far a translation read along the world's axes has its lines' neighbours: the gear train's response is
+    periodic in the carrier's frame, so turned into the world's it moves from k f_mesh to k f_mesh +/- f_carrier
+    (its stage's carrier frequency), which a window shorter than 2 / f_carrier cannot tell from the line (inf: no
+    such neighbours)."""
+    if signal.kind != "acceleration" or not signal.name.endswith(".world"):
+        return math.inf
+    f_carrier = plan._frequencies(signal.name)[1]
+    return f_carrier if f_carrier > 0 else math.inf
 
 
 def _window(result, names, start: float, freqs: np.ndarray, switch_times=None):
@@ -878,12 +899,15 @@ class SweepResult:
                 "failed": [{"point": int(r.point), "solver": r.solver, "error": r.error} for r in failed.itertuples()]}
 
     def headline(self) -> list[str]:
-        """Carrier and ring accelerations (world y) and the first sun and ring mesh forces of each stage."""
+        """Carrier and ring accelerations (y, carrier frame) and the first sun and ring mesh forces of each stage.
+        The carrier frame's: the response is periodic there, and its lines stand apart; read along the world's axes
+        they move to k f_mesh +/- f_carrier, which no window shorter than 2 / f_carrier separates (0.4 s for a
+        5 Hz carrier: those lines are flagged unresolved)."""
         spec = load_text(self.plan.points[0].text, self.plan.points[0].source)
         names = []
         for stage in spec.stages:
             for member in (stage.carrier, *[c for c in stage.centrals if spec.members[c].kind == "ring"]):
-                names.append(f"{member}.ay.world")
+                names.append(f"{member}.ay.carrier")
             names += [f"{m.id}.force" for m in spec.meshes if m.stage == stage.name and m.planet_index == 0]
         present = set(self.table.column("quantity").to_pylist())
         return [n for n in names if n in present]

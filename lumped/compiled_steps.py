@@ -33,15 +33,18 @@ over time, and that Python runs 10-100 times slower than compiled code.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from gearcheck.lumped.elements import base
+from gearcheck.shared.compiled_cache import ensure_cache_folder
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
+ensure_cache_folder(Path(__file__).parent)  # before the cached kernels below are defined
 
 
 class Sparse(NamedTuple):

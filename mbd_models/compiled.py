@@ -29,6 +29,7 @@ import ctypes
 import math
 import os
 from glob import glob
+from pathlib import Path
 from typing import NamedTuple
 
 import mujoco
@@ -37,9 +38,11 @@ import numpy as np
 
 from gearcheck.mbd_models.elements import base
 from gearcheck.mbd_models.twin import TurningCoefficients
+from gearcheck.shared.compiled_cache import ensure_cache_folder
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
 
+ensure_cache_folder(Path(__file__).parent)  # before the cached kernels below are defined
 _LIBRARY_NAMES = ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll")
 STAGE_TIMES = (0, 1, 1, 2)  # RK4's stages at the drive's stage times t, t + h/2, t + h
 STAGE_ADVANCE = (0.5, 0.5, 1.0)  # stage i + 1 starts from the step's start advanced by this times h along stage i

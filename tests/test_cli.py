@@ -3,12 +3,16 @@
 import json
 import logging
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
+import gearcheck
+from gearcheck import cli
 from gearcheck.cli import main
 from gearcheck.shared import settings
 from gearcheck.train.loader import preset_text
@@ -19,6 +23,27 @@ def test_presets_lists_every_preset_with_its_source(capsys):
     assert main(["presets"]) == 0
     out = capsys.readouterr().out
     assert "demo-3p" in out and "demo-4p" in out and "gearcheck demo design" in out
+
+
+HEAVY = {"numpy", "scipy", "mujoco", "numba", "pandas", "matplotlib"}
+
+
+@pytest.mark.parametrize("flag", ["--version", "--help"])
+def test_version_and_help_import_no_solver(flag):
+    """``python -m gearcheck --version`` and ``--help`` answer without loading the numerical stack: the modules
+    that ``-X importtime`` lists (every import of the process) include none of it."""
+    done = subprocess.run([sys.executable, "-X", "importtime", "-m", "gearcheck", flag], capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 0 and ("gearcheck " in done.stdout), done.stderr[-2000:]
+    imported = {line.rsplit("|", 1)[1].strip().split(".")[0] for line in done.stderr.splitlines()
+                if line.startswith("import time:") and "|" in line}
+    assert "gearcheck" in imported and not HEAVY & imported
+
+
+def test_the_names_the_parser_offers_are_the_librarys():
+    from gearcheck.compare.engine.crosscheck import MODELS
+
+    assert cli.SOLVERS == tuple(gearcheck.SOLVERS) and ("general", *cli.PUBLISHED_MODELS) == MODELS
 
 
 def test_show_json_derived_quantities(capsys):

@@ -1,6 +1,6 @@
 """Release hygiene: the license the metadata states is the file shipped, the citation and the changelog name the
 installed version, type checkers are told the package carries its own annotations, and ``dir(gearcheck)`` shows
-the front door only."""
+the front door only, each of its names imported on first use."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ import importlib.metadata
 import importlib.resources
 import re
 from pathlib import Path
+
+import pytest
 
 import gearcheck
 
@@ -36,3 +38,15 @@ def test_dir_shows_the_front_door_and_its_packages_only():
     names = dir(gearcheck)
     assert set(gearcheck.__all__) <= set(names) and {"lumped", "mbd_models", "compare", "train", "shared"} <= set(names)
     assert not {"os", "metadata", "util", "Path", "ensure_cache_folder"} & set(names)
+
+
+def test_every_public_name_resolves_on_first_use_and_no_other():
+    """The front door imports its names when first asked for (PEP 562): each of ``__all__`` and each package
+    beneath resolves, the lazy table lists ``__all__`` exactly, and an unknown name is an AttributeError."""
+    lazy = {name for names in gearcheck._DEFINED_IN.values() for name in names}
+    assert lazy | {"__version__"} == set(gearcheck.__all__) and len(lazy) == len(gearcheck.__all__) - 1
+    for name in [*gearcheck.__all__, *gearcheck._PACKAGES]:
+        assert getattr(gearcheck, name) is not None, name
+    assert gearcheck.crosscheck is gearcheck.api.crosscheck and gearcheck.Train is gearcheck.session.Train
+    with pytest.raises(AttributeError, match="no attribute 'nothing_here'"):
+        gearcheck.nothing_here

@@ -1,6 +1,7 @@
 """Reports read at a glance: a verdict banner that counts every status, failing rows first, spectral lines
 flagged against their tolerance, a plot of every failing quantity, spectra that reach every stage's mesh
-harmonics and the natural frequencies, measured values explained, and the same as JUnit XML."""
+harmonics and the natural frequencies, measured values explained, and the same as JUnit XML; long series drawn as
+their envelope per pixel column."""
 
 from __future__ import annotations
 
@@ -16,9 +17,10 @@ import pytest
 from matplotlib.image import imread
 
 import gearcheck
+from gearcheck.compare.presentation.envelope import COLUMNS, envelope
 from gearcheck.compare.presentation.junit import junit_xml, write_junit
-from gearcheck.compare.presentation.plots import (MAX_FAILING, failing_figure, headline_quantities, spectra_figure,
-                                                  time_histories_figure)
+from gearcheck.compare.presentation.plots import (MAX_FAILING, _png, failing_figure, headline_quantities,
+                                                  spectra_figure, spectrum_range, time_histories_figure)
 from gearcheck.compare.presentation.report import (LINE_NEGLIGIBLE, LINE_SHARE, MISS, STATUSES, calibration,
                                                    line_status)
 from gearcheck.train.kinematics import kinematics
@@ -161,6 +163,36 @@ def test_the_spectra_reach_every_stage_and_the_natural_frequencies(hub):
     elastic = [f for f, kind in zip(modal.frequencies, modal.types) if kind != "rigid" and f < nyquist]
     assert low < min(elastic) and max(elastic) < high <= nyquist
     assert max(elastic) > 7000  # hub-drive's highest mode, far beyond the 6 x 31.6 Hz the spectra used to stop at
+
+
+def test_a_long_series_is_drawn_as_its_envelope_with_every_peak():
+    """A long series is drawn as the smallest and largest sample of each column, in order, its ends kept: a
+    one-sample spike stays (a subsampling would drop it), every point drawn is a sample, and on a logarithmic axis
+    the columns are logarithmic; a short series is drawn as it is."""
+    x = np.linspace(0.0, 0.5, 92_600)
+    y = np.sin(2 * np.pi * 31.6 * x) + 1e-3 * np.cos(2 * np.pi * 7000 * x)
+    y[31_337], y[50_001] = 7.0, -5.0
+    ex, ey = envelope(x, y)
+    assert ex.size <= 2 * COLUMNS + 2 and np.all(np.diff(ex) > 0) and set(zip(ex, ey)) <= set(zip(x, y))
+    assert (ey.max(), ey.min()) == (7.0, -5.0) and (ex[0], ey[0], ex[-1], ey[-1]) == (x[0], y[0], x[-1], y[-1])
+    f = np.linspace(1.0, 10_000.0, 50_000)
+    amplitude = 1.0 / f
+    amplitude[10] = 50.0  # at 3 Hz: a column of its own on a logarithmic axis, one among 25 on a linear one
+    lf, la = envelope(f, amplitude, log=True)
+    assert la.max() == 50.0 and np.sum(lf < 10.0) > 2 * np.sum(envelope(f, amplitude)[0] < 10.0)
+    assert all(np.array_equal(a, b) for a, b in zip(envelope(x[:500], y[:500]), (x[:500], y[:500])))
+
+
+def test_the_spectra_draw_the_range_shown_and_draw_again_byte_for_byte(hub):
+    result = hub[0]
+    rng = spectrum_range(result)
+    fig = spectra_figure(result)
+    for line in fig.axes[0].get_lines():
+        drawn = np.asarray(line.get_xdata())
+        if drawn.size > 2:  # the spectra, not the marks
+            assert drawn.size <= 2 * COLUMNS + 2 and rng.high <= drawn[-1]  # one sample beyond each end at most
+            assert np.sum(drawn < rng.low) <= 1 and np.sum(drawn > rng.high) <= 1
+    assert _png(fig) == _png(spectra_figure(result))
 
 
 def test_measured_values_are_explained(hub):

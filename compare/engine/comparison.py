@@ -250,6 +250,9 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
     periodic = False
     if rerunnable and needed is not None and needed > EXTENSION_FACTOR * asked:
         periodic = _periodic_note(plan, reference, needed, asked, notes)
+    elif rerunnable and needed is not None and asked < needed and not plan.detectable(asked):
+        duration, extended = needed, True  # a run of the duration asked could only be thrown away and extended
+        notes.append(_extended_note(asked, needed, plan))
     while True:
         runs = [replace(s, duration=duration, dt=dt) for s, dt in zip(settings, steps)]
         log.info("%s: %.4g s simulated, steps %s, %s", spec.name, duration,
@@ -265,9 +268,7 @@ def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSetting
             continue
         if (attempt.how is None and not extended and needed is not None
                 and duration < needed <= EXTENSION_FACTOR * asked and rerunnable):
-            notes.append(f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: "
-                         f"the free vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s, plus "
-                         f"{STEADY_WINDOW_CYCLES} mesh cycles to compare.")
+            notes.append(_extended_note(duration, needed, plan))
             duration, extended = needed, True
             continue
         if best is not None and attempt.worst >= best.worst:
@@ -393,6 +394,12 @@ class _Attempt:
         own = {n: (a, b, t0) for n in names if n not in sensed}
         comparisons = _quantities(a, names, series, grid >= t0, fs, plan, tolerances, errors, own)
         return cls((a, b), (a_check, b_check), grid, fs, series, t0, how, comparisons, starts, drifting)
+
+
+def _extended_note(duration: float, needed: float, plan) -> str:
+    return (f"The run was extended from {duration:.6g} s to {needed:.6g} s to reach its steady state: the free "
+            f"vibration of its start decays to {STEADY_THRESHOLD:g} in {plan.settle:.4g} s, plus "
+            f"{STEADY_WINDOW_CYCLES} mesh cycles to compare.")
 
 
 def _modal_rows(spec, reference, test, modes_a, modes_b) -> list[dict]:

@@ -27,8 +27,9 @@ from fractions import Fraction
 
 import numpy as np
 
-from gearcheck.compare.engine.align import STEADY_THRESHOLD, STEADY_WINDOW_CYCLES
+from gearcheck.compare.engine.align import STEADY_CYCLES, STEADY_THRESHOLD, STEADY_WINDOW_CYCLES
 from gearcheck.compare.engine.metrics import spectral_lines
+from gearcheck.shared.results import train_signals
 from gearcheck.shared.stepping import transient_step
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import kinematics
@@ -81,6 +82,13 @@ class TrainPlan:
         """The shortest run whose steady state the decay of the free vibration guarantees."""
         return None if self.settle is None or math.isinf(self.settle) else \
             self.settle + STEADY_WINDOW_CYCLES * self.cycle
+
+    def detectable(self, duration: float) -> bool:
+        """Whether a run of ``duration`` s holds enough cycles for the cycle test of its steady state
+        (:func:`~gearcheck.compare.engine.align.steady_start`: ``STEADY_CYCLES`` + 1 of each group of the train's
+        compared mesh forces); a shorter one finds a steady state only by the decay of its free vibration."""
+        names = [s.name for s in train_signals(self.spec) if s.compared]
+        return all(duration >= (STEADY_CYCLES + 1) * cycle for _, cycle in self.steady_groups(names))
 
     @property
     def cycle(self) -> float:

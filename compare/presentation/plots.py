@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.figure import Figure
 
+from gearcheck.compare.presentation.envelope import envelope
 from gearcheck.train.cycloid import conjugate_disc_angle, disc_profile
 from gearcheck.train.mesh_stiffness import stiffness_model
 
@@ -85,8 +86,8 @@ def time_histories_figure(result, names=None, cycles: int = 4) -> Figure:
     for ax, name in zip(axes[:, 0], names):
         a, b = result.series[name]
         style_a, style_b = _styles(result)
-        ax.plot(t[window] * 1e3, a[window], **style_a)
-        ax.plot(t[window] * 1e3, b[window], **style_b)
+        ax.plot(*envelope(t[window] * 1e3, a[window]), **style_a)
+        ax.plot(*envelope(t[window] * 1e3, b[window]), **style_b)
         ax.set_ylabel(f"[{units[name]}]")
         ax.set_title(name, fontsize=9)
         ax.grid(alpha=0.3)
@@ -166,9 +167,11 @@ def _spectrum_panel(ax, result, name: str, rng: SpectrumRange, legend: bool) -> 
     peak = 0.0
     for x, style in zip(result.series[name], _styles(result)):
         freq, amp = _amplitude_spectrum(x[window], fs)
-        ax.plot(freq[1:], np.maximum(amp[1:], 1e-30), **style)
         shown = (freq >= rng.low) & (freq <= rng.high)
         peak = max(peak, float(np.max(amp[shown], initial=0.0)))
+        low, high = np.searchsorted(freq, (rng.low, rng.high))  # drawn: the range shown, a sample beyond each end
+        drawn = slice(max(low - 1, 1), high + 1)
+        ax.plot(*envelope(freq[drawn], np.maximum(amp[drawn], 1e-30), log=rng.log), **style)
     ax.set_yscale("log")
     if rng.log:
         ax.set_xscale("log")
@@ -238,9 +241,10 @@ def failing_figure(result, cycles: int = 4) -> Figure | None:
         period = 1.0 / mesh if mesh else result.settings["steady_cycle_s"]
         window = t >= max(t[-1] - cycles * period, result.steady_start_s)
         a, b = (x[window] for x in result.series[q.name])
-        ax_t.plot(t[window] * 1e3, b - a, color="tab:red", lw=0.7, alpha=0.6, label=f"{b_name} - {a_name}")
-        ax_t.plot(t[window] * 1e3, a, **style_a)
-        ax_t.plot(t[window] * 1e3, b, **style_b)
+        ms = t[window] * 1e3
+        ax_t.plot(*envelope(ms, b - a), color="tab:red", lw=0.7, alpha=0.6, label=f"{b_name} - {a_name}")
+        ax_t.plot(*envelope(ms, a), **style_a)
+        ax_t.plot(*envelope(ms, b), **style_b)
         ax_t.set_ylabel(f"[{q.unit}]")
         nrmse = q.metrics["nrmse"]
         ratio = f" ({nrmse / q.tolerance:.3g}x)" if nrmse is not None and q.tolerance else ""

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import NamedTuple
 
 import mujoco
@@ -57,8 +58,10 @@ from gearcheck.mbd_models.mjcf_text import (
     site,
     vec,
 )
+from gearcheck.shared.compiled_cache import ensure_cache_folder
 from gearcheck.shared.results import Signal, TimeResult
 
+ensure_cache_folder(Path(__file__).parent)  # before the cached kernels below are defined
 PIN_BAND = 1.0  # m: a pin tendon's dead band reaches this far below contact (compression only)
 HEADER = [
     "Cycloid pin contacts are compression-only fixed tendons (length = compression) with the coefficients of",

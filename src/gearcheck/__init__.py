@@ -40,65 +40,83 @@ presentation), :mod:`gearcheck.shared` (what every package shares).
 """
 
 import os
-from importlib import metadata, util
-from pathlib import Path
+from importlib import import_module, metadata
+from typing import TYPE_CHECKING
 
-from gearcheck.shared.compiled_cache import ensure_cache_folder
+from gearcheck.shared.public import public
 
 # MuJoCo picks its OpenGL platform when it is imported: without a display, offscreen rendering (animations)
 # goes through EGL unless the user chose otherwise
 if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
     os.environ["MUJOCO_GL"] = "egl"
 
-# before the compiled kernels are defined: a read-only install still imports
-_lumped = util.find_spec("gearcheck.lumped")
-if _lumped is None or not _lumped.submodule_search_locations:  # pragma: no cover - a broken install
-    raise ImportError("gearcheck is installed without its lumped solver (gearcheck.lumped)")
-ensure_cache_folder(Path(_lumped.submodule_search_locations[0]))
-del _lumped
-
-from gearcheck.api import (  # noqa: E402
-                           SOLVERS,
-                           calibrate,
-                           campbell,
-                           crosscheck,
-                           dashboard,
-                           describe,
-                           export_model,
-                           harmonic_response,
-                           load,
-                           mjcf,
-                           mode_pairing,
-                           modes,
-                           pin_loads,
-                           preset_data,
-                           presets,
-                           runup,
-                           sensitivity,
-                           simulate,
-                           sweep,
-                           write_report,
-)
-from gearcheck.compare.engine.comparison import CrosscheckResult
-from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
-from gearcheck.session import Train
-from gearcheck.train.excitation import Excitation
-from gearcheck.train.kinematics import kinematics
-from gearcheck.train.loader import load_text, preset_text
-from gearcheck.train.spec import TrainSpec
-from gearcheck.train.variants import edited
-from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
-from gearcheck.shared.modal import ModalResult
-from gearcheck.shared.results import TimeResult
-from gearcheck.shared.trust import allow_data, trust
-
 __version__ = metadata.version("gearcheck")
 _PACKAGES = ("train", "lumped", "mbd_models", "compare", "shared")
+_DEFINED_IN = {  # module -> the public names it defines, imported on first use: ``gearcheck --version`` loads none
+    "api": ("SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model",
+            "harmonic_response", "load", "mjcf", "mode_pairing", "modes", "pin_loads", "preset_data", "presets",
+            "runup", "sensitivity", "simulate", "sweep", "write_report"),
+    "compare.engine.comparison": ("CrosscheckResult",),
+    "lumped.linear_model": ("LinearModel", "Mesh", "Periodic"),
+    "session": ("Train",),
+    "train.excitation": ("Excitation",),
+    "train.kinematics": ("kinematics",),
+    "train.loader": ("load_text", "preset_text"),
+    "train.spec": ("TrainSpec",),
+    "train.variants": ("edited",),
+    "shared.errors": ("DivergenceError", "GearcheckError", "SolverError", "TrainFileError"),
+    "shared.modal": ("ModalResult",),
+    "shared.results": ("TimeResult",),
+    "shared.trust": ("allow_data", "trust"),
+}
+_, _public_name, _ = public(__name__, {name: module for module, names in _DEFINED_IN.items() for name in names})
+
+if TYPE_CHECKING:  # what type checkers read; at run time :func:`__getattr__` imports each name when first asked
+    from gearcheck.api import (
+                               SOLVERS,
+                               calibrate,
+                               campbell,
+                               crosscheck,
+                               dashboard,
+                               describe,
+                               export_model,
+                               harmonic_response,
+                               load,
+                               mjcf,
+                               mode_pairing,
+                               modes,
+                               pin_loads,
+                               preset_data,
+                               presets,
+                               runup,
+                               sensitivity,
+                               simulate,
+                               sweep,
+                               write_report,
+    )
+    from gearcheck.compare.engine.comparison import CrosscheckResult
+    from gearcheck.lumped.linear_model import LinearModel, Mesh, Periodic
+    from gearcheck.session import Train
+    from gearcheck.train.excitation import Excitation
+    from gearcheck.train.kinematics import kinematics
+    from gearcheck.train.loader import load_text, preset_text
+    from gearcheck.train.spec import TrainSpec
+    from gearcheck.train.variants import edited
+    from gearcheck.shared.errors import DivergenceError, GearcheckError, SolverError, TrainFileError
+    from gearcheck.shared.modal import ModalResult
+    from gearcheck.shared.results import TimeResult
+    from gearcheck.shared.trust import allow_data, trust
+
+
+def __getattr__(name: str):
+    """A public name, or a package beneath (``gearcheck.lumped``), imported when first asked for (PEP 562)."""
+    return import_module(f"{__name__}.{name}") if name in _PACKAGES else _public_name(name)
 
 
 def __dir__() -> list[str]:
     """The front door and the packages beneath it, not the modules this file imports (``os``, ``metadata``)."""
     return sorted({*__all__, *_PACKAGES})
+
 
 __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "GearcheckError", "LinearModel", "Mesh",
            "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",

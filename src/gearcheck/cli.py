@@ -28,22 +28,20 @@ from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-
 import gearcheck
-from gearcheck.compare.presentation import history
-from gearcheck.compare.engine.crosscheck import MODELS
-from gearcheck.compare.presentation.junit import write_junit
 from gearcheck.shared.progress import ProgressBar
-from gearcheck.compare.presentation.report import write_report
 from gearcheck.compare.presentation.summary import overall, overall_line, summary_row, write_summary
 from gearcheck.shared.citations import REFERENCES
 from gearcheck.shared.errors import GearcheckError, did_you_mean, one_line
 from gearcheck.shared.outputs import OutputDirectory, check_place, write_file
 from gearcheck.shared.trust import granted
 from gearcheck.shared.units import checked_rpm, rad_s_to_rpm
-from gearcheck.train.files import report_folders, train_list
 from gearcheck.train.schema import HISTORY_START
+
+# the names the arguments offer, written here so that building the parser imports no solver (``gearcheck --help``
+# answers at once); tests/test_cli.py checks them against the library's own
+SOLVERS = ("lumped", "mujoco")  # gearcheck.SOLVERS
+PUBLISHED_MODELS = ("as-published", "energy-derived", "energy-derived-axis", "consistent")  # --model's 4-DOF models
 
 
 FULL = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}  # a disk full, a quota, a read-only file system
@@ -326,7 +324,7 @@ def settling_line(s: dict) -> str:
 
 def cmd_modes(args) -> int:
     spec = gearcheck.load(args.train)
-    solvers = list(gearcheck.SOLVERS) if args.solver == "both" else [args.solver]
+    solvers = list(SOLVERS) if args.solver == "both" else [args.solver]
     results = [gearcheck.modes(spec, solver, speed=args.speed) for solver in solvers]
     if args.json:
         out = {"train": spec.name, "unit": "Hz", "solvers": [r.to_dict() for r in results]}
@@ -393,6 +391,8 @@ def cmd_mac(args) -> int:
 
 
 def cmd_ste(args) -> int:
+    import numpy as np
+
     from gearcheck.compare.presentation import plots
 
     if args.slices is not None and not 1 <= args.slices <= 1000:
@@ -460,7 +460,7 @@ def cmd_runup(args) -> int:
             raise GearcheckError(f"--against {args.against}: not a sweep table ({one_line(exc)})") from None
         if not {"metric", "solver", "quantity", "mesh", "order", "speed_rpm", "amplitude"} <= set(sweep.columns):
             raise GearcheckError(f"--against {args.against}: not a sweep table (gearcheck sweep's sweep.parquet)")
-    solvers = tuple(gearcheck.SOLVERS) if args.solver == "both" else (args.solver,)
+    solvers = SOLVERS if args.solver == "both" else (args.solver,)
     natural = gearcheck.modes(spec).frequencies
     with OutputDirectory(args.out) as place:
         bar = ProgressBar(f"run-up {spec.name}")
@@ -487,6 +487,8 @@ def cmd_runup(args) -> int:
 
 
 def cmd_sensitivity(args) -> int:
+    import numpy as np
+
     from gearcheck.compare.presentation import plots
     from gearcheck.compare.studies import sensitivity
     from gearcheck.train.loader import read_train_text
@@ -798,6 +800,12 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_crosscheck(args) -> int:
+    from gearcheck.compare.engine.crosscheck import MODELS
+    from gearcheck.compare.presentation import history
+    from gearcheck.compare.presentation.junit import write_junit
+    from gearcheck.compare.presentation.report import write_report
+    from gearcheck.train.files import report_folders, train_list
+
     if args.all == bool(args.train):
         raise GearcheckError("give TRAIN (one or more) or --all, not both")
     names = gearcheck.presets() if args.all else train_list(args.train)
@@ -897,7 +905,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
     "modes": Command(
         cmd_modes, "natural frequencies and mode types (at rest, or turning at --speed)",
         TRAIN,
-        arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="lumped"),
+        arg("--solver", choices=SOLVERS + ("both",), default="lumped"),
         arg("--speed", type=RPM_OR_ZERO, metavar="RPM",
             help="the gyroscopic modes of the train turning at this input speed (0 allowed)"),
         arg("--json", action="store_true", help="machine-readable output"),
@@ -907,7 +915,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         TRAIN,
         arg("--speeds", type=SPEED_RANGE, required=True, metavar="A:B:N",
             help="N input speeds from A to B rpm (0 <= A < B, N >= 2)"),
-        arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both"),
+        arg("--solver", choices=SOLVERS + ("both",), default="both"),
         arg("--harmonics", type=int, default=3, metavar="H", help="mesh harmonics drawn (default 3)"),
         arg("--out", type=PATH, default=Path("out/campbell"), metavar="DIR",
             help="writes campbell.png and campbell.json (default out/campbell)"),
@@ -935,7 +943,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
     "run": Command(
         cmd_run, "time response at the operating point",
         TRAIN,
-        arg("--solver", choices=tuple(gearcheck.SOLVERS), default="lumped"),
+        arg("--solver", choices=SOLVERS, default="lumped"),
         arg("--speed", type=RPM, metavar="RPM", help="input speed (default: the train file's)"),
         arg("--duration", type=SECONDS, default=0.2, metavar="S", help="simulated time (default 0.2 s)"),
         arg("--dt", type=SECONDS, metavar="S", help="time step (default: from the highest natural frequency)"),
@@ -960,7 +968,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
                  "than general)"),
         arg("--model", default="general", metavar="MODEL",
             help="the model checked: gearcheck's general model against MuJoCo (default), a published "
-                        f"4-DOF model ({', '.join(MODELS[1:])}: double-planet) against the twin of its "
+                        f"4-DOF model ({', '.join(PUBLISHED_MODELS)}: double-planet) against the twin of its "
                         "idealisation, or your own: a .mat/.npz file of matrices, module:factory, "
                         "file.py:factory, or 'user' (the train file's train.user_model), checked against --against"),
         arg("--against", default="lumped", choices=("lumped", "mujoco"),
@@ -1022,7 +1030,7 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
             help="Monte Carlo: a TOML file with a [distributions] table, \"FIELD\" = \"normal(mean, sd)\""),
         arg("--samples", type=int, metavar="N", help="Monte Carlo draws (default 32)"),
         arg("--seed", type=int, default=0, metavar="S", help="Monte Carlo seed (default 0)"),
-        arg("--solver", choices=tuple(gearcheck.SOLVERS) + ("both",), default="both"),
+        arg("--solver", choices=SOLVERS + ("both",), default="both"),
         arg("--duration", type=SECONDS, default=0.5, metavar="S",
             help="simulated time of a run from the static state, the longest a continued point runs (default 0.5 s)"),
         arg("--harmonics", type=int, default=3, metavar="N", help="mesh harmonics per mesh frequency (default 3)"),

@@ -2,9 +2,10 @@
 
 numba caches a kernel beside its source (``__pycache__``) or, where that is read-only, in the user's cache folder;
 with neither writable (a read-only install used by a user without a writable home) it refuses to define the
-kernel at all ("cannot cache function: no locator available"), and gearcheck could not be imported.  There
-:func:`ensure_cache_folder` points numba at a private folder of this user in the system's temporary folder, and the
-kernels compile there once per machine instead.
+kernel at all ("cannot cache function: no locator available"), and its module could not be imported.  There
+:func:`ensure_cache_folder`, called by each module of cached kernels before it defines them (not by ``import
+gearcheck``, which loads no numba), points numba at a private folder of this user in the system's temporary folder,
+and the kernels compile there once per machine instead.
 """
 
 from __future__ import annotations

@@ -14,8 +14,14 @@ Both solvers call these numerics; each locates its own events from its own state
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from numba import njit
+
+from gearcheck.shared.compiled_cache import ensure_cache_folder
+
+ensure_cache_folder(Path(__file__).parent)  # before the cached kernels below are defined
 
 MAX_EVENTS = 8  # contact events located within one (sub-)step; more are resolved to the step
 MIN_FRACTION = 1e-9  # an event this close to a step's ends is taken as there

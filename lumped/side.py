@@ -99,7 +99,8 @@ class LumpedSide(Side):
         steady = periodic_steady_state(self.model, dt=settings.dt)
         run = simulate(self.model, replace(settings, dt=steady.dt), method=self.method, y0=steady.y0,
                        progress=progress)
-        check = simulate(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None), method=self.method,
+        check = simulate(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None,
+                                     signals=tuple(run.names(compared=True))), method=self.method,
                          y0=steady.y0)
         return run, check, steady.words("lumped")
 

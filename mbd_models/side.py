@@ -84,7 +84,8 @@ class MujocoSide(Side):
         steady = periodic_state(self.model, dt=settings.dt)
         options = {"initial_state": steady.initial_state, "stiffness_clock": self.stiffness_clock}
         run = simulate_mujoco(self.model, replace(settings, dt=steady.dt), progress=progress, **options)
-        check = simulate_mujoco(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None), **options)
+        check = simulate_mujoco(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None,
+                                                    signals=tuple(run.names(compared=True))), **options)
         return run, check, steady.words("MuJoCo")
 
 

@@ -3,6 +3,7 @@
 import io
 
 import numpy as np
+import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
@@ -157,3 +158,19 @@ def test_a_translation_along_the_worlds_axes_is_unresolved_where_its_carrier_sid
     assert not lines.loc[lines["quantity"] == "stage1.ring.ay.world", "resolved"].any()
     assert lines.loc[lines["quantity"] == "stage1.ring.ay.carrier", "resolved"].any()
     assert all(q.endswith(".ay.carrier") or q.endswith(".force") for q in result.headline())
+
+
+def test_a_line_at_an_unchecked_speed_is_read_by_its_checked_neighbours():
+    """Speeds 1..5, checked at 1, 3 and 5: the line's relative estimate there is 1 %, 30 % and 2 %; at 2 and 4 it
+    takes the larger of its neighbours' (30 %: not counted); without any check every line counts."""
+    from gearcheck.compare.studies.sweep_lines import counted
+
+    rows = pd.DataFrame({"sample": 0, "solver": "lumped", "quantity": "q", "mesh": "I", "order": 1,
+                         "speed_rpm": [1.0, 2.0, 3.0, 4.0, 5.0], "amplitude": 10.0, "resolved": True,
+                         "steady": "continued", "integration_error": [0.1, np.nan, 3.0, np.nan, 0.2]})
+    assert list(counted(rows)) == [True, False, False, False, True]
+    rows.loc[2, "integration_error"] = 0.5  # 5 %: every line within a tenth
+    assert counted(rows).all()
+    assert counted(rows.assign(integration_error=np.nan)).all()
+    rows.loc[1, "integration_error"] = 2.0  # its own estimate, 20 %, rules
+    assert list(counted(rows)) == [True, False, True, True, True]

@@ -485,7 +485,8 @@ def _run_pairs(sides, settings, clock, progress, periodic=False, starts=None):
         check_dt = check_step(side, run.info["dt_s"])
         report = (lambda f, i=i: progress((1.5 * i + 1.0 + 0.5 * f) / 3.0)) if progress else None
         with clock.step(f"{label}_check_s"):
-            check = side.run(replace(run_settings, dt=check_dt, output_dt=None), report)
+            check = side.run(replace(run_settings, dt=check_dt, output_dt=None,
+                                     signals=tuple(run.names(compared=True)) or None), report)
         _log_work(f"{label} check", check)
         pairs.append((run, check))
     return pairs

@@ -791,7 +791,8 @@ def cmd_sweep(args) -> int:
               "helps")
     if summary["unconverged_lines"]:
         print(f"  {summary['unconverged_lines']} of {summary['lines']} resolved lines have an integration error "
-              f"estimate above {CONVERGED:.0%} of their amplitude: left out of the peaks, faint in the plots")
+              f"estimate above {CONVERGED:.0%} of their amplitude (their own, or at an unchecked speed their checked "
+              "neighbours'): left out of the peaks, faint in the plots")
     for failure in summary["failed"]:
         print(f"  point {failure['point']} ({failure['solver']}) failed: {failure['error']}")
     print(f"  wrote {args.out / 'sweep.parquet'} ({result.table.num_rows} rows), "

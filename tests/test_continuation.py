@@ -174,3 +174,11 @@ def test_a_line_at_an_unchecked_speed_is_read_by_its_checked_neighbours():
     assert counted(rows.assign(integration_error=np.nan)).all()
     rows.loc[1, "integration_error"] = 2.0  # its own estimate, 20 %, rules
     assert list(counted(rows)) == [True, False, True, True, True]
+
+
+def test_both_solvers_read_a_continued_point_over_one_window():
+    frame = sw.sweep("demo-3p", speeds=[1000.0, 1010.0, 1020.0], workers=1, integration_check="none").to_pandas()
+    runs = frame[frame["metric"] == "rms"].drop_duplicates(["point", "solver"]).set_index(["point", "solver"])
+    for point in (1, 2):
+        assert runs.loc[(point, "lumped"), "start"] == runs.loc[(point, "mujoco"), "start"] == "continued"
+        assert runs.loc[(point, "lumped"), "steady_start_s"] == runs.loc[(point, "mujoco"), "steady_start_s"]

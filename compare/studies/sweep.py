@@ -50,6 +50,7 @@ a byte-identical Parquet file.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import importlib.metadata
 import io
@@ -529,11 +530,21 @@ def _run_point(point: Point, before: bytes | None) -> tuple[bytes, float, float]
                      order=k, frequency_hz=float(f))
     lines = [(label, k, k * f) for label, f in mesh_groups(spec, model.kin) for k in range(1, point.harmonics + 1)]
     checked = _checked(point, [f for _, _, f in lines], *lumped.resonances())
-    states = {}
+    runs, failed = {}, {}
     for solver in point.solvers:
         side = lumped if solver == "lumped" else MujocoSide(spec)
         try:
-            run = _steady_run(side, point, plan, lines, before)
+            runs[solver] = (side, _steady_run(side, point, plan, lines, before))
+        except SolverError as exc:
+            failed[solver] = str(exc)
+    runs = _aligned(runs, point, plan, lines, failed)
+    states = {}
+    for solver in point.solvers:
+        if solver in failed:
+            rows.add(solver=solver, quantity="", metric="failed", error=failed[solver])
+            continue
+        side, run = runs[solver]
+        try:
             check = _check_run(side, point, run) if checked != "no" else None
         except SolverError as exc:
             rows.add(solver=solver, quantity="", metric="failed", error=str(exc))
@@ -599,6 +610,41 @@ def _steady_run(side, point: Point, plan, lines, before) -> _SteadyRun:
     found_at, found_how = steady_state(result.t, series, plan.settle) if series else (None, None)
     at, how = (found_at, found_how) if found_at is not None and found_how else (0.5 * result.t[-1], "none")
     return _SteadyRun(result, (at, how), start, final, None, continued.waveforms(result, groups, at), None, dt)
+
+
+def _aligned(runs: dict, point: Point, plan, lines, failed: dict) -> dict:
+    """The solvers' runs of a point ({solver: (side, run)}) over one steady window: where every one continued, the
+    shorter runs extended to the longest's end and the window started at the latest of their steady starts; where
+    some did not, every solver's run from the static state.  Windows over other instants read other phases of a
+    response that two incommensurate stages make quasi-periodic, and the solvers would differ by that (on the
+    hub-drive sweep, each on its own window: 1e-4 median, 20 % at the 99th percentile over the lines that count).
+    A run that fails on the way goes into ``failed``."""
+    starts = {run.start for _, run in runs.values()}
+    if len(runs) < 2 or "continued" not in starts:
+        return runs
+    aligned = {}
+    for solver, (side, run) in runs.items():
+        try:
+            if starts != {"continued"}:
+                aligned[solver] = (side, run if run.start != "continued" else dataclasses.replace(
+                    _steady_run(side, point, plan, lines, None), start="cold: continuation did not settle"))
+            else:
+                aligned[solver] = (side, _extended(side, run, max(r.result.t[-1] for _, r in runs.values()),
+                                                   max(r.steady[0] for _, r in runs.values()), plan))
+        except SolverError as exc:
+            failed[solver] = str(exc)
+    return aligned
+
+
+def _extended(side, run: _SteadyRun, end: float, start: float, plan) -> _SteadyRun:
+    """``run`` (continued) gone on to ``end``, its steady window from ``start``."""
+    names = tuple(run.result.names())
+    result, state = run.result, run.state
+    if end - state.t > 0.5 * run.dt:
+        more, state = side.run_from(RunSettings(end - state.t, dt=run.dt, start=state.t, signals=names), state)
+        result = continued.joined([result, more])
+    return dataclasses.replace(run, result=result, state=state, steady=(start, "continued"),
+                               shapes=continued.waveforms(result, plan.steady_groups(names), start))
 
 
 def _signal_names(spec) -> list[str]:

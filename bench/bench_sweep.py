@@ -60,6 +60,26 @@ def timed(label, count, speeds, args, continuation=True, check="subset", **backe
             "checked": float(np.mean(frame["checked"] != "no")), "bytes": result.parquet()}
 
 
+def memory(train: str, speed: float) -> tuple[float, float]:
+    """Peak memory (MB, numpy's allocations by tracemalloc) of one point from rest and of the next, continued, in
+    this process, both solvers, no integration check."""
+    import tracemalloc
+
+    from gearcheck.compare.studies import sweep as engine
+
+    first, second = engine.plan_sweep(train, speeds=[speed, speed + 10.0], integration_check="none").points
+    engine.run_point(engine.plan_sweep("demo-3p", speeds=[1000.0], duration=0.005).points[0])  # imports, kernels
+    peaks = []
+    tracemalloc.start()
+    before = None
+    for point in (first, second):
+        tracemalloc.reset_peak()
+        before, _, _ = engine.run_point(point, before)
+        peaks.append(tracemalloc.get_traced_memory()[1] / 2**20)
+    tracemalloc.stop()
+    return peaks[0], peaks[1]
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--train", default="hub-drive")
@@ -72,6 +92,7 @@ def main(argv=None):
     p.add_argument("--workers", default="1,2", help="local process counts (default 1,2)")
     p.add_argument("--no-dask", action="store_true", help="leave the Dask LocalCluster out")
     p.add_argument("--gains", action="store_true", help="also run each saving on its own (on the most workers)")
+    p.add_argument("--memory", action="store_true", help="also measure a point's peak memory, from rest and continued")
     args = p.parse_args(argv)
     grid = np.linspace(args.low, args.high, args.points) if args.points > 1 else np.array([args.low])
     if args.span:
@@ -115,6 +136,10 @@ def main(argv=None):
         for g in gains:
             print(f"{g['label']:<40} {g['cpu']:>11.3f} {gains[0]['cpu'] / g['cpu']:>6.2f} {g['wall']:>9.2f} "
                   f"{g['continued']:>9.0%} {g['checked']:>8.0%} {g['load']:>5.1f}")
+    if args.memory:
+        rest, going_on = memory(args.train, speeds[len(speeds) // 2])
+        print(f"\npeak memory of a point (numpy's allocations, both solvers, no check): from rest {rest:.0f} MB, "
+              f"continued {going_on:.0f} MB (target <= 150 MB)")
     full = len(speeds) == TARGET_POINTS and args.points == TARGET_POINTS and args.train == "hub-drive" and \
         args.solver == "both" and args.duration == 0.5
     two = [r for r in rows if r["workers"] == 2]

@@ -171,26 +171,43 @@ def joined(results: list[TimeResult]) -> TimeResult:
     return TimeResult(first.train, first.solver, t, first.signals, values, first.settle_time, first.info)
 
 
+def run_over(side, settings: RunSettings, state: RunState, dense: float, end: float):
+    """(run, final state) of ``side`` from ``state`` to ``end`` (at the step and with the signals of ``settings``)
+    sampled at every step from ``dense`` on, and before that only where it starts and ends: a point's settling
+    stretch, which nothing reads, takes no memory.  The run is None where ``end`` is not a step away."""
+    results, now = [], state
+    for stop, sparse in ((dense, True), (end, False)):
+        steps = round((stop - now.t) / settings.dt)
+        if steps > 0:
+            span = steps * settings.dt  # whole steps: sampled once at the end, the sparse stretch ends on its step
+            result, now = side.run_from(dataclasses.replace(settings, duration=span, start=now.t,
+                                                            output_dt=span if sparse else None), now)
+            results.append(result)
+    return (joined(results) if results else None), now
+
+
 def run_continued(side, settings: RunSettings, state: RunState, rho_guess: float | None, window: float, groups,
                   before: dict):
     """The continued run of ``side`` from ``state`` (already at the point's speed), at the step and with the signals
     of ``settings``: (run, its steady start, rho, the state it ended in, its waveforms), or None where it does not
     settle within ``settings.duration``.  ``window``: how long the steady window must be; ``groups``: the plan's
-    steady-state groups; ``before``: the neighbour's waveforms."""
+    steady-state groups; ``before``: the neighbour's waveforms.  The run waits the settle time of ``rho_guess`` (the
+    neighbour's rho) sampled sparsely, then holds the window; where the rho it measures there asks for longer, it
+    goes on to that settle time and a window after it."""
     t0 = state.t
-    target = settle_after(side, rho_guess) + window
+    start = t0 + settle_after(side, rho_guess)
     results, now = [], state
     while True:
-        if target > settings.duration:
+        if start + window - t0 > settings.duration:
             return None
-        result, now = side.run_from(dataclasses.replace(settings, duration=target - (now.t - t0), start=now.t), now)
-        results.append(result)
+        result, now = run_over(side, settings, now, start, start + window)
+        if result is not None:
+            results.append(result)
         run = joined(results)
-        shapes = waveforms(run, groups, t0 + min(settle_after(side, rho_guess), now.t - t0 - window))
+        shapes = waveforms(run, groups, start)
         rho = mismatch(shapes, before)
         if rho >= 1.0:
             return None
-        need = settle_after(side, rho) + window
-        if need <= now.t - t0 + 1e-12:
-            return run, t0 + settle_after(side, rho), rho, now, shapes
-        rho_guess, target = rho, need
+        if t0 + settle_after(side, rho) <= start + 1e-12:
+            return run, start, rho, now, shapes
+        start = t0 + settle_after(side, rho)

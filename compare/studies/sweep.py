@@ -657,8 +657,9 @@ def _check_run(side, point: Point, run: _SteadyRun):
     names = tuple(run.result.names())
     if run.initial is None:
         return side.run(RunSettings(point.duration, dt=h, signals=names))
-    return side.run_from(RunSettings(run.result.t[-1] - run.initial.t, dt=h, start=run.initial.t, signals=names),
-                         run.initial)[0]
+    span = run.result.t[-1] - run.initial.t
+    return continued.run_over(side, RunSettings(span, dt=h, signals=names), run.initial, run.steady[0],
+                              run.result.t[-1])[0]
 
 
 def reduce_run(result, plan, lines, rows: _Rows, solver: str, steady: tuple[float, str], check=None,

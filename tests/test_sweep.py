@@ -200,10 +200,10 @@ def test_monte_carlo_draws_are_seeded_and_prefix_stable():
 def test_a_solver_that_fails_on_a_point_is_a_row(monkeypatch):
     from gearcheck.lumped.side import LumpedSide
 
-    def refuse(self, settings, progress=None):
+    def refuse(self, settings, state=None):
         raise SolverError("diverged at t = 0.01 s: test")
 
-    monkeypatch.setattr(LumpedSide, "run", refuse)
+    monkeypatch.setattr(LumpedSide, "run_from", refuse)
     frame = sw.sweep("demo-3p", speeds=[1000.0], workers=1, **FAST).to_pandas()
     failed = frame[frame["metric"] == "failed"]
     assert failed["error"].tolist() == ["diverged at t = 0.01 s: test"]

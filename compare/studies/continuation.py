@@ -171,18 +171,20 @@ def joined(results: list[TimeResult]) -> TimeResult:
     return TimeResult(first.train, first.solver, t, first.signals, values, first.settle_time, first.info)
 
 
-def run_over(side, settings: RunSettings, state: RunState, dense: float, end: float):
-    """(run, final state) of ``side`` from ``state`` to ``end`` (at the step and with the signals of ``settings``)
-    sampled at every step from ``dense`` on, and before that only where it starts and ends: a point's settling
-    stretch, which nothing reads, takes no memory.  The run is None where ``end`` is not a step away."""
-    results, now = [], state
+def run_over(side, settings: RunSettings, state: RunState | None, dense: float, end: float):
+    """(run, final state) of ``side`` from ``state`` (None: its own start at t = 0) to ``end`` (at the step and with
+    the signals of ``settings``) sampled at every step from ``dense`` on, and before that only where it starts and
+    ends: a point's settling stretch, which nothing reads, takes no memory.  The run is None where ``end`` is not a
+    step away."""
+    results, now, t = [], state, 0.0 if state is None else state.t
     for stop, sparse in ((dense, True), (end, False)):
-        steps = round((stop - now.t) / settings.dt)
+        steps = round((stop - t) / settings.dt)
         if steps > 0:
             span = steps * settings.dt  # whole steps: sampled once at the end, the sparse stretch ends on its step
-            result, now = side.run_from(dataclasses.replace(settings, duration=span, start=now.t,
+            result, now = side.run_from(dataclasses.replace(settings, duration=span, start=t,
                                                             output_dt=span if sparse else None), now)
             results.append(result)
+            t = now.t
     return (joined(results) if results else None), now
 
 

@@ -303,6 +303,15 @@ def mjcf(train, speed: float | None = None) -> str:
     return Train(train, speed).mjcf()
 
 
+def compile_kernels() -> None:
+    """Compile the solvers' numba kernels now, or load them from numba's disk cache: a few steps of demo-3p in each
+    solver.  A process about to start others that run gearcheck (a test session before its workers) calls it
+    once, so that they read the cache instead of each compiling (some 10 s of CPU in a fresh environment)."""
+    train = Train("demo-3p")
+    for solver in SOLVERS:
+        train.simulate(solver, duration=0.003)
+
+
 def describe(train) -> dict:
     """What a train derives from its file (``gearcheck show``): speeds, ratio, gear radii, every mesh's contact
     ratio, frequency, phase, stiffness and damping, an RV reducer's cycloid-pin stage; JSON-ready."""

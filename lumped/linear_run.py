@@ -21,6 +21,7 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from numba import njit
 
 from gearcheck.lumped.linear_model import Periodic
 from gearcheck.lumped.member_motion import member_motion
@@ -109,26 +110,25 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None, y0=
     steps, every = settings.check_work(dt, 3 * model.n, f"model {model.name}")
     t = np.arange(steps + 1) * dt
     rates = _rates(model, t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt)
-
-    def acceleration(i, s, q, v):
-        return rates(i, s, q[:, None], v[:, None])[:, 0]
-
     q0, v = _start(model) if y0 is None else (np.array(y0[0], dtype=float), np.array(y0[1], dtype=float))
-    q = q0
+    q, v = q0.copy(), v.copy()
     n_out = steps // every + 1
     Q, V, Qdd = (np.empty((n_out, model.n)) for _ in range(3))
-    for i in range(steps + 1):
-        if i % every == 0:
-            j = i // every
-            Q[j], V[j], Qdd[j] = q, v, acceleration(i, 0, q, v)
-        if i == steps:
-            break
-        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(i, s, q_, v_), q, v, dt)
-        if i % CHUNK == 0:
-            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-                raise DivergenceError(float(t[i + 1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
-            if progress is not None:
-                progress(i / steps)
+    for first in range(0, steps, CHUNK):
+        last = min(first + CHUNK, steps)
+        if rates.terms is not None:
+            _rk4_steps(q, v, dt, first, last, every, *rates.terms, Q, V, Qdd)
+        else:
+            for i in range(first, last):
+                if i % every == 0:
+                    Q[i // every], V[i // every], Qdd[i // every] = q, v, rates(i, 0, q[:, None], v[:, None])[:, 0]
+                q, v = rk4_step(lambda s, q_, v_, i=i: rates(i, s, q_[:, None], v_[:, None])[:, 0], q, v, dt)
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            raise DivergenceError(float(t[last]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
+        if progress is not None:
+            progress(first / steps)
+    if steps % every == 0:
+        Q[-1], V[-1], Qdd[-1] = q, v, rates(steps, 0, q[:, None], v[:, None])[:, 0]
     if not np.all(np.isfinite(Q)):
         raise DivergenceError(float(t[-1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
     if progress is not None:
@@ -143,23 +143,71 @@ def _rates(model, stage_t: np.ndarray):
     """q'' = M^-1 (f(t) - D q' - (K(t) + K_omega + sum_m k_m(t) a_m a_m^T) q) at the stage times ``stage_t``
     (steps x stages): ``rates(i, s, Q, V)`` for states as the columns of Q, V, the forcing f(t) = F(t) +
     sum_m a_m (k_m e_m + c_m e_m') acting on the last column alone -- one column is a run; the unit states
-    beside a last zero one give a period's monodromy matrix and its particular response."""
+    beside a last zero one give a period's monodromy matrix and its particular response.  M^-1 is applied to
+    each matrix once, and to a constant K or F once, not at every stage."""
     M_inv = np.linalg.inv(model.M)
-    D = model.damping
     K_omega = model.frame[1]
     A = model.mesh_rows
+    MD, MA = M_inv @ model.damping, M_inv @ A.T
+    MK = M_inv @ (model.matrix("K") + K_omega) if model.stiffness is None else None
+    MF = M_inv @ model.matrix("F") if model.forcing is None else None
     errors = [m.transmission_error(stage_t) for m in model.meshes]
     k_mesh = _along_last([m.k(stage_t) for m in model.meshes], stage_t.shape)
-    e_mesh = _along_last([e for e, _ in errors], stage_t.shape)
-    c_de = _along_last([m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
+    mesh_forcing = k_mesh * _along_last([e for e, _ in errors], stage_t.shape) + _along_last(
+        [m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
 
     def rates(i, s, Q, V):
-        ti, k = stage_t[i, s], k_mesh[i, s]
-        force = -(D @ V) - (model.K_at(ti) + K_omega) @ Q - A.T @ (k[:, None] * (A @ Q))
-        force[:, -1] += model.F_at(ti) + A.T @ (k * e_mesh[i, s] + c_de[i, s])
-        return M_inv @ force
+        ti = stage_t[i, s]
+        stiffness = MK if MK is not None else M_inv @ (model.K_at(ti) + K_omega)
+        out = -(MD @ V) - stiffness @ Q - MA @ (k_mesh[i, s][:, None] * (A @ Q))
+        out[:, -1] += (MF if MF is not None else M_inv @ model.F_at(ti)) + MA @ mesh_forcing[i, s]
+        return out
 
+    # with K and F constant, the arrays of a compiled run (:func:`_rk4_steps`)
+    rates.terms = None if MK is None or MF is None else (MD, MK, MA, np.ascontiguousarray(A), k_mesh, mesh_forcing,
+                                                         MF, np.empty(A.shape[0]), np.empty((4, model.n)))
     return rates
+
+
+@njit(cache=True)
+def _acceleration(i, s, q, v, MD, MK, MA, A, k_mesh, mesh_forcing, MF, w, out):
+    """``rates`` of :func:`_rates` for one run, K and F constant: q'' = M^-1 F - M^-1 D q' - M^-1 K q - M^-1 A^T w,
+    w_m = k_m a_m.q - (k_m e_m + c_m e_m'), into ``out``."""
+    n = q.size
+    for m in range(A.shape[0]):
+        x = 0.0
+        for c in range(n):
+            x += A[m, c] * q[c]
+        w[m] = k_mesh[i, s, m] * x - mesh_forcing[i, s, m]
+    for r in range(n):
+        x = MF[r]
+        for c in range(n):
+            x -= MD[r, c] * v[c] + MK[r, c] * q[c]
+        for m in range(A.shape[0]):
+            x -= MA[r, m] * w[m]
+        out[r] = x
+
+
+@njit(cache=True)
+def _rk4_steps(q, v, h, first, last, every, MD, MK, MA, A, k_mesh, mesh_forcing, MF, w, acc, Q, V, Qdd):
+    """Steps ``first`` to ``last`` of :func:`simulate_linear`'s RK4 (the stages of
+    :func:`~gearcheck.lumped.time_solver.rk4_step`) compiled, q and v updated in place, the state of every
+    ``every``-th step written to Q, V, Qdd."""
+    terms = (MD, MK, MA, A, k_mesh, mesh_forcing, MF, w)
+    for i in range(first, last):
+        if i % every == 0:
+            Q[i // every] = q
+            V[i // every] = v
+            _acceleration(i, 0, q, v, *terms, Qdd[i // every])
+        _acceleration(i, 0, q, v, *terms, acc[0])
+        q2, v2 = q + 0.5 * h * v, v + 0.5 * h * acc[0]
+        _acceleration(i, 1, q2, v2, *terms, acc[1])
+        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * acc[1]
+        _acceleration(i, 1, q3, v3, *terms, acc[2])
+        q4, v4 = q + h * v3, v + h * acc[2]
+        _acceleration(i, 2, q4, v4, *terms, acc[3])
+        q[:] = q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4)
+        v[:] = v + h / 6.0 * (acc[0] + 2 * acc[1] + 2 * acc[2] + acc[3])
 
 
 def drive_period(model) -> float:

@@ -116,8 +116,8 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None, y0=
     Q, V, Qdd = (np.empty((n_out, model.n)) for _ in range(3))
     for first in range(0, steps, CHUNK):
         last = min(first + CHUNK, steps)
-        if rates.terms is not None:
-            _rk4_steps(q, v, dt, first, last, every, *rates.terms, Q, V, Qdd)
+        if rates.chunk is not None:
+            _rk4_steps(q, v, dt, first, last, every, *rates.chunk(first, last), Q, V, Qdd)
         else:
             for i in range(first, last):
                 if i % every == 0:
@@ -144,7 +144,8 @@ def _rates(model, stage_t: np.ndarray):
     (steps x stages): ``rates(i, s, Q, V)`` for states as the columns of Q, V, the forcing f(t) = F(t) +
     sum_m a_m (k_m e_m + c_m e_m') acting on the last column alone -- one column is a run; the unit states
     beside a last zero one give a period's monodromy matrix and its particular response.  M^-1 is applied to
-    each matrix once, and to a constant K or F once, not at every stage."""
+    each matrix once, not at every stage.  ``rates.chunk(first, last)``: the arrays of a run's compiled steps
+    (:func:`_rk4_steps`), None where the stiffness K(t) varies (its stages then run in Python)."""
     M_inv = np.linalg.inv(model.M)
     K_omega = model.frame[1]
     A = model.mesh_rows
@@ -163,49 +164,57 @@ def _rates(model, stage_t: np.ndarray):
         out[:, -1] += (MF if MF is not None else M_inv @ model.F_at(ti)) + MA @ mesh_forcing[i, s]
         return out
 
-    # with K and F constant, the arrays of a compiled run (:func:`_rk4_steps`)
-    rates.terms = None if MK is None or MF is None else (MD, MK, MA, np.ascontiguousarray(A), k_mesh, mesh_forcing,
-                                                         MF, np.empty(A.shape[0]), np.empty((4, model.n)))
+    def chunk(first, last):
+        """The arrays of :func:`_rk4_steps` over steps ``first`` to ``last``: the matrices, the meshes' stiffness
+        and the forcing M^-1 f(t) at the stage times."""
+        times = stage_t[first:last]
+        F = MF if MF is not None else np.array([model.F_at(t) for t in times.ravel()]).reshape(
+            *times.shape, model.n) @ M_inv.T
+        return (MD, MK, MA, A, np.ascontiguousarray(k_mesh[first:last]), F + mesh_forcing[first:last] @ MA.T,
+                np.empty(A.shape[0]), np.empty((4, model.n)))
+
+    rates.chunk = chunk if MK is not None else None
     return rates
 
 
 @njit(cache=True)
-def _acceleration(i, s, q, v, MD, MK, MA, A, k_mesh, mesh_forcing, MF, w, out):
-    """``rates`` of :func:`_rates` for one run, K and F constant: q'' = M^-1 F - M^-1 D q' - M^-1 K q - M^-1 A^T w,
-    w_m = k_m a_m.q - (k_m e_m + c_m e_m'), into ``out``."""
+def _acceleration(r, s, q, v, MD, MK, MA, A, k_mesh, force, w, out):
+    """``rates`` of :func:`_rates` for one run with K constant, into ``out``: q'' = force[r, s] - M^-1 D q'
+    - M^-1 K q - M^-1 A^T w, w_m = k_m a_m.q at stage s of the chunk's step r."""
     n = q.size
     for m in range(A.shape[0]):
         x = 0.0
         for c in range(n):
             x += A[m, c] * q[c]
-        w[m] = k_mesh[i, s, m] * x - mesh_forcing[i, s, m]
-    for r in range(n):
-        x = MF[r]
+        w[m] = k_mesh[r, s, m] * x
+    for i in range(n):
+        x = force[r, s, i]
         for c in range(n):
-            x -= MD[r, c] * v[c] + MK[r, c] * q[c]
+            x -= MD[i, c] * v[c] + MK[i, c] * q[c]
         for m in range(A.shape[0]):
-            x -= MA[r, m] * w[m]
-        out[r] = x
+            x -= MA[i, m] * w[m]
+        out[i] = x
 
 
 @njit(cache=True)
-def _rk4_steps(q, v, h, first, last, every, MD, MK, MA, A, k_mesh, mesh_forcing, MF, w, acc, Q, V, Qdd):
+def _rk4_steps(q, v, h, first, last, every, MD, MK, MA, A, k_mesh, force, w, acc, Q, V, Qdd):
     """Steps ``first`` to ``last`` of :func:`simulate_linear`'s RK4 (the stages of
     :func:`~gearcheck.lumped.time_solver.rk4_step`) compiled, q and v updated in place, the state of every
-    ``every``-th step written to Q, V, Qdd."""
-    terms = (MD, MK, MA, A, k_mesh, mesh_forcing, MF, w)
+    ``every``-th step written to Q, V, Qdd; the drive (``k_mesh``, ``force``) is the chunk's."""
+    terms = (MD, MK, MA, A, k_mesh, force, w)
     for i in range(first, last):
+        r = i - first
         if i % every == 0:
             Q[i // every] = q
             V[i // every] = v
-            _acceleration(i, 0, q, v, *terms, Qdd[i // every])
-        _acceleration(i, 0, q, v, *terms, acc[0])
+            _acceleration(r, 0, q, v, *terms, Qdd[i // every])
+        _acceleration(r, 0, q, v, *terms, acc[0])
         q2, v2 = q + 0.5 * h * v, v + 0.5 * h * acc[0]
-        _acceleration(i, 1, q2, v2, *terms, acc[1])
+        _acceleration(r, 1, q2, v2, *terms, acc[1])
         q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * acc[1]
-        _acceleration(i, 1, q3, v3, *terms, acc[2])
+        _acceleration(r, 1, q3, v3, *terms, acc[2])
         q4, v4 = q + h * v3, v + h * acc[2]
-        _acceleration(i, 2, q4, v4, *terms, acc[3])
+        _acceleration(r, 2, q4, v4, *terms, acc[3])
         q[:] = q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4)
         v[:] = v + h / 6.0 * (acc[0] + 2 * acc[1] + 2 * acc[2] + acc[3])
 

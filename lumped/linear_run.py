@@ -5,7 +5,8 @@
   K_omega (Cooley & Parker 2012); :func:`set_aside` parts the modes that the model's extra coordinates (a
   motor, a coupling: mapped to no train coordinate) dominate from the train's;
 * :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest, or any state), the
-  stiffness, meshes and forcing evaluated at each stage's time; :func:`periodic_start`, the state its RK4 map
+  stiffness, meshes and forcing evaluated at each stage's time, its steps compiled (numba) where the stiffness K
+  is constant (with a K(t), in Python); :func:`periodic_start`, the state its RK4 map
   returns to after the drive's period, solved exactly (the map is affine);
 * :func:`linear_result` -- what the run reports: every coordinate, its velocity and its acceleration, and,
   through the model's map to the train's coordinates, the train's signals the model has (member accelerations,

@@ -5,7 +5,8 @@
   K_omega (Cooley & Parker 2012); :func:`set_aside` parts the modes that the model's extra coordinates (a
   motor, a coupling: mapped to no train coordinate) dominate from the train's;
 * :func:`simulate_linear` -- fixed-step classical RK4 from the static state (or from rest, or any state), the
-  stiffness, meshes and forcing evaluated at each stage's time; :func:`periodic_start`, the state its RK4 map
+  stiffness, meshes and forcing evaluated at each stage's time, its steps compiled (numba) where the stiffness K
+  is constant (with a K(t), in Python); :func:`periodic_start`, the state its RK4 map
   returns to after the drive's period, solved exactly (the map is affine);
 * :func:`linear_result` -- what the run reports: every coordinate, its velocity and its acceleration, and,
   through the model's map to the train's coordinates, the train's signals the model has (member accelerations,
@@ -21,6 +22,7 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from numba import njit
 
 from gearcheck.lumped.linear_model import Periodic
 from gearcheck.lumped.member_motion import member_motion
@@ -109,26 +111,25 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None, y0=
     steps, every = settings.check_work(dt, 3 * model.n, f"model {model.name}")
     t = np.arange(steps + 1) * dt
     rates = _rates(model, t[:, None] + np.array(stepping.STAGE_OFFSETS) * dt)
-
-    def acceleration(i, s, q, v):
-        return rates(i, s, q[:, None], v[:, None])[:, 0]
-
     q0, v = _start(model) if y0 is None else (np.array(y0[0], dtype=float), np.array(y0[1], dtype=float))
-    q = q0
+    q, v = q0.copy(), v.copy()
     n_out = steps // every + 1
     Q, V, Qdd = (np.empty((n_out, model.n)) for _ in range(3))
-    for i in range(steps + 1):
-        if i % every == 0:
-            j = i // every
-            Q[j], V[j], Qdd[j] = q, v, acceleration(i, 0, q, v)
-        if i == steps:
-            break
-        q, v = rk4_step(lambda s, q_, v_, i=i: acceleration(i, s, q_, v_), q, v, dt)
-        if i % CHUNK == 0:
-            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-                raise DivergenceError(float(t[i + 1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
-            if progress is not None:
-                progress(i / steps)
+    for first in range(0, steps, CHUNK):
+        last = min(first + CHUNK, steps)
+        if rates.chunk is not None:
+            _rk4_steps(q, v, dt, first, last, every, *rates.chunk(first, last), Q, V, Qdd)
+        else:
+            for i in range(first, last):
+                if i % every == 0:
+                    Q[i // every], V[i // every], Qdd[i // every] = q, v, rates(i, 0, q[:, None], v[:, None])[:, 0]
+                q, v = rk4_step(lambda s, q_, v_, i=i: rates(i, s, q_[:, None], v_[:, None])[:, 0], q, v, dt)
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            raise DivergenceError(float(t[last]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
+        if progress is not None:
+            progress(first / steps)
+    if steps % every == 0:
+        Q[-1], V[-1], Qdd[-1] = q, v, rates(steps, 0, q[:, None], v[:, None])[:, 0]
     if not np.all(np.isfinite(Q)):
         raise DivergenceError(float(t[-1]), f"the RK4 integration of model {model.name} (dt = {dt:g} s)")
     if progress is not None:
@@ -143,23 +144,80 @@ def _rates(model, stage_t: np.ndarray):
     """q'' = M^-1 (f(t) - D q' - (K(t) + K_omega + sum_m k_m(t) a_m a_m^T) q) at the stage times ``stage_t``
     (steps x stages): ``rates(i, s, Q, V)`` for states as the columns of Q, V, the forcing f(t) = F(t) +
     sum_m a_m (k_m e_m + c_m e_m') acting on the last column alone -- one column is a run; the unit states
-    beside a last zero one give a period's monodromy matrix and its particular response."""
+    beside a last zero one give a period's monodromy matrix and its particular response.  M^-1 is applied to
+    each matrix once, not at every stage.  ``rates.chunk(first, last)``: the arrays of a run's compiled steps
+    (:func:`_rk4_steps`), None where the stiffness K(t) varies (its stages then run in Python)."""
     M_inv = np.linalg.inv(model.M)
-    D = model.damping
     K_omega = model.frame[1]
     A = model.mesh_rows
+    MD, MA = M_inv @ model.damping, M_inv @ A.T
+    MK = M_inv @ (model.matrix("K") + K_omega) if model.stiffness is None else None
+    MF = M_inv @ model.matrix("F") if model.forcing is None else None
     errors = [m.transmission_error(stage_t) for m in model.meshes]
     k_mesh = _along_last([m.k(stage_t) for m in model.meshes], stage_t.shape)
-    e_mesh = _along_last([e for e, _ in errors], stage_t.shape)
-    c_de = _along_last([m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
+    mesh_forcing = k_mesh * _along_last([e for e, _ in errors], stage_t.shape) + _along_last(
+        [m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
 
     def rates(i, s, Q, V):
-        ti, k = stage_t[i, s], k_mesh[i, s]
-        force = -(D @ V) - (model.K_at(ti) + K_omega) @ Q - A.T @ (k[:, None] * (A @ Q))
-        force[:, -1] += model.F_at(ti) + A.T @ (k * e_mesh[i, s] + c_de[i, s])
-        return M_inv @ force
+        ti = stage_t[i, s]
+        stiffness = MK if MK is not None else M_inv @ (model.K_at(ti) + K_omega)
+        out = -(MD @ V) - stiffness @ Q - MA @ (k_mesh[i, s][:, None] * (A @ Q))
+        out[:, -1] += (MF if MF is not None else M_inv @ model.F_at(ti)) + MA @ mesh_forcing[i, s]
+        return out
 
+    def chunk(first, last):
+        """The arrays of :func:`_rk4_steps` over steps ``first`` to ``last``: the matrices, the meshes' stiffness
+        and the forcing M^-1 f(t) at the stage times."""
+        times = stage_t[first:last]
+        F = MF if MF is not None else np.array([model.F_at(t) for t in times.ravel()]).reshape(
+            *times.shape, model.n) @ M_inv.T
+        return (MD, MK, MA, A, np.ascontiguousarray(k_mesh[first:last]), F + mesh_forcing[first:last] @ MA.T,
+                np.empty(A.shape[0]), np.empty((4, model.n)))
+
+    rates.chunk = chunk if MK is not None else None
     return rates
+
+
+@njit(cache=True)
+def _acceleration(r, s, q, v, MD, MK, MA, A, k_mesh, force, w, out):
+    """``rates`` of :func:`_rates` for one run with K constant, into ``out``: q'' = force[r, s] - M^-1 D q'
+    - M^-1 K q - M^-1 A^T w, w_m = k_m a_m.q at stage s of the chunk's step r."""
+    n = q.size
+    for m in range(A.shape[0]):
+        x = 0.0
+        for c in range(n):
+            x += A[m, c] * q[c]
+        w[m] = k_mesh[r, s, m] * x
+    for i in range(n):
+        x = force[r, s, i]
+        for c in range(n):
+            x -= MD[i, c] * v[c] + MK[i, c] * q[c]
+        for m in range(A.shape[0]):
+            x -= MA[i, m] * w[m]
+        out[i] = x
+
+
+@njit(cache=True)
+def _rk4_steps(q, v, h, first, last, every, MD, MK, MA, A, k_mesh, force, w, acc, Q, V, Qdd):
+    """Steps ``first`` to ``last`` of :func:`simulate_linear`'s RK4 (the stages of
+    :func:`~gearcheck.lumped.time_solver.rk4_step`) compiled, q and v updated in place, the state of every
+    ``every``-th step written to Q, V, Qdd; the drive (``k_mesh``, ``force``) is the chunk's."""
+    terms = (MD, MK, MA, A, k_mesh, force, w)
+    for i in range(first, last):
+        r = i - first
+        if i % every == 0:
+            Q[i // every] = q
+            V[i // every] = v
+            _acceleration(r, 0, q, v, *terms, Qdd[i // every])
+        _acceleration(r, 0, q, v, *terms, acc[0])
+        q2, v2 = q + 0.5 * h * v, v + 0.5 * h * acc[0]
+        _acceleration(r, 1, q2, v2, *terms, acc[1])
+        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * acc[1]
+        _acceleration(r, 1, q3, v3, *terms, acc[2])
+        q4, v4 = q + h * v3, v + h * acc[2]
+        _acceleration(r, 2, q4, v4, *terms, acc[3])
+        q[:] = q + h / 6.0 * (v + 2 * v2 + 2 * v3 + v4)
+        v[:] = v + h / 6.0 * (acc[0] + 2 * acc[1] + 2 * acc[2] + acc[3])
 
 
 def drive_period(model) -> float:

@@ -1,4 +1,5 @@
-"""Shared fixtures: every preset as a parameter; a headless Chromium that loads a page and tells its console."""
+"""Shared fixtures: every preset as a parameter; a headless Chromium that loads a page and tells its console; demo-3p's
+cross-check shared; the compiled kernels compiled once before xdist's workers start."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from types import SimpleNamespace
 
 import pytest
 
+from gearcheck.api import compile_kernels, crosscheck
 from gearcheck.train.loader import preset_names
 
 os.environ.setdefault("GEARCHECK_DEBUG", "1")  # a fault of gearcheck's own raises in a test, with its traceback
@@ -18,6 +20,12 @@ os.environ.setdefault("GEARCHECK_DEBUG", "1")  # a fault of gearcheck's own rais
 @pytest.fixture(params=preset_names())
 def preset(request):
     return request.param
+
+
+@pytest.fixture(scope="session")
+def demo_check():
+    """demo-3p cross-checked over 0.05 s, one run for every test that reads it (a worker's tests share it)."""
+    return crosscheck("demo-3p", duration=0.05)
 
 
 CHROMIUM = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
@@ -73,6 +81,8 @@ SMOKE = (
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "smoke: the contributor's subset (pytest -m smoke), listed in conftest.SMOKE")
+    if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        compile_kernels()  # xdist's controller, before its workers start: they load the kernels from numba's cache
 
 
 def pytest_collection_modifyitems(config, items):

@@ -24,9 +24,8 @@ from gearcheck.shared.settings import RunSettings
 DURATION = "0.05"
 
 
-def test_demo_presets_pass_with_default_tolerances():
-    for name in ("demo-3p", "demo-4p"):
-        result = crosscheck(name, duration=0.05)
+def test_demo_presets_pass_with_default_tolerances(demo_check):
+    for name, result in (("demo-3p", demo_check), ("demo-4p", crosscheck("demo-4p", duration=0.05))):
         assert result.passed, result.failures
         assert result.steady_found
         gated = [q for q in result.quantities if q.status == "pass"]
@@ -171,10 +170,10 @@ def test_tolerances_from_the_train_file_and_a_file(tmp_path, capsys):
     assert tol.lookup("stage1.planet2.sun.force", "mesh_force", "nrmse") == 1e-9
 
 
-def test_sensor_band_filters_both_solvers_alike():
+def test_sensor_band_filters_both_solvers_alike(demo_check):
     """A 100-1000 Hz accelerometer chain keeps the 406 Hz mesh line and removes the 2 kHz resonance
     content: the filtered ring acceleration is smaller and the solvers still agree."""
-    plain = crosscheck("demo-3p", duration=0.05)
+    plain = demo_check
     band = crosscheck("demo-3p", duration=0.05, sensor_band=(100.0, 1000.0))
     q0, q1 = plain["stage1.ring.ay.world"], band["stage1.ring.ay.world"]
     assert q1.metrics["reference"]["rms"] < 0.5 * q0.metrics["reference"]["rms"]

@@ -16,33 +16,28 @@ from gearcheck.shared.settings import RunSettings
 from gearcheck.train.loader import load_train
 
 
-@pytest.fixture(scope="module")
-def check():
-    return gearcheck.crosscheck("demo-3p", duration=0.05)
-
-
-def test_a_crosscheck_is_one_tidy_table(check):
-    frame = check.to_dataframe()
+def test_a_crosscheck_is_one_tidy_table(demo_check):
+    frame = demo_check.to_dataframe()
     assert list(frame.columns) == ["quantity", "kind", "side", "metric", "value", "unit", "tolerance", "status"]
-    assert frame.attrs == {"train": "demo-3p", "verdict": check.verdict, "solvers": ["lumped", "mujoco"]}
+    assert frame.attrs == {"train": "demo-3p", "verdict": demo_check.verdict, "solvers": ["lumped", "mujoco"]}
     per_quantity = 2 * 5 + 7  # each side: mean, rms, peak-to-peak, peak, integration error; 7 comparisons
-    assert len(frame) == per_quantity * len(check.quantities) + 3 * len(check.modal)
+    assert len(frame) == per_quantity * len(demo_check.quantities) + 3 * len(demo_check.modal)
     assert not frame.duplicated(["quantity", "side", "metric"]).any()
-    q = check.quantities[3]
+    q = demo_check.quantities[3]
     row = frame.set_index(["quantity", "side", "metric"])
     assert row.loc[(q.name, "both", "nrmse"), "value"] == q.metrics["nrmse"]
     assert row.loc[(q.name, "both", "nrmse"), "tolerance"] == q.tolerance
     assert row.loc[(q.name, "mujoco", "rms"), "value"] == q.metrics["test"]["rms"]
     assert row.loc[(q.name, "lumped", "rms"), "unit"] == q.unit and row.loc[(q.name, "both", "lag"), "unit"] == "s"
-    mode = check.modal[0]
+    mode = demo_check.modal[0]
     assert row.loc[("mode 1", "mujoco", "frequency"), "value"] == mode["test_hz"]
-    assert row.loc[("mode 1", "both", "rel_error"), "tolerance"] == check.modal_tolerance
+    assert row.loc[("mode 1", "both", "rel_error"), "tolerance"] == demo_check.modal_tolerance
     gated = frame[frame["tolerance"].notna()]  # every gated metric within its tolerance in a PASS
-    assert check.verdict == "PASS" and (gated["value"].abs() <= gated["tolerance"]).all()
+    assert demo_check.verdict == "PASS" and (gated["value"].abs() <= gated["tolerance"]).all()
 
 
-def test_a_time_result_is_an_xarray_dataset_with_units(check):
-    run = check.results[0]
+def test_a_time_result_is_an_xarray_dataset_with_units(demo_check):
+    run = demo_check.results[0]
     data = run.to_xarray(["stage1.planet1.sun.force", "stage1.ring.ay.world"])
     assert data["t"].attrs["unit"] == "s" and np.array_equal(data["t"].values, run.t)
     force = data["stage1.planet1.sun.force"]
@@ -52,13 +47,13 @@ def test_a_time_result_is_an_xarray_dataset_with_units(check):
     assert len(run.to_xarray().data_vars) == len(run.signals)
 
 
-def test_a_mistyped_name_is_answered_with_the_closest(check):
-    run = check.results[1]
+def test_a_mistyped_name_is_answered_with_the_closest(demo_check):
+    run = demo_check.results[1]
     with pytest.raises(KeyError, match=r"no signal 'stage1\.sun\.alfa' \(did you mean 'stage1\.sun\.alpha'"):
         run["stage1.sun.alfa"]
     with pytest.raises(KeyError, match=r"no compared quantity 'stage1\.ring\.ay\.wrld' \(did you mean "
                                        r"'stage1\.ring\.ay\.world'"):
-        check["stage1.ring.ay.wrld"]
+        demo_check["stage1.ring.ay.wrld"]
 
 
 def test_progress_true_draws_a_bar_and_closes_it(capsys):

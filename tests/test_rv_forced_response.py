@@ -2,6 +2,8 @@
 (Yang, Chen & Wang 2018, Eqs. 5-6 and 13-16): closed forms against finite differences, the paper's truncated
 Eq. (15), a selection rule, and the quasi-static limit against the static solutions of frozen configurations."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -20,6 +22,7 @@ ECCENTRICITY, SHAFT = "stages[0].crank.eccentricity_mm", "operating.input_shaft_
 PINS, INERTIA = "stages[0].cycloid.contact.stiffness", "stages[0].sun.inertia"
 
 
+@functools.cache  # a sensitivity that several tests read is computed once
 def sensitivity(parameter, method):
     return field_sensitivity(TEXT, "preset:rv-reducer", parameter, (3, 2), method, **GRIDS)
 

@@ -23,6 +23,7 @@ from gearcheck.compare.studies.calibrate import calibrate as fit_train
 from gearcheck.compare.studies.runup import RunUp, run_up
 from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
+from gearcheck.lumped.linear_run import simulate_linear
 from gearcheck.session import SOLVERS, Train
 from gearcheck.train.loader import load_train, preset_names, read_train_text
 from gearcheck.train.spec import TrainSpec, with_profiles
@@ -30,6 +31,7 @@ from gearcheck.train.schema import parse_measurements_file
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.modal import ModalResult
 from gearcheck.shared.results import TimeResult
+from gearcheck.shared.settings import RunSettings
 
 __all__ = ["SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model",
            "harmonic_response", "load", "mjcf", "mode_pairing", "pin_loads",
@@ -308,6 +310,17 @@ def sensitivity(train, parameter: str, method: str = "Fourier series", orders=No
 def mjcf(train, speed: float | None = None) -> str:
     """The MuJoCo model (MJCF text) of the train, deterministic, loadable in MuJoCo's viewer."""
     return Train(train, speed).mjcf()
+
+
+def compile_kernels() -> None:
+    """Compile the solvers' numba kernels now, or load them from numba's disk cache: a few steps of demo-3p in each
+    solver and in its exported linear model (a user's model's run).  A process about to start others that run
+    gearcheck (a test session before its workers) calls it once, so that they read the cache instead of each
+    compiling (some 10 s of CPU in a fresh environment)."""
+    train = Train("demo-3p")
+    for solver in SOLVERS:
+        train.simulate(solver, duration=0.003)
+    simulate_linear(reference_linear_model(train.spec), RunSettings(0.003))
 
 
 def describe(train) -> dict:

@@ -20,6 +20,15 @@ static one: a jump between orbits under backlash near a resonance) or the run wo
 the point is run again from the static state, and its table says so (``start`` = "cold: continuation did not
 settle").
 
+Both solvers read a continued point over one window, and their continued waveforms must agree within
+:data:`PARTED` (each within the steady threshold of its steady state): where contacts open and close (backlash
+near a resonance), two chains that differ by their integration errors can reach two different orbits, which a
+cross-check of the solvers would read as a disagreement between them (hub-drive above 1380 rpm: waveforms apart
+by up to 0.27 of half their peak-to-peak, where from rest they agree to 2.6e-4).  Such a point runs every solver
+from rest (``start`` = "cold: the solvers' continuations parted"), and the point after it too, without trying
+(contacts that part two chains at one speed mostly do at the next: "... parted at the previous speed"); the
+one after that tries again.
+
 A chain is at most :data:`CHAIN_POINTS` points of one parameter set at neighbouring speeds (at most
 :data:`MAX_SPEED_STEP` apart), so the sweep's table does not depend on how many workers share its chains: the
 chains are the plan's, each the same run on any backend, and a resumed chain goes on from its last cached
@@ -45,6 +54,9 @@ from gearcheck.shared.settings import RunSettings
 CHAIN_POINTS = 16  # points of a chain: the first starts from the static state
 MAX_SPEED_STEP = 0.1  # neighbours further apart (relative to the slower) start a new chain
 STATE = "gearcheck.state"  # a point table's metadata: {solver: [final state as RunState text, rho or null]}
+PARTED = 2 * STEADY_THRESHOLD  # two solvers' continued waveforms further apart than this are on two orbits
+START = "gearcheck.start"  # a point table's metadata: how the point started (its rows' ``start``)
+PARTED_START = "cold: the solvers' continuations parted"
 
 
 def link(points: list) -> list:
@@ -105,6 +117,13 @@ def carried(before: bytes | None, solver: str) -> tuple[RunState | None, float |
     return RunState.from_text(state), rho, {name: (p2p, np.array(w)) for name, (p2p, w) in shapes.items()}
 
 
+def started(before: bytes | None) -> str | None:
+    """How the point whose table is ``before`` started (None: no such point)."""
+    if before is None:
+        return None
+    return (pq.read_schema(io.BytesIO(before)).metadata or {}).get(START.encode(), b"").decode() or None
+
+
 BINS = 64  # phases of a mesh cycle at which a waveform is averaged
 
 
@@ -117,7 +136,7 @@ def waveforms(run: TimeResult, groups, start: float) -> dict:
     shapes = {}
     for forces, cycle in groups:
         window = t >= start
-        whole = math.floor((t[-1] - t[window][0]) / cycle + 1e-9)
+        whole = math.floor((t[-1] - t[window][0]) / cycle + 1e-3)  # two grids a step apart: the same cycles
         if whole >= 1:
             window &= t >= t[-1] - whole * cycle - 1e-12
         phase = np.minimum((np.mod(t[window] / cycle, 1.0) * BINS).astype(np.int64), BINS - 1)

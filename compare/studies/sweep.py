@@ -137,8 +137,8 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
                    "mismatch decayed (see start)"),
     "steady_start_s": ("s", "start of the steady window"),
     "dt_s": ("s", "the solver's step"),
-    "start": ("", "cold (from the static state), continued (from the previous speed's final state) or 'cold: "
-                  "continuation did not settle'"),
+    "start": ("", "cold (from the static state), continued (from the previous speed's final state), or from the "
+                  "static state because the continuation did not settle or the solvers' continuations parted"),
     "checked": ("", "why the point's integration error was estimated: all, every Nth (every Nth speed), "
                     "resonance (a line in the half-power band of a mode), or no"),
     "error": ("", "why a solver failed at this point (metric failed)"),
@@ -531,10 +531,13 @@ def _run_point(point: Point, before: bytes | None) -> tuple[bytes, float, float]
     lines = [(label, k, k * f) for label, f in mesh_groups(spec, model.kin) for k in range(1, point.harmonics + 1)]
     checked = _checked(point, [f for _, _, f in lines], *lumped.resonances())
     runs, failed = {}, {}
+    skip = point.after and continued.started(before) == continued.PARTED_START
     for solver in point.solvers:
         side = lumped if solver == "lumped" else MujocoSide(spec)
         try:
-            runs[solver] = (side, _steady_run(side, point, plan, lines, before))
+            run = _steady_run(side, point, plan, lines, None if skip else before)
+            runs[solver] = (side, dataclasses.replace(run, start=continued.PARTED_START + " at the previous speed")
+                            if skip else run)
         except SolverError as exc:
             failed[solver] = str(exc)
     runs = _aligned(runs, point, plan, lines, failed)
@@ -552,7 +555,8 @@ def _run_point(point: Point, before: bytes | None) -> tuple[bytes, float, float]
         reduce_run(run.result, plan, lines, rows, solver, run.steady, check, model.excitation.switch_times,
                    {"start": run.start, "checked": checked})
         states[solver] = continued.kept(run.state, run.rho, run.shapes)
-    metadata = {KEY: point.key, continued.STATE: json.dumps(states, sort_keys=True)}
+    metadata = {KEY: point.key, continued.STATE: json.dumps(states, sort_keys=True),
+                continued.START: next((run.start for _, run in runs.values()), "")}
     sink = io.BytesIO()
     pq.write_table(rows.table().replace_schema_metadata(metadata), sink, compression="zstd")
     return sink.getvalue(), time.perf_counter() - started, time.process_time() - cpu
@@ -629,26 +633,36 @@ def _decays(plan, point: Point) -> float | None:
 
 def _aligned(runs: dict, point: Point, plan, lines, failed: dict) -> dict:
     """The solvers' runs of a point ({solver: (side, run)}) over one steady window: where every one continued, the
-    shorter runs extended to the longest's end and the window started at the latest of their steady starts; where
-    some did not, every solver's run from the static state.  Windows over other instants read other phases of a
-    response that two incommensurate stages make quasi-periodic, and the solvers would differ by that (on the
-    hub-drive sweep, each on its own window: 1e-4 median, 20 % at the 99th percentile over the lines that count).
-    A run that fails on the way goes into ``failed``."""
+    shorter runs extended to the longest's end and the window started at the latest of their steady starts, and
+    kept where their waveforms agree within :data:`~gearcheck.compare.studies.continuation.PARTED`; else (some
+    did not continue, or their continuations parted) every solver's run from the static state. Windows over other
+    instants read other phases of a response that two incommensurate stages make quasi-periodic, and the solvers
+    would differ by that (on the hub-drive sweep, each on its own window: 1e-4 median, 20 % at the 99th
+    percentile over the lines that count). A run that fails on the way goes into ``failed``."""
     starts = {run.start for _, run in runs.values()}
     if len(runs) < 2 or "continued" not in starts:
         return runs
-    aligned = {}
-    for solver, (side, run) in runs.items():
-        try:
-            if starts != {"continued"}:
-                aligned[solver] = (side, run if run.start != "continued" else dataclasses.replace(
-                    _steady_run(side, point, plan, lines, None), start="cold: continuation did not settle"))
-            else:
+    why = "cold: continuation did not settle"
+    if starts == {"continued"}:
+        aligned = {}
+        for solver, (side, run) in runs.items():
+            try:
                 aligned[solver] = (side, _extended(side, run, max(r.result.t[-1] for _, r in runs.values()),
                                                    max(r.steady[0] for _, r in runs.values()), plan))
+            except SolverError as exc:
+                failed[solver] = str(exc)
+        shapes = [run.shapes for _, run in aligned.values()]
+        if all(continued.mismatch(b, a) <= continued.PARTED for a, b in zip(shapes, shapes[1:])):
+            return aligned
+        runs, why = aligned, continued.PARTED_START
+    cold = {}
+    for solver, (side, run) in runs.items():
+        try:
+            cold[solver] = (side, run if run.start != "continued" else dataclasses.replace(
+                _steady_run(side, point, plan, lines, None), start=why))
         except SolverError as exc:
             failed[solver] = str(exc)
-    return aligned
+    return cold
 
 
 def _extended(side, run: _SteadyRun, end: float, start: float, plan) -> _SteadyRun:

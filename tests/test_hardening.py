@@ -397,7 +397,7 @@ def _descendants(pid: int) -> set[int]:
 def test_a_killed_sweep_leaves_no_worker_behind(tmp_path):
     script = ("import gearcheck\n"
               "gearcheck.sweep('demo-3p', speeds=[1000.0, 1100.0, 1200.0, 1300.0], solver='lumped', "
-              "duration=5.0, workers=2)\n")
+              "duration=5.0, workers=2, continuation=False)\n")  # four points for the pool, not one chain
     parent = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     while len(_descendants(parent.pid)) < 3:  # the fork server and two workers

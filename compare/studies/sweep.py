@@ -598,18 +598,18 @@ def _steady_run(side, point: Point, plan, lines, before) -> _SteadyRun:
     settles, else from the static state over the point's duration, its steady window found by the plan's rule."""
     dt = side.default_step() / point.refine
     names = tuple(_signal_names(plan.spec))
+    settings = RunSettings(point.duration, dt=dt, signals=names)
     groups = plan.steady_groups(names)
     state, rho, shapes = continued.carried(before, side.solver)
     start = "cold"
     if state is not None and shapes is not None and point.speed_rpm and point.after_rpm:
         initial = state.at_speed(point.speed_rpm / point.after_rpm)
-        found = continued.run_continued(side, RunSettings(point.duration, dt=dt, signals=names), initial, rho,
-                                        continued.window_length(plan, lines), groups, shapes)
+        found = continued.run_continued(side, settings, initial, rho, continued.window_length(plan, lines), groups,
+                                        shapes)
         if found is not None:
             result, at, rho, final, shapes = found
             return _SteadyRun(result, (at, "continued"), "continued", final, rho, shapes, initial, dt)
         start = "cold: continuation did not settle"
-    settings = RunSettings(point.duration, dt=dt, signals=names)
     decays = _decays(plan, point)
     if decays is not None:  # the decay of the start reaches the steady state within the run: no test needed
         result, final = continued.run_over(side, settings, None, decays, point.duration)
@@ -668,10 +668,9 @@ def _aligned(runs: dict, point: Point, plan, lines, failed: dict) -> dict:
 def _extended(side, run: _SteadyRun, end: float, start: float, plan) -> _SteadyRun:
     """``run`` (continued) gone on to ``end``, its steady window from ``start``."""
     names = tuple(run.result.names())
-    result, state = run.result, run.state
-    if end - state.t > 0.5 * run.dt:
-        more, state = side.run_from(RunSettings(end - state.t, dt=run.dt, start=state.t, signals=names), state)
-        result = continued.joined([result, more])
+    # run_over sets each stretch's duration: the settings give its step and signals
+    more, state = continued.run_over(side, RunSettings(run.dt, dt=run.dt, signals=names), run.state, run.state.t, end)
+    result = run.result if more is None else continued.joined([run.result, more])
     return dataclasses.replace(run, result=result, state=state, steady=(start, "continued"),
                                shapes=continued.waveforms(result, plan.steady_groups(names), start))
 

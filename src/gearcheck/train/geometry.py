@@ -59,6 +59,7 @@ class Gear:
     relief_amount: float = 0.0  # tip relief C_a, m
     relief_length: float = 0.0  # its roll length L_a along the line of action, m
     relief_power: int = 1  # 1 linear, 2 parabolic
+    axial_offset: float = 0.0  # its face centre from its member's centre of mass along the axis, m
 
     @property
     def normal_module(self) -> float | None:

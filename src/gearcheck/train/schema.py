@@ -335,6 +335,9 @@ GEOMETRY = {
                                          "carrier for a planet)", "µm", 0.0, bound("displacement", UM)),
     "installation_error_phase_deg": Number("direction of the installation error at t = 0, like the eccentricity's",
                                            "deg", 0.0, -3600.0, False, 3600.0),
+    "axial_offset_mm": Number("axial position of the gear's face centre from its member's centre of mass (a "
+                              "tilting stage: it places the mesh's centre of stiffness)", "mm", 0.0,
+                              -bound("length", MM), False, bound("length", MM)),
     "tip_relief": Table(
         {
             "amount_um": NonNegative("material removed at the tip, normal to the flank (C_a)", "µm", REQUIRED,
@@ -369,7 +372,33 @@ BODY = {
                                 "carrier need it", "mm", None, bound("length", MM)),
     "thickness_mm": Positive("axial length of that annulus: a gear's default its face width; a carrier needs it "
                              "(its plates together)", "mm", None, bound("length", MM)),
+    "tilting_inertia": Number("moment of inertia about a diameter through the centre of mass (a tilting stage); "
+                              "default I/2 + m w²/12 with w the thickness (a gear's face width), exact for an "
+                              "annulus", "kg·m²", None, floor("inertia"), False, bound("inertia")),
 }
+
+STATION = Table(
+    {
+        "position_mm": Number("axial position of the bearing station from the member's centre of mass", "mm",
+                              REQUIRED, -bound("length", MM), False, bound("length", MM)),
+        "share": Number("its share of the radial stiffness and damping (the shares sum to 1)", "-", REQUIRED, 0.0,
+                        True, 1.0),
+    },
+    "a bearing station along the axis (a tilting stage)",
+)
+
+
+def _tilting(what: str) -> dict:
+    """The keys of a support or bearing that hold a tilting member's tilt (Eritenel & Parker 2009's 3-D model)."""
+    return {
+        "tilting_stiffness": NonNegative(f"tilting stiffness {what} (a tilting stage: this, or stations at two "
+                                         "positions, holds each tilt)", "N·m/rad", 0.0, bound("stiffness")),
+        "tilting_damping": NonNegative(f"tilting damping {what}", "N·m·s/rad", 0.0, bound("damping")),
+        "stations": TableList(STATION, "bearing stations along the axis over which the radial stiffness and damping "
+                                       "are shared (a tilting stage; default: all at the centre of mass)",
+                              default=()),
+    }
+
 
 SUPPORT = Table(
     {
@@ -384,6 +413,7 @@ SUPPORT = Table(
         "axial_stiffness": NonNegative("axial stiffness to the housing (helical stages need it)", "N/m", 0.0,
                                        bound("stiffness")),
         "axial_damping": NonNegative("axial damping to the housing", "N·s/m", 0.0, bound("damping")),
+        **_tilting("to the housing"),
     },
     "support of a central member (sun, ring, carrier) on the housing",
 )
@@ -397,6 +427,7 @@ PLANET_BEARING = Table(
         "axial_stiffness": NonNegative("axial stiffness of the planet on its pin (helical stages need it)", "N/m",
                                        0.0, bound("stiffness")),
         "axial_damping": NonNegative("axial damping of the planet bearing", "N·s/m", 0.0, bound("damping")),
+        **_tilting("of the planet on its pin"),
     },
     "planet bearing on the carrier pin (an RV reducer's planets sit on their crankshafts instead)",
     default=None,
@@ -576,6 +607,9 @@ STAGE = Table(
         "dedendum_coefficient": NonNegative("default dedendum coefficient h_f*", "-", 1.25, 3.0),
         "torsional": Flag("every member of the stage rotation only (see the members' `torsional`), unless a member "
                           "says otherwise", False),
+        "tilting": Flag("every member of the stage tilts: two small rotations about its translation axes beside "
+                        "its translations, rotation and axial motion (Eritenel & Parker 2009's 3-D model); each "
+                        "tilt needs a tilting stiffness or bearing stations", False),
         "mesh": MESH,
         "carrier": CARRIER,
         "planet": PLANET,

@@ -29,6 +29,7 @@ from gearcheck.train.mesh_stiffness import MODELS
 from gearcheck.train.parts import Part, train_parts
 from gearcheck.train.schema import Context, parse_measurements_file
 from gearcheck.train.torsional import check_torsional_couplings, torsional_members
+from gearcheck.train.tilting import tilting_stage
 from gearcheck.shared.errors import GearcheckError, TrainFileError, TrainNote, did_you_mean, shown
 from gearcheck.shared.trust import inside_roots
 
@@ -45,13 +46,30 @@ HOLDABLE = ("sun", "ring", "carrier", "pin_wheel")  # members on the housing's a
 
 
 @dataclass(frozen=True)
+class Station:
+    """A bearing station of a tilting member: its axial position from the member's centre of mass (m) and its
+    share of the support's radial stiffness and damping."""
+
+    position: float
+    radial_stiffness: float
+    radial_damping: float
+
+
+@dataclass(frozen=True)
 class Support:
+    """A member's support on the housing (central members) or bearing on its carrier's pin (planets).  A tilting
+    member's tilt is held by ``tilting_stiffness`` and by its ``stations`` along the axis, over which the radial
+    stiffness and damping are shared (none: all at the centre of mass)."""
+
     radial_stiffness: float
     radial_damping: float = 0.0
     torsional_stiffness: float = 0.0
     torsional_damping: float = 0.0
     axial_stiffness: float = 0.0
     axial_damping: float = 0.0
+    tilting_stiffness: float = 0.0
+    tilting_damping: float = 0.0
+    stations: tuple[Station, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -71,6 +89,8 @@ class Eccentric:
 TRANSLATIONS = {"axis": ("x", "y"), "pin": ("radial", "tangential"), "eccentric": ("x", "y")}
 ROTATION = "theta"  # absolute, about the stage axis
 AXIAL = "z"  # translation along the stage axis (absolute, like the others)
+# A tilting member's two tilts: small rotations (right-hand rule) about its two translation axes
+TILTS = {"axis": ("tilt_x", "tilt_y"), "pin": ("tilt_radial", "tilt_tangential")}
 FRAMES = {"sun": "axis", "ring": "axis", "carrier": "axis", "pin_wheel": "axis", "planet": "pin", "crank": "pin",
           "disc": "eccentric"}
 
@@ -94,6 +114,8 @@ class Member:
     reference_radius: float = 0.0  # where its rotation is read as a tangential motion (see below)
     eccentric: Eccentric | None = None  # on an eccentric (frame "eccentric"): the one that carries it
     torsional: bool = False  # rotation only: translations held (on the axis) or riding the carrier's pin (planets)
+    tilting: bool = False  # tilts about its two translation axes (every member of a tilting stage)
+    tilting_inertia: float = 0.0  # about a diameter through its centre of mass, kg m^2
 
     # reference_radius: a gear's pitch radius (a compound planet's first gear), a carrier's pin circle, a crankshaft's
     # eccentricity, a cycloid disc's rolling circle and a pin wheel's pin circle
@@ -123,9 +145,10 @@ class Member:
     @property
     def dofs(self) -> tuple[str, ...]:
         """Its degrees of freedom, defined here once for both models and the result names: two translations
-        (:data:`TRANSLATIONS`), the absolute rotation ``theta``, and ``z`` along the stage axis when it slides
-        axially."""
-        return TRANSLATIONS[self.frame] + (ROTATION,) + ((AXIAL,) if self.axial else ())
+        (:data:`TRANSLATIONS`), the absolute rotation ``theta``, ``z`` along the stage axis when it slides
+        axially, and its two tilts (:data:`TILTS`) when it tilts."""
+        return (TRANSLATIONS[self.frame] + (ROTATION,) + ((AXIAL,) if self.axial else ())
+                + (TILTS[self.frame] if self.tilting else ()))
 
     @property
     def coordinates(self) -> tuple[str, ...]:
@@ -156,6 +179,8 @@ class MeshSpec(Part):
     backlash: float  # total backlash 2b along the line of action
     ste: tuple[tuple[int, float, float], ...]  # (harmonic, amplitude m, phase rad)
     planet_index: int
+    axial_centre: float = 0.0  # a tilting stage: its centre of stiffness from the members' centres of mass, m
+    contact_width: float = 0.0  # a tilting stage: the length of the two faces' overlap, m
 
     @property
     def internal(self) -> bool:
@@ -326,6 +351,7 @@ class Stage:
     carrier: str
     helical: bool = False  # a gear with a helix: every member of the stage has an axial degree of freedom
     idealised: bool = False  # no teeth: base radii and a pressure angle (see _idealised_gear)
+    tilting: bool = False  # every member of the stage tilts (see gearcheck.train.tilting)
 
 
 @dataclass(frozen=True)
@@ -686,6 +712,7 @@ def _gear(name: str, raw: dict, stage: dict, internal: bool, path: str, fail) ->
         profile_shift=raw["profile_shift"], internal=internal, base_radius=base,
         eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"], helix_angle=beta,
         installation_error=raw["installation_error"], installation_error_phase=raw["installation_error_phase"],
+        axial_offset=raw["axial_offset"],
         relief_amount=relief["amount"], relief_length=relief["length"],
         relief_power=2 if relief["shape"] == "parabolic" else 1,
     )
@@ -714,7 +741,8 @@ def _idealised_gear(name: str, raw: dict, stage: dict, internal: bool, path: str
     return Gear(name=name, teeth=None, module=None, pressure_angle=alpha, face_width=face or 0.0, addendum=None,
                 dedendum=None, profile_shift=0.0, internal=internal, base_radius=raw["base_radius"],
                 eccentricity=raw["eccentricity"], eccentricity_phase=raw["eccentricity_phase"], helix_angle=beta,
-                installation_error=raw["installation_error"], installation_error_phase=raw["installation_error_phase"])
+                installation_error=raw["installation_error"], installation_error_phase=raw["installation_error_phase"],
+                axial_offset=raw["axial_offset"])
 
 
 def _body(raw: dict, radius: float, path: str, fail, gear: Gear | None = None) -> tuple[float, float]:
@@ -754,8 +782,11 @@ def _body(raw: dict, radius: float, path: str, fail, gear: Gear | None = None) -
 
 
 def _support(raw: dict) -> Support:
-    return Support(raw["radial_stiffness"], raw["radial_damping"], raw.get("torsional_stiffness", 0.0),
-                   raw.get("torsional_damping", 0.0), raw["axial_stiffness"], raw["axial_damping"])
+    k, c = raw["radial_stiffness"], raw["radial_damping"]
+    stations = tuple(Station(s["position"], s["share"] * k, s["share"] * c) for s in raw["stations"])
+    return Support(k, c, raw.get("torsional_stiffness", 0.0), raw.get("torsional_damping", 0.0),
+                   raw["axial_stiffness"], raw["axial_damping"], raw["tilting_stiffness"], raw["tilting_damping"],
+                   stations)
 
 
 def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:
@@ -795,8 +826,9 @@ def _build_stage(st: dict, path: str, fail):
     if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
         members = {mid: replace(m, axial=True) for mid, m in members.items()}
     members = torsional_members(st, centrals, members, rv, path, fail)
+    members, meshes = tilting_stage(st, centrals, members, meshes, rv, path, fail)
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
-                  f"{name}.carrier", helical, idealised)
+                  f"{name}.carrier", helical, idealised, st["tilting"])
     return members, stage, meshes, cycloids
 
 

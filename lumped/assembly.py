@@ -51,7 +51,7 @@ from gearcheck.lumped.constraints import torsional
 from gearcheck.lumped.elements.bearing import pin_rows
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import Kinematics, kinematics
-from gearcheck.train.spec import AXIAL, ROTATION, TrainSpec
+from gearcheck.train.spec import AXIAL, ROTATION, TILTS, TrainSpec
 
 __all__ = ["DofMap", "LumpedModel", "Row", "build_model", "contact_sets", "frozen_at"]
 
@@ -180,6 +180,9 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
         K_euler[iv, iu] += member.mass * omega
         K_cent[iu, iu] = K_cent[iv, iv] = -member.mass * omega**2
         F_inertia[ith] -= member.inertia * kin.speeds[mid]  # -J w: the torque that accelerates its rotation
+        if member.tilting:
+            _tilt_terms(member, [dofs(mid, d) for d in TILTS[member.frame]], omega, kin.speeds[mid], M, G, K_cent,
+                        K_euler)
         if member.orbits:
             F_cent[iu] += member.mass * member.radius * omega**2  # centripetal load of the nominal orbit
             F_inertia[iv] -= member.mass * member.radius * omega  # -m r_c Omega: the orbit's tangential inertia
@@ -190,10 +193,7 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
                 member.radius * np.outer(e_c, e_c) + np.outer(e_c, s_t) + np.outer(s_t, e_c))
             # the Euler load -m Omega' r_c along the turned tangent, in carrier coordinates: m Omega' r_c theta_c s_r
             K_euler += member.mass * omega * member.radius * (np.outer(e_c, s_r) + np.outer(s_r, e_c))
-        elif member.support:
-            c = member.support.radial_damping  # damping relative to the housing: -c (q' + Omega k x q)
-            K_circ[iu, iv] -= c * omega
-            K_circ[iv, iu] += c * omega
+        elif member.support:  # (its circulatory damping: the support's element)
             F[ith] -= member.support.torsional_damping * kin.speeds[mid]  # drag of a turning member
 
     excitation = Excitation(spec, kin)
@@ -213,6 +213,26 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
             model = p.place(model)
     model = torsional(model)
     return model if rotating_frame_terms else model.without_rotating_frame_terms()
+
+
+def _tilt_terms(member, tilts: list[int], omega: float, spin: float, M, G, K_cent, K_euler) -> None:
+    """A tilting member's inertia and its tilts' frame terms, into M, G, K_cent and K_euler.
+
+    An axisymmetric body spinning at ``spin`` with small tilts w = phi_1 + i phi_2 about fixed axes obeys
+    I_d w'' - i J spin w' = moment (Euler's equations to first order; I_d its tilting inertia, J its polar one);
+    in axes turning at ``omega`` (w = e^{i omega t} v) this is
+    I_d v'' + i (2 I_d omega - J spin) v' + (J spin omega - I_d omega^2) v = moment,
+    the gyroscopic moment and the frame's Coriolis and centripetal terms of a rotor (the translations' terms with
+    I_d for m and the spin's own term J spin besides); the Euler term of a turning frame is i I_d omega' v."""
+    i1, i2 = tilts
+    inertia = member.tilting_inertia
+    M[i1, i1] = M[i2, i2] = inertia
+    gyroscopic = 2.0 * inertia * omega - member.inertia * spin
+    G[i1, i2] -= gyroscopic
+    G[i2, i1] += gyroscopic
+    K_cent[i1, i1] = K_cent[i2, i2] = member.inertia * spin * omega - inertia * omega**2
+    K_euler[i1, i2] -= inertia * omega
+    K_euler[i2, i1] += inertia * omega
 
 
 def frozen_at(model: LumpedModel, t: float, touching=None) -> LumpedModel:

@@ -1,5 +1,6 @@
 """A member on a pin of its carrier (a planet, an RV reducer's crankshaft): an isotropic spring-damper between
-its centre and the pin, and along the axis when the stage is helical."""
+its centre and the pin, along the axis when the stage is helical, and on its tilt relative to the carrier's when
+the stage tilts, the radial stiffness then shared over bearing stations along the pin."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, Contribution, DofMap, Row
-from gearcheck.train.spec import AXIAL, ROTATION
+from gearcheck.train.spec import AXIAL, ROTATION, TILTS
 
 
 def pin_rows(spec, dofs: DofMap, mid: str) -> tuple[np.ndarray, np.ndarray]:
@@ -24,13 +25,44 @@ def pin_rows(spec, dofs: DofMap, mid: str) -> tuple[np.ndarray, np.ndarray]:
     return radial, tangential
 
 
+def carrier_tilts(spec, dofs: DofMap, mid: str) -> tuple[np.ndarray, np.ndarray]:
+    """Its carrier's tilt about the member's radial and tangential axes (the carrier's tilts are about its x, y)."""
+    p = spec.members[mid]
+    c = f"{p.stage}.carrier"
+    tilt_x, tilt_y = TILTS["axis"]
+    cs, sn = math.cos(p.angle), math.sin(p.angle)
+    return dofs.unit((c, tilt_x, cs), (c, tilt_y, sn)), dofs.unit((c, tilt_x, -sn), (c, tilt_y, cs))
+
+
+def relative_tilts(spec, dofs: DofMap, mid: str) -> list[np.ndarray]:
+    """A tilting member's tilts about its radial and tangential axes less its carrier's tilts about them."""
+    own = [dofs.unit((mid, t, 1.0)) for t in TILTS[spec.members[mid].frame]]
+    return [a - c for a, c in zip(own, carrier_tilts(spec, dofs, mid))]
+
+
 @ELEMENTS.register("bearing")
 def bearing_rows(part, build: Build) -> Contribution:
+    """The pin point at p along the axis moves with the carrier by phi_c x (r_c e_r + p e_z), the member's point
+    there by phi x (p e_z) = p (phi_t e_r - phi_r e_t): a station deflects radially by the centres' difference plus
+    p times the relative tangential tilt, tangentially minus p times the relative radial one, and the pin moves
+    axially by -r_c times the carrier's tangential tilt (Eritenel & Parker 2009's 3-D bearing)."""
+    spec, dofs = build.spec, build.dofs
     mid, b = part.member, part.bearing
-    radial, tangential = pin_rows(build.spec, build.dofs, mid)
-    rows = [Row(f"{mid}.bearing_radial", "bearing", radial, b.radial_stiffness, b.radial_damping),
-            Row(f"{mid}.bearing_tangential", "bearing", tangential, b.radial_stiffness, b.radial_damping)]
+    member = spec.members[mid]
+    radial, tangential = pin_rows(spec, dofs, mid)
+    stations = [("", radial, tangential, b.radial_stiffness, b.radial_damping)]
+    if member.tilting:
+        tilt_r, tilt_t = relative_tilts(spec, dofs, mid)
+        stations = [(f".station{i + 1}", radial + st.position * tilt_t, tangential - st.position * tilt_r,
+                     st.radial_stiffness, st.radial_damping) for i, st in enumerate(b.stations)] or stations
+    rows = [Row(f"{mid}.bearing_{direction}{label}", "bearing", a, k, c) for label, a_r, a_t, k, c in stations
+            for direction, a in (("radial", a_r), ("tangential", a_t))]
     if part.axial:
         axial = build.dofs.unit((mid, AXIAL, 1.0), (part.carrier, AXIAL, -1.0))
+        if member.tilting:
+            axial = axial + member.radius * carrier_tilts(spec, dofs, mid)[1]
         rows.append(Row(f"{mid}.bearing_axial", "bearing", axial, b.axial_stiffness, b.axial_damping))
+    if member.tilting and (b.tilting_stiffness or b.tilting_damping):
+        rows += [Row(f"{mid}.bearing_{t}", "bearing", a, b.tilting_stiffness, b.tilting_damping)
+                 for t, a in zip(TILTS[member.frame], relative_tilts(spec, dofs, mid))]
     return Contribution(rows)

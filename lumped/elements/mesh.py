@@ -1,5 +1,10 @@
 """A gear mesh (spur, helical or relieved): one row along its line of action, driven by the excitation's
-time-varying stiffness, transmission error and backlash (DESIGN.md 4)."""
+time-varying stiffness, transmission error and backlash (DESIGN.md 4).  In a tilting stage the row is taken at the
+mesh's centre of stiffness with the members' tilts in it, and a second, constant row resists their relative tilt
+across the face: slices of stiffness k/w dz at z in [-w/2, w/2] about the centre give
+sum k_j (g + z_j h)(g + z_j h)^T = k g g^T + k w^2/12 h h^T, h the rate at which the slices' deflection grows along
+the face (Eritenel & Parker 2009's mesh tilting stiffness; the mean stiffness, its variation left to the centre
+row)."""
 
 from __future__ import annotations
 
@@ -8,9 +13,9 @@ import math
 import numpy as np
 
 from gearcheck.lumped.elements import ELEMENTS
-from gearcheck.lumped.elements.base import Build, Contribution
+from gearcheck.lumped.elements.base import Build, Contribution, Row
 from gearcheck.train.line_of_action import lever, line_of_action
-from gearcheck.train.spec import AXIAL, ROTATION
+from gearcheck.train.spec import AXIAL, ROTATION, TILTS
 
 
 @ELEMENTS.register("mesh")
@@ -37,7 +42,30 @@ def mesh_row(mesh, build: Build) -> Contribution:
     if planet.axial:  # the normal line of action's axial part (Eritenel & Parker 2009)
         a[dofs(c, AXIAL)] += loa.axial
         a[dofs(p, AXIAL)] -= loa.axial
-    return Contribution(mesh=(a, _damping(spec, mesh, a, dofs, build.mean_stiffness[mesh.id])))
+    k_mean = build.mean_stiffness[mesh.id]
+    damping = _damping(spec, mesh, a, dofs, k_mean)
+    if not planet.tilting:
+        return Contribution(mesh=(a, damping))
+    # the tilts: a rotation phi moves the flank's point p (at the centre of stiffness) by phi x (p - centre), which
+    # changes delta by phi . ((p - centre) x n); across the face, by phi . (e_z x n) per unit length (the tilt row)
+    n = np.array([d[0], d[1], loa.axial])
+    frame = (np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    sides = ((c, np.zeros(2), 1.0, frame), (p, loa.planet_centre, -1.0, (e_r, e_t)))
+    tilt = np.zeros(build.n)
+    for member, centre, sign, axes in sides:
+        arm = np.append(loa.pitch_point - centre, mesh.axial_centre)
+        _add_tilts(a, dofs, spec.members[member], axes, sign * np.cross(arm, n))
+        _add_tilts(tilt, dofs, spec.members[member], axes, sign * np.cross([0.0, 0.0, 1.0], n))
+    slices = mesh.contact_width**2 / 12.0  # sum of z^2 over the face's slices per unit stiffness, z from its centre
+    row = Row(f"{mesh.id}.tilt", "mesh", tilt, k_mean * slices, damping * slices)
+    return Contribution(rows=[row], mesh=(a, damping))
+
+
+def _add_tilts(a: np.ndarray, dofs, member, axes, moment: np.ndarray) -> None:
+    """Add to row ``a`` the component of ``moment`` (a 3-vector) along each of ``member``'s tilt axes (``axes``: its
+    two translation axes in the carrier frame, in the order of its tilts)."""
+    for tilt, axis in zip(TILTS[member.frame], axes):
+        a[dofs(member.id, tilt)] += float(moment[:2] @ axis)
 
 
 def _damping(spec, mesh, row, dofs, k_mean) -> float:

@@ -39,9 +39,10 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
     out = {}
     for mid, member in members.items():
         raw, raw_path, support_path = holders[mid]
-        support = member.support if member.support is not None else member.bearing
-        if not member.torsional:
-            _check_held(support, support_path, fail)
+        if member.torsional:
+            raise fail(f"{raw_path}.torsional", "a tilting stage's members move in three dimensions; a torsional "
+                                                "member only turns: remove one of the two flags")
+        _check_held(member.support if member.support is not None else member.bearing, support_path, fail)
         out[mid] = replace(member, tilting=True, tilting_inertia=_tilting_inertia(member, raw))
     return out, [_placed(mesh, path, fail) for mesh in meshes]
 
@@ -59,8 +60,8 @@ def _holders(st: dict, centrals: dict, path: str) -> dict:
 def _set_aside(members: dict, holders: dict, path: str, name: str) -> dict:
     """The members of a stage that does not tilt, with any tilting key of their supports set aside (noted)."""
     out, ignored = dict(members), []
-    for mid, member in members.items():
-        raw, raw_path, support_path = holders[mid]
+    for mid, (raw, raw_path, support_path) in holders.items():
+        member = members[mid]
         if raw.get("tilting_inertia") is not None:
             ignored.append(f"{raw_path}.tilting_inertia")
         for attr in ("support", "bearing"):

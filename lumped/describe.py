@@ -33,6 +33,8 @@ def describe(spec) -> dict:
             "name": stage.name, "planets": len(stage.planets), "carrier_radius_m": stage.carrier_radius,
             "planet_angles_deg": [math.degrees(a) for a in stage.planet_angles],
             "torsional": [mid for mid, m in spec.members.items() if m.stage == stage.name and m.torsional],
+            "tilting_inertia_kg_m2": {mid: m.tilting_inertia for mid, m in spec.members.items()
+                                      if m.stage == stage.name and m.tilting},
             "gears": {_gear_label(spec.members[mid], g): {
                 "teeth": g.teeth, "pitch_radius_m": g.pitch_radius, "base_radius_m": g.base_radius,
                 "tip_radius_m": g.tip_radius, "profile_shift": g.profile_shift,
@@ -45,6 +47,7 @@ def describe(spec) -> dict:
         shown = part.describe(spec, kin, touching)
         if shown:
             stages[part.stage][part.element] = shown
+    rows = {r.name: r for r in model.rows}
     for j, mesh in enumerate(spec.meshes):
         g = mesh.geometry
         out["meshes"].append({
@@ -57,6 +60,10 @@ def describe(spec) -> dict:
             "damping_n_s_per_m": float(model.mesh_damping[j]), "backlash_m": mesh.backlash,
             "stiffness_model": mesh.stiffness["model"],
         })
+        tilt = rows.get(f"{mesh.id}.tilt")
+        if tilt is not None:  # a tilting stage's mesh: its face and tilting stiffness
+            out["meshes"][-1].update(face_centre_m=mesh.axial_centre, face_width_m=mesh.contact_width,
+                                     tilting_stiffness_n_m_per_rad=tilt.stiffness)
     out["settling"] = settling(spec, model)
     return out
 
@@ -77,7 +84,8 @@ def _undamped(support) -> list[str]:
     """The directions in which ``support`` is stiff but has no damping."""
     return [direction for direction, k, c in (("radial", support.radial_stiffness, support.radial_damping),
                                               ("torsional", support.torsional_stiffness, support.torsional_damping),
-                                              ("axial", support.axial_stiffness, support.axial_damping))
+                                              ("axial", support.axial_stiffness, support.axial_damping),
+                                              ("tilting", support.tilting_stiffness, support.tilting_damping))
             if k > 0.0 and c <= 0.0]
 
 

@@ -36,7 +36,7 @@ from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.units import rad_s_to_rpm
 from gearcheck.train.periods import whole_cycles
-from gearcheck.train.spec import AXIAL
+from gearcheck.train.spec import AXIAL, TILTS
 
 CHUNK = 2000  # steps between progress reports
 PERIOD_LIMIT = 64  # the longest common period sought, in multiples of the longest periodic part's
@@ -301,8 +301,8 @@ def linear_result(model, train, t, q, v, qdd, q0, info) -> TimeResult:
 def _train_signals(model, train, t, q, v, qdd, q0, taken=frozenset()):
     """The train's signals the model has (but those named in ``taken``, its coordinates' own): a member's rotation
     signals (:func:`~gearcheck.shared.results.member_columns`) when its rotation is one of the model's coordinates,
-    its translation signals when both its translations are, its axial ones when its axial coordinate is, and its
-    meshes'."""
+    its translation signals when both its translations are, its axial ones when its axial coordinate is, its tilts
+    when both its tilts are, and its meshes'."""
     labels = train.physical_dofs.labels()
     T, mapped = model.to_physical(labels)
     has = dict(zip(labels, mapped))
@@ -312,7 +312,8 @@ def _train_signals(model, train, t, q, v, qdd, q0, taken=frozenset()):
     for j, (mid, member) in enumerate(train.spec.members.items()):
         u, w, th = (f"{mid}.{d}" for d in member.dofs[:3])
         wanted = {"translation": has.get(u) and has.get(w), "rotation": has.get(th),
-                  "axial": member.axial and has.get(f"{mid}.{AXIAL}")}
+                  "axial": member.axial and has.get(f"{mid}.{AXIAL}"),
+                  "tilt": member.tilting and all(has.get(f"{mid}.{d}") for d in TILTS[member.frame])}
         if not any(wanted.values()):
             continue
         for group, named in member_columns(mid, motion(j)).items():

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from gearcheck.shared.results import MemberMotion
-from gearcheck.train.spec import AXIAL
+from gearcheck.train.spec import AXIAL, TILTS
 
 
 def nominal_angle(speed: float, t: np.ndarray, clock=None) -> tuple[np.ndarray, np.ndarray]:
@@ -79,8 +79,9 @@ def member_motion(spec, kin, dofs, t, q, v, qdd, rotating_frame_terms: bool = Tr
         if member.axial:
             iz = dofs(member.id, AXIAL)
             axial = np.stack([qdd[:, iz], q[:, iz], v[:, iz]], axis=-1)
+        tilt = q[:, [dofs(member.id, d) for d in TILTS[member.frame]]] if member.tilting else None
         return MemberMotion(nominal_angle(kin.speeds[carrier], t, clock)[0] + member.angle + theta_c, acc, alpha,
                             np.stack([u, w], axis=-1), velocity, np.stack([du, dw], axis=-1), q[:, ith],
-                            speed + v[:, ith], v[:, ith], axial)
+                            speed + v[:, ith], v[:, ith], axial, tilt)
 
     return motion

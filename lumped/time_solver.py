@@ -38,7 +38,7 @@ from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
                                      samples_between)
-from gearcheck.shared.results import TimeResult, bearing_names, train_result, train_signals
+from gearcheck.shared.results import TimeResult, bearing_names, tilting_meshes, train_result, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import STAGE_OFFSETS
@@ -412,14 +412,20 @@ def _result(model, sys, t, q, v, static, settle, info, wanted=None) -> TimeResul
     q_t, v_t, qdd_t = (q, v, qdd) if model.expansion is None else (x @ model.expansion.T for x in (q, v, qdd))
     motion = member_motion(spec, model.kin, model.physical_dofs, t, q_t, v_t, qdd_t, model.rotating_frame_terms,
                            model.excitation.clock)
-    rows = {r.name: r for r in model.rows if r.kind == "bearing"}
+    rows = {r.name: r for r in model.rows}
     bearings = [rows[name] for name in bearing_names(spec)]
-    a = np.array([r.a for r in bearings]).reshape(len(bearings), model.n)
-    bearing_force = (q @ a.T) * [r.stiffness for r in bearings] + (v @ a.T) * [r.damping for r in bearings]
+    bearing_force = _row_forces(bearings, q, v, model.n)
+    moments = _row_forces([rows[f"{mesh.id}.tilt"] for mesh in tilting_meshes(spec)], q, v, model.n)
     raw = {label: q[:, i] for i, label in enumerate(dofs.labels())}
     raw.update({f"{label}_dot": v[:, i] for i, label in enumerate(dofs.labels())})
     static_bearing = [static.row_forces[static.row_names.index(r.name)] for r in bearings]
     contacts = [e for e in model.turning if e.has_contacts]
     pins = np.concatenate([e.pin_forces(t, q, v) for e in contacts], axis=1) if contacts else None
     return train_result(spec, "lumped", t, motion, delta, force, k, static.mesh_force, static_bearing,
-                        bearing_force, settle, info, raw, pins, wanted)
+                        bearing_force, settle, info, raw, pins, wanted, moments)
+
+
+def _row_forces(rows, q, v, n: int) -> np.ndarray:
+    """(n_t, len(rows)) the spring-damper forces k a.q + c a.q' of ``rows`` over the run."""
+    a = np.array([r.a for r in rows]).reshape(len(rows), n)
+    return (q @ a.T) * [r.stiffness for r in rows] + (v @ a.T) * [r.damping for r in rows]

@@ -8,7 +8,9 @@ Keys are ``KIND.METRIC`` (``mesh_force.nrmse``) or ``QUANTITY.METRIC``
 * ``mesh_force.nrmse`` and ``dte.nrmse`` 0.01: the two integrators at their default steps;
 * ``acceleration.nrmse`` and ``angular_acceleration.nrmse`` 0.05: accelerations weight the
   high-frequency content where the two time discretisations differ most;
-* ``bearing_force.nrmse`` and ``pin_force.nrmse`` (an RV reducer's largest pin force per disc) 0.02.
+* ``bearing_force.nrmse`` and ``pin_force.nrmse`` (an RV reducer's largest pin force per disc) 0.02;
+* ``tilt.nrmse`` and ``mesh_moment.nrmse`` 0.01: a tilting member's tilts are angles and a mesh's tilting
+  moment a spring's force, read like the mesh deflections and forces.
 
 Overrides come from the train file's ``[tolerances]`` table and then from a ``[tolerances]``
 table in a TOML file given with ``--tolerances`` (or a dict from Python; these win).
@@ -31,6 +33,8 @@ DEFAULTS = {
     "angular_acceleration.nrmse": 0.05,
     "bearing_force.nrmse": 0.02,
     "pin_force.nrmse": 0.02,
+    "tilt.nrmse": 0.01,
+    "mesh_moment.nrmse": 0.01,
 }
 
 

@@ -275,6 +275,9 @@ def cmd_show(args) -> int:
               f"{st['carrier_radius_m'] * 1e3:.6g} mm")
         if st["torsional"]:
             print(f"    torsional (rotation only): {', '.join(st['torsional'])}")
+        if st["tilting_inertia_kg_m2"]:
+            print("    tilting, inertias about a diameter (kg·m²): "
+                  + ", ".join(f"{mid.split('.')[-1]} {i:.4g}" for mid, i in st["tilting_inertia_kg_m2"].items()))
         for name, g in st["gears"].items():
             helix = f"  beta={g['helix_angle_deg']:+.6g} deg" if g["helix_angle_deg"] else ""
             teeth = "—" if g["teeth"] is None else g["teeth"]  # an idealised gear's
@@ -299,6 +302,9 @@ def cmd_show(args) -> int:
               f"alpha'={m['operating_pressure_angle_deg']:.4f} deg  "
               f"f_mesh={m['mesh_frequency_hz']:.6g} Hz  phase={m['phase_cycles']:.4f}  "
               f"k={m['mean_stiffness_n_per_m']:.4g} N/m ({m['stiffness_model']})  c={m['damping_n_s_per_m']:.4g} N·s/m")
+        if "face_width_m" in m:
+            print(f"    {'':<24} face w={m['face_width_m'] * 1e3:.6g} mm at z={m['face_centre_m'] * 1e3:.6g} mm  "
+                  f"k_tilt={m['tilting_stiffness_n_m_per_rad']:.4g} N·m/rad")
     print(settling_line(info["settling"]))
     return 0
 

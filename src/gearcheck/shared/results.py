@@ -214,10 +214,15 @@ def units_of(path) -> dict:
 
 def bearing_names(spec) -> list[str]:
     """``MEMBER.bearing_radial`` and ``MEMBER.bearing_tangential`` of every member borne on a carrier pin (a
-    planet, an RV reducer's crankshaft), in member order; a torsional planet rides its pin rigidly and has none
-    (its bearing's force is a constraint force, not reported)."""
-    planets = [mid for mid, m in spec.members.items() if m.orbits and m.bearing is not None]
-    return [f"{mid}.bearing_{axis}" for mid in planets for axis in ("radial", "tangential")]
+    planet, an RV reducer's crankshaft), in member order, each station's (``.station1`` ...) where a tilting
+    member's bearing has stations; a torsional planet rides its pin rigidly and has none (its bearing's force is a
+    constraint force, not reported)."""
+    names = []
+    for mid, m in spec.members.items():
+        if m.orbits and m.bearing is not None:
+            stations = [f".station{i + 1}" for i in range(len(m.bearing.stations))] if m.tilting else []
+            names += [f"{mid}.bearing_{axis}{at}" for at in stations or [""] for axis in ("radial", "tangential")]
+    return names
 
 
 def coordinate_signals(coordinates, descriptions: dict, model: str, compared: bool = True) -> list[Signal]:
@@ -237,6 +242,12 @@ def coordinate_signals(coordinates, descriptions: dict, model: str, compared: bo
     return signals
 
 
+def tilting_meshes(spec) -> list:
+    """The meshes of tilting stages, whose tilting moments :func:`train_result` takes (in ``spec.meshes`` order)."""
+    tilting = {stage.name for stage in spec.stages if stage.tilting}
+    return [mesh for mesh in spec.meshes if mesh.stage in tilting]
+
+
 def train_signals(spec) -> list[Signal]:
     """The signals of a gear train run, in the order :func:`train_result` holds them."""
     signals = acceleration_signals(spec)
@@ -245,6 +256,11 @@ def train_signals(spec) -> list[Signal]:
                     Signal(f"{mesh.id}.dte", "dte", "m", f"{mesh.id} dynamic transmission error"),
                     Signal(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static", False),
                     Signal(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", False)]
+    for mesh in tilting_meshes(spec):
+        signals += [Signal(f"{mesh.id}.moment", "mesh_moment", "N·m", f"{mesh.id} mesh tilting moment across the "
+                           "face"),
+                    Signal(f"{mesh.id}.khb", "face_load_factor", "1", f"{mesh.id} face load factor: largest load per "
+                           "unit face width over the mean, 1 + 6|M|/(F w)", False)]
     signals += [Signal(f"{name}.force", "bearing_force", "N", f"{name} force") for name in bearing_names(spec)]
     for disc in disc_names(spec):
         signals += [Signal(f"{disc}.pin_force_max", "pin_force", "N", f"{disc}: largest pin contact force"),
@@ -269,6 +285,9 @@ def member_accelerations(mid: str, member) -> list[Signal]:
     if member.axial:
         signals.append(Signal(f"{mid}.az", "acceleration", "m/s^2", f"{mid} acceleration along the stage axis",
                               gated and not member.torsional))
+    if member.tilting:  # a tilt is compared as an angle: the body's angular acceleration holds its spin's turning
+        signals += [Signal(f"{mid}.tilt_{axis}.{frame}", "tilt", "rad", f"{mid} tilt about {axis} ({frame} frame)",
+                           gated) for frame in ("world", "carrier") for axis in "xy"]
     return signals
 
 
@@ -315,19 +334,22 @@ class MemberMotion(NamedTuple):
     omega: np.ndarray  # absolute angular velocity, rad/s
     omega_relative: np.ndarray  # d/dt of ``theta``
     axial: np.ndarray | None = None  # along the stage axis: acceleration, displacement, velocity (time x 3)
+    tilt: np.ndarray | None = None  # tilts about the carrier's axes (time x 2), rad: members that tilt
 
 
 def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh_stiffness, static_mesh_force,
                  static_bearing_force, bearing_force, settle_time, info, raw, pin_force=None,
-                 wanted=None) -> TimeResult:
+                 wanted=None, mesh_moment=None) -> TimeResult:
     """The named signals of a gear train run, from what every solver of a train computes.
 
     motion: j -> :class:`MemberMotion` of the j-th member of ``spec.members`` (axial for members that slide),
     asked once per member, and only of members with a signal kept; mesh arrays (n_t, n_mesh) in ``spec.meshes``
     order; bearing_force (n_t, n_bearing) in :func:`bearing_names` order; the static forces of the meshes and
     bearings are the run's ``static`` values; pin_force (n_t, n_disc, Z_p) every pin contact's force, discs in
-    :func:`disc_names` order (an RV reducer's).  ``wanted``: the names of the signals to keep (None: all), in
-    :func:`train_signals`' order."""
+    :func:`disc_names` order (an RV reducer's); mesh_moment (n_t, n) the tilting moments of the
+    :func:`tilting_meshes`, whose face load factors follow from them: the load per unit width of a face w wide
+    under a force F and a moment M is F/w + 12 M z / w^3, z from its centre.  ``wanted``: the names of the signals
+    to keep (None: all), in :func:`train_signals`' order."""
     signals = [s for s in train_signals(spec) if wanted is None or s.name in wanted]
     if wanted is not None and len(signals) != len(set(wanted)):
         missing = sorted(set(wanted) - {s.name for s in signals})
@@ -348,6 +370,11 @@ def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh
     for i, mesh in enumerate(spec.meshes):
         put({f"{mesh.id}.force": mesh_force[:, i], f"{mesh.id}.dte": mesh_deflection[:, i],
              f"{mesh.id}.kv": mesh_force[:, i] / static_mesh_force[i], f"{mesh.id}.stiffness": mesh_stiffness[:, i]})
+    forces = {mesh.id: mesh_force[:, i] for i, mesh in enumerate(spec.meshes)}
+    for i, mesh in enumerate(tilting_meshes(spec)):
+        moment = mesh_moment[:, i]
+        put({f"{mesh.id}.moment": moment,
+             f"{mesh.id}.khb": 1.0 + 6.0 * np.abs(moment) / (np.abs(forces[mesh.id]) * mesh.contact_width)})
     put({f"{name}.force": bearing_force[:, i] for i, name in enumerate(bearing_names(spec))})
     for i, disc in enumerate(disc_names(spec)):
         put({f"{disc}.pin_force_max": pin_force[:, i].max(axis=-1), f"{disc}.pins_loaded": (pin_force[:, i] > 0).sum(
@@ -362,16 +389,19 @@ def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh
 def member_columns(mid: str, m: MemberMotion) -> dict[str, dict[str, np.ndarray]]:
     """The named signals of member ``mid`` from its motion ``m``, by what they need of it: ``"translation"`` (its
     centre's accelerations, displacements and velocities along the world's and the carrier's axes),
-    ``"rotation"`` (alpha, theta, omega, omega.relative) and ``"axial"`` (az, z, vz, when ``m`` has them)."""
+    ``"rotation"`` (alpha, theta, omega, omega.relative), ``"axial"`` (az, z, vz) and ``"tilt"`` (tilt_x, tilt_y
+    along the world's and the carrier's axes) when ``m`` has them."""
     c, s = np.cos(m.angle), np.sin(m.angle)
-    translation = {}
-    for name, vector in (("a{}", m.acceleration), ("{}", m.displacement), ("v{}", m.velocity)):
+    translation, tilt = {}, {}
+    vectors = [("a{}", m.acceleration, translation), ("{}", m.displacement, translation),
+               ("v{}", m.velocity, translation)] + ([("tilt_{}", m.tilt, tilt)] if m.tilt is not None else [])
+    for name, vector, out in vectors:
         x, y = (f"{mid}.{name.format(axis)}" for axis in "xy")
-        translation[f"{x}.world"] = c * vector[:, 0] - s * vector[:, 1]
-        translation[f"{y}.world"] = s * vector[:, 0] + c * vector[:, 1]
-        translation[f"{x}.carrier"], translation[f"{y}.carrier"] = vector[:, 0], vector[:, 1]
+        out[f"{x}.world"] = c * vector[:, 0] - s * vector[:, 1]
+        out[f"{y}.world"] = s * vector[:, 0] + c * vector[:, 1]
+        out[f"{x}.carrier"], out[f"{y}.carrier"] = vector[:, 0], vector[:, 1]
     translation[f"{mid}.vx.relative"], translation[f"{mid}.vy.relative"] = m.relative_velocity.T
     rotation = {f"{mid}.alpha": m.alpha, f"{mid}.theta": m.theta, f"{mid}.omega": m.omega,
                 f"{mid}.omega.relative": m.omega_relative}
     axial = {} if m.axial is None else {f"{mid}.{name}": m.axial[:, k] for k, name in enumerate(("az", "z", "vz"))}
-    return {"translation": translation, "rotation": rotation, "axial": axial}
+    return {"translation": translation, "rotation": rotation, "axial": axial, "tilt": tilt}

@@ -191,4 +191,5 @@ def round_off_floor(spec, kin, omega_max: float, duration: float) -> dict[str, f
     turn = max(abs(w) for w in kin.speeds.values()) * duration
     radius = max(central_radius(spec, mid) for mid, m in spec.members.items() if not m.orbits)
     angular = omega_max ** 2 * np.finfo(float).eps * turn
-    return {"angular_acceleration": angular, "acceleration": angular * radius, "tilt": np.finfo(float).eps * turn}
+    return {"angular_acceleration": angular, "acceleration": angular * radius,
+            "tilt": np.finfo(float).eps * turn}

@@ -187,7 +187,8 @@ def round_off_floor(spec, kin, omega_max: float, duration: float) -> dict[str, f
     """Accelerations below which a solver integrating absolute angles (MuJoCo: the carrier turns by
     Omega t radians) cannot resolve anything: a position known to eps Omega t r, seen through the
     stiffest mode, is an acceleration of omega_max^2 eps Omega t r (and omega_max^2 eps Omega t for
-    angles), and a tilt is known to eps Omega t.  The lumped model integrates small vibrations about nominal motion and has no such floor."""
+    angles), and a tilt is known to eps Omega t.  The lumped model integrates small vibrations about nominal
+    motion and has no such floor."""
     turn = max(abs(w) for w in kin.speeds.values()) * duration
     radius = max(central_radius(spec, mid) for mid, m in spec.members.items() if not m.orbits)
     angular = omega_max ** 2 * np.finfo(float).eps * turn

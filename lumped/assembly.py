@@ -82,6 +82,7 @@ class LumpedModel:
     K_euler: np.ndarray | None = None
     F_inertia: np.ndarray | None = None
     F_centripetal: np.ndarray | None = None
+    F_rest: np.ndarray | None = None  # the part of F_static that connections made with an offset (Row.rest) exert
     expansion: np.ndarray | None = None  # T: the train's coordinates are T q where some are tied (constraints)
     train_dofs: DofMap | None = None  # the train's coordinates, where they are not the model's (``expansion``)
 
@@ -133,7 +134,7 @@ class LumpedModel:
     def without_rotating_frame_terms(self) -> "LumpedModel":
         zero = np.zeros_like(self.M)
         turning = [e.without_frame_terms() for e in self.turning]
-        held = sum((e.held_load(self.n) for e in turning), np.zeros(self.n))
+        held = sum((e.held_load(self.n) for e in turning), np.zeros(self.n) if self.F_rest is None else self.F_rest)
         return replace(self, G=zero, K_centripetal=zero, K_circulatory=zero, F_static=held, K_euler=zero,
                        F_centripetal=np.zeros(self.n),
                        rotating_frame_terms=False, turning=turning)
@@ -200,14 +201,16 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
     build = Build(spec, kin, dofs, dict(zip((m.id for m in spec.meshes), excitation.mean_stiffness)))
     parts = [ELEMENTS[part.element](part, build) for part in spec.parts]
     rows = [row for p in parts for row in p.rows]
+    F_rest = sum((r.stiffness * r.rest * r.a for r in rows if r.rest), np.zeros(n))  # offsets' loads: k rest a
     meshes = [p.mesh for p in parts if p.mesh is not None]
     mesh_rows = np.array([a for a, _ in meshes]).reshape(len(meshes), n)
     damping = np.array([c for _, c in meshes])
     b_in = dofs.unit((spec.input, ROTATION, 1.0))
     b_out = dofs.unit((spec.output, ROTATION, 1.0))
-    model = LumpedModel(spec, kin, dofs, M, G, K_cent, K_circ, rows, mesh_rows, damping, F + F_cent, b_in, b_out,
+    model = LumpedModel(spec, kin, dofs, M, G, K_cent, K_circ, rows, mesh_rows, damping, F + F_cent + F_rest, b_in,
+                        b_out,
                         excitation, turning=[e for p in parts for e in p.turning], K_euler=K_euler,
-                        F_inertia=F_inertia, F_centripetal=F_cent)
+                        F_inertia=F_inertia, F_centripetal=F_cent, F_rest=F_rest)
     for p in parts:
         if p.place:
             model = p.place(model)

@@ -40,6 +40,7 @@ def constrained(model, coordinates: list[str], T: np.ndarray):
                    F_static=T.T @ model.F_static, b_input=T.T @ model.b_input, b_output=T.T @ model.b_output,
                    K_euler=T.T @ model.K_euler @ T, F_inertia=T.T @ model.F_inertia,
                    F_centripetal=T.T @ model.F_centripetal,
+                   F_rest=None if model.F_rest is None else T.T @ model.F_rest,
                    expansion=T if model.expansion is None else model.expansion @ T,
                    train_dofs=model.train_dofs or model.dofs)
 

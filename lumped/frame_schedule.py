@@ -93,7 +93,7 @@ def with_schedule(model):
     if model.turning:
         raise UnsupportedError(f"{model.spec.name}: an operating history with {model.turning[0].words} is not "
                                "supported yet (its rows turn with the nominal time at the reference speed)")
-    drag = model.F_static - model.F_centripetal
+    drag = model.F_static - model.F_centripetal - (0.0 if model.F_rest is None else model.F_rest)
     schedule = FrameSchedule(clock, model.G, model.K_centripetal, model.K_circulatory, model.K_euler,
                              model.F_centripetal, drag, model.F_inertia)
     return replace(model, turning=[schedule if model.rotating_frame_terms else schedule.without_frame_terms()])

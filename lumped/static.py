@@ -69,7 +69,7 @@ def static_solution(model, load_scale: float = 1.0) -> StaticResult:
     else:  # pragma: no cover - the active set settles in at most n_mesh passes
         raise SolverError("static solution: the contact set did not converge")
     force = k * deadzone(delta, half_backlash)
-    row_forces = np.array([r.stiffness * float(r.a @ q) for r in model.rows])
+    row_forces = np.array([r.stiffness * (float(r.a @ q) - r.rest) for r in model.rows])
     return StaticResult(q, [m.id for m in model.spec.meshes], delta, force, contact,
                         [r.name for r in model.rows], row_forces)
 

@@ -426,6 +426,6 @@ def _result(model, sys, t, q, v, static, settle, info, wanted=None) -> TimeResul
 
 
 def _row_forces(rows, q, v, n: int) -> np.ndarray:
-    """(n_t, len(rows)) the spring-damper forces k a.q + c a.q' of ``rows`` over the run."""
+    """(n_t, len(rows)) the spring-damper forces k (a.q - rest) + c a.q' of ``rows`` over the run."""
     a = np.array([r.a for r in rows]).reshape(len(rows), n)
-    return (q @ a.T) * [r.stiffness for r in rows] + (v @ a.T) * [r.damping for r in rows]
+    return ((q @ a.T) - [r.rest for r in rows]) * [r.stiffness for r in rows] + (v @ a.T) * [r.damping for r in rows]

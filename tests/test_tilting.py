@@ -173,3 +173,40 @@ def test_bad_tilting_input_names_the_field(pairs, expected):
 def test_an_rv_reducer_does_not_tilt():
     with pytest.raises(TrainFileError, match=r"stages\[0\].tilting: an RV reducer's stage does not tilt"):
         edited("rv-reducer", [(r'^name = "rv"', 'name = "rv"\ntilting = true')])
+
+
+def test_a_misaligned_pin_loads_the_face_as_iso_6336s_k_h_beta():
+    """A planet held rigidly at its pin's tilt gamma meets untilted central gears across a face w: the slices'
+    deflection grows by F_beta_y / w = |gamma . (e_z x n)| along the face, and the face load factor 1 + 6|M|/(F w)
+    is ISO 6336-1's K_H_beta = 1 + F_beta_y c_gamma / (2 F_m / b) for a linear load distribution (c_gamma = k/w,
+    F_m/b = F/w), with F_beta_y from the line of action's geometry alone."""
+    stiff = (r"tilting_stiffness = 2.0e5", "tilting_stiffness = 1.0e13")
+    gamma = np.array([40e-6, -25e-6])
+    pins = (r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, -25.0], [0.0, 0.0], [0.0, 0.0]]")
+    spec = tilting(stiff, pins)
+    assert spec.members["stage1.planet1"].bearing.rest_tilt == pytest.approx(tuple(gamma))
+    model = build_model(spec, rotating_frame_terms=False)
+    static = static_solution(model)
+    forces = dict(zip(static.row_names, static.row_forces))
+    kin, planet = kinematics(spec), spec.members["stage1.planet1"]
+    tilt = static.q[[model.dofs(planet.id, d) for d in TILTS["pin"]]]
+    assert tilt == pytest.approx(gamma, rel=1e-6)  # held at the pin's tilt
+    e_r = np.array([math.cos(planet.angle), math.sin(planet.angle)])
+    e_t = np.array([-e_r[1], e_r[0]])
+    for j, mesh in enumerate(spec.meshes):
+        loa = line_of_action(mesh, planet.angle, spec.stages[0].carrier_radius, kin.flanks[mesh.id])
+        slope = 0.0 if mesh.planet != planet.id else abs(gamma @ [np.cross([0, 0, 1], [*loa.direction, 0])[:2] @ e
+                                                                  for e in (e_r, e_t)])
+        force, width = static.mesh_force[j], mesh.contact_width
+        khb_iso = 1.0 + (width * slope) * (model.excitation.mean_stiffness[j] / width) / (2.0 * force / width)
+        khb = 1.0 + 6.0 * abs(forces[f"{mesh.id}.tilt"]) / (force * width)
+        assert khb == pytest.approx(khb_iso, rel=1e-5), mesh.id
+        assert (khb > 1.05) == (mesh.planet == planet.id)
+
+
+def test_pin_tilts_are_one_pair_per_planet():
+    with pytest.raises(TrainFileError, match=r"stages\[0\].planet.pin_tilts_urad: needs one pair per planet \(3\), "
+                                             r"got 1"):
+        tilting((r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, 0.0]]"))
+    with pytest.raises(TrainFileError, match=r"stages\[0\].planet.pin_tilts_urad\[0\]: needs 2 entries, got 3"):
+        tilting((r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, 0.0, 1.0]]"))

@@ -24,13 +24,15 @@ from gearcheck.shared.kernel_hooks import Hook
 
 @dataclass(frozen=True)
 class Row:
-    """One elastic connection: deflection a . q, stiffness, damping."""
+    """One elastic connection: deflection a . q, stiffness, damping, and the deflection at which it carries no load
+    (a connection made with an offset: a misaligned pin's bearing); its force k (a . q - rest) + c a . q'."""
 
     name: str
     kind: str  # mesh | bearing | support | coupling | shaft | contact
     a: np.ndarray
     stiffness: float
     damping: float
+    rest: float = 0.0
 
 
 @dataclass

@@ -19,6 +19,7 @@ MAX_RPM = 1e6  # the fastest input speed accepted (gearcheck.train.schema.LIMITS
 SUFFIXES = {
     "_mm": ("mm", 1e-3),
     "_um": ("µm", 1e-6),
+    "_urad": ("µrad", 1e-6),
     "_deg": ("deg", math.pi / 180.0),
     "_rpm": ("rpm", RAD_S_PER_RPM),
 }

@@ -118,6 +118,7 @@ def bound(name: str, unit_in_si: float = 1.0) -> float:
 
 
 MM, UM = 1e-3, 1e-6
+MAX_TILT_URAD = 1e4  # a misalignment past 10 mrad is no small tilt (its sine and angle part by 2e-5)
 MIN_MODULE_MM = 0.01  # the finest gears made (watches) have modules of about 0.05 mm
 
 
@@ -302,7 +303,7 @@ def _scale(value, factor: float):
     if factor == 1.0 or value is None:
         return value
     if isinstance(value, list):
-        return [v * factor for v in value]
+        return [_scale(v, factor) for v in value]
     return value * factor
 
 
@@ -497,6 +498,11 @@ PLANET = Table(
                          maximum=int(bound("teeth"))),
         **BODY,
         "bearing": PLANET_BEARING,
+        "pin_tilts_urad": ListOf(ListOf(Number("tilt", "µrad", REQUIRED, -MAX_TILT_URAD, False, MAX_TILT_URAD),
+                                        "[about the planet's radial axis, about its tangential axis]", min_length=2,
+                                        max_length=2, unit="µrad"),
+                                 "misalignment of each planet's pin in the carrier (a tilting stage), one pair per "
+                                 "planet: its bearing's rest tilt", (), unit="µrad"),
         "gears": Table({}, "compound planet: named gears, e.g. [stages.planet.gears.f]", None,
                        patterns=((r"[A-Za-z][A-Za-z0-9_]*", PLANET_GEAR),), pattern_label="NAME"),
     },

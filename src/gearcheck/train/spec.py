@@ -59,7 +59,8 @@ class Station:
 class Support:
     """A member's support on the housing (central members) or bearing on its carrier's pin (planets).  A tilting
     member's tilt is held by ``tilting_stiffness`` and by its ``stations`` along the axis, over which the radial
-    stiffness and damping are shared (none: all at the centre of mass)."""
+    stiffness and damping are shared (none: all at the centre of mass); a planet's misaligned pin holds it at the
+    ``rest_tilt`` the pin has in the carrier."""
 
     radial_stiffness: float
     radial_damping: float = 0.0
@@ -70,6 +71,7 @@ class Support:
     tilting_stiffness: float = 0.0
     tilting_damping: float = 0.0
     stations: tuple[Station, ...] = ()
+    rest_tilt: tuple[float, float] = (0.0, 0.0)  # a misaligned pin's tilt about the planet's radial, tangential axes
 
 
 @dataclass(frozen=True)

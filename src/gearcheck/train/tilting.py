@@ -5,7 +5,9 @@ Every member of a tilting stage gains two tilts, small rotations about its two t
 Eritenel & Parker (2009), whose members' centres of mass lie in the stage's plane.  What holds a tilt is the
 member's support (a central member on the housing) or bearing (a planet on its carrier's pin): a tilting stiffness,
 and the bearing stations along the axis over which the radial stiffness is shared, which a radial spring at an
-axial distance p from the centre of mass turns into a moment p F and a tilting stiffness p^2 k.  A mesh acts at its
+axial distance p from the centre of mass turns into a moment p F and a tilting stiffness p^2 k.  A planet's pin may
+be misaligned in the carrier (``pin_tilts_urad``): its bearing then holds the planet at the pin's tilt, and the
+meshes meet a tilted gear, whose load moves along the face.  A mesh acts at its
 centre of stiffness, the middle of the two faces' overlap (a gear's face may be offset axially from its member's
 centre of mass), and resists the members' relative tilt across the face by its slices.
 
@@ -32,10 +34,13 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
     (a tilting key given there noted and set aside)."""
     holders = _holders(st, centrals, path)
     if not st[FLAG]:
-        return _set_aside(members, holders, path, st["name"]), meshes
+        return _set_aside(members, holders, path, st["name"], st["planet"]["pin_tilts"]), meshes
     if rv:
         raise fail(f"{path}.{FLAG}", "an RV reducer's stage does not tilt here (its cycloid discs and pins are "
                                      "planar): remove it")
+    pins = st["planet"]["pin_tilts"]
+    if pins and len(pins) != st["planets"]:
+        raise fail(f"{path}.planet.pin_tilts_urad", f"needs one pair per planet ({st['planets']}), got {len(pins)}")
     out = {}
     for mid, member in members.items():
         raw, raw_path, support_path = holders[mid]
@@ -44,6 +49,8 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
                                                 "member only turns: remove one of the two flags")
         _check_held(member.support if member.support is not None else member.bearing, support_path, fail)
         out[mid] = replace(member, tilting=True, tilting_inertia=_tilting_inertia(member, raw))
+        if member.is_planet and pins:
+            out[mid] = replace(out[mid], bearing=replace(member.bearing, rest_tilt=tuple(pins[int(mid.rsplit(".planet", 1)[1]) - 1])))
     return out, [_placed(mesh, path, fail) for mesh in meshes]
 
 
@@ -57,9 +64,9 @@ def _holders(st: dict, centrals: dict, path: str) -> dict:
     return out
 
 
-def _set_aside(members: dict, holders: dict, path: str, name: str) -> dict:
+def _set_aside(members: dict, holders: dict, path: str, name: str, st_pins) -> dict:
     """The members of a stage that does not tilt, with any tilting key of their supports set aside (noted)."""
-    out, ignored = dict(members), []
+    out, ignored = dict(members), [f"{path}.planet.pin_tilts_urad"] if st_pins else []
     for mid, (raw, raw_path, support_path) in holders.items():
         member = members[mid]
         if raw.get("tilting_inertia") is not None:

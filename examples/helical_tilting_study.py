@@ -45,7 +45,8 @@ def statistics(run, mesh: str, tilting: bool) -> dict:
 
 
 def main(out: Path) -> None:
-    trains = {"planar+axial": with_errors(gearcheck.preset_text("helical-planetary"), "helical-planetary (5 um eccentricity)"),
+    trains = {"planar+axial": with_errors(gearcheck.preset_text("helical-planetary"),
+                                          "helical-planetary (5 um eccentricity)"),
               "3-D": with_errors(EXAMPLE.read_text(), f"{EXAMPLE.name} (5 um eccentricity)")}
     results, runs = {}, {}
     for model, spec in trains.items():

@@ -3,7 +3,7 @@
 :func:`run_steps` does, step for step, what :class:`gearcheck.mbd_models.runner._Stepper` does in Python (the
 same operations in the same order): classical RK4, the stage loop of MuJoCo's ``mj_RungeKutta`` written out so
 that every stage gets its own drive.  At each of the four stages, from that stage's own state, it turns the mesh
-tendons' world-frame slide coefficients with their carriers (``wrap_prm``), sets an RV reducer's pin tendons to
+tendons' world-frame coefficients with their carriers (``wrap_prm``), sets an RV reducer's pin tendons to
 the discs' poses, drives the stage (mesh stiffness, controls, spring lengths of a transmission error and a
 backlash, the relieved meshes' tooth pairs in contact, the damping correction J^T g into ``qfrc_applied``) with
 the excitation at the stage's time (t, t + h/2, t + h/2, t + h), and calls ``mj_forward`` (``mj_forwardSkip``
@@ -141,8 +141,8 @@ class DataViews(NamedTuple):
 
 
 class Turning(NamedTuple):
-    """The mesh tendons' turning slide coefficients (``MbdModel.turning``), the meshes' damping and half
-    backlash."""
+    """The turning tendons' world-frame coefficients (``MbdModel.turning``), the corrected tendons' damping
+    (``MbdModel.corrected_damping``) and the meshes' half backlash."""
 
     coefficients: TurningCoefficients
     damping: np.ndarray
@@ -175,8 +175,8 @@ class MeshSwitches(NamedTuple):
 
 
 class Work(NamedTuple):
-    """Work space of the damping correction and the switching functions: the mesh Jacobian, the turned
-    coefficients, g, each mesh's deflection rate from its coefficients' turning."""
+    """Work space of the damping correction and the switching functions: the corrected tendons' Jacobian, the
+    turned coefficients, g, each corrected tendon's deflection rate from its coefficients' turning."""
 
     jacobian: np.ndarray
     coef: np.ndarray
@@ -259,7 +259,7 @@ class Outputs(NamedTuple):
 # ---------------------------------------------------------------------------------------------- the kernel
 @numba.njit(cache=True)
 def _refresh(qpos, wrap_prm, coefficients, coef):
-    """The world-frame slide coefficients (:class:`TurningCoefficients`) turned to the carriers' angles
+    """The world-frame coefficients (:class:`TurningCoefficients`) turned to the carriers' angles
     (``MbdModel.refresh``)."""
     wraps, base, carrier_qadr = coefficients.wraps, coefficients.base, coefficients.carrier_qadr
     for w in range(wraps.size):
@@ -270,15 +270,15 @@ def _refresh(qpos, wrap_prm, coefficients, coef):
 
 @numba.njit(inline="always")
 def _turning_rates(qpos, qvel, turning, coef, out):
-    """Per mesh, the part of its deflection rate that its tendon's J qvel misses, its coefficients c(phi) turning
-    with their carrier: d/dt (c q) = c q' + (dc/dphi) phi' q (``TurningCoefficients.missing_rate``), ``coef`` the
-    coefficients at qpos."""
-    wraps, _, carrier_qadr, tendon, slide_qadr, _ = turning.coefficients
+    """Per corrected tendon (``MbdModel.corrected``: the meshes', then their tilting tendons'), the part of its
+    deflection rate that its J qvel misses, its coefficients c(phi) turning with their carrier:
+    d/dt (c q) = c q' + (dc/dphi) phi' q (``TurningCoefficients.missing_rate``), ``coef`` the coefficients at qpos."""
+    wraps, _, carrier_qadr, tendon, joint_qadr, _ = turning.coefficients
     half = wraps.size // 2
     out[:] = 0.0
     for w in range(wraps.size):
-        turned = -coef[w + half] if w < half else coef[w - half]  # dc/dphi: the pair (x, y) turns as (-y, x)
-        out[tendon[w]] += turned * qvel[carrier_qadr[w]] * qpos[slide_qadr[w]]
+        turned = -coef[w + half] if w < half else coef[w - half]  # dc/dphi: a pair (a, b) turns as (-b, a)
+        out[tendon[w]] += turned * qvel[carrier_qadr[w]] * qpos[joint_qadr[w]]
 
 
 @numba.njit(cache=True)
@@ -286,7 +286,7 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
     """``_Stepper.set_stage``: stiffness, controls, spring lengths, tooth contacts, damping correction."""
     stiffness, lengthspring, wrap_prm = model.tendon_stiffness, model.tendon_lengthspring, model.wrap_prm
     qpos, qvel, ctrl, applied = data.qpos, data.qvel, data.ctrl, data.qfrc_applied
-    (wraps, base, carrier_qadr, tendon, slide_qadr, slide_dof), damping, half_backlash = turning
+    (wraps, base, carrier_qadr, tendon, joint_qadr, joint_dof), damping, half_backlash = turning
     rel_tendons, rel_wraps, rel_qadr, rel_starts = contacts
     J, coef, g, _ = work
     n = k.size
@@ -316,19 +316,19 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
             spring = offset + (moment / total if total > 0 else 0.0)
             lengthspring[t, 0] = spring
             lengthspring[t, 1] = spring
-    # DampingCorrection.apply: g = c (de/dt - m), qfrc_applied = J^T g
+    # DampingCorrection.apply: g = c (de/dt - m) (de/dt on the meshes only), qfrc_applied = J^T g
     for w in range(wraps.size):
         coef[w] = wrap_prm[wraps[w]]
-        J[tendon[w], slide_dof[w]] = coef[w]
+        J[tendon[w], joint_dof[w]] = coef[w]
     _turning_rates(qpos, qvel, turning, coef, g)
-    for i in range(n):
+    for i in range(g.size):
         g[i] *= -damping[i]
     if has_te:
         for i in range(n):
             g[i] += damping[i] * de[i]
     for v in range(applied.size):
         s = 0.0
-        for i in range(n):
+        for i in range(g.size):
             s += g[i] * J[i, v]
         applied[v] = s
 

@@ -12,12 +12,14 @@ them), with respect to qpos and qvel at the nominal configuration with every bod
 nominal speed (damping removed), and its mass matrix there: M q'' = A q + B q'.  (The mass matrix is
 held at the nominal configuration, as in the linear model: differentiating qacc = M(q)^-1 f instead
 would add dM^-1/dq times the centrifugal force the nominal configuration leaves unbalanced.)
-MuJoCo's central members translate along world axes, which turn under a rotating train; in the axes
-of their stage's carrier (x_w = R(Omega t) x_r) the system is time-invariant:
-M q_r'' = (A + B P - M P^2) q_r + (B - 2 M P) q_r', P = Omega J on those slides.
+MuJoCo's central members translate along world axes (and tilt about them), which turn under a rotating train;
+in the axes of their stage's carrier (x_w = R(Omega t) x_r) the system is time-invariant:
+M q_r'' = (A + B P - M P^2) q_r + (B - 2 M P) q_r', P = Omega J on those slides' (and tilts') pairs.  A tilting
+member spins about its own tilted axis, so its gyroscopic moments are in MuJoCo's bias forces.
 
 Mode types are read from MuJoCo's own coordinates: the kinetic-energy fractions of the central
-members' slides (translation) and hinges (rotation), classified by
+members' slides and tilts (translation: Eritenel & Parker 2009's translational-tilting modes) and hinges and
+axial slides (rotation: their rotational-axial modes), classified by
 :func:`gearcheck.shared.modal.mode_types`; they do not depend on MuJoCo's choice of coordinates
 (planet slides relative to the carrier).  An RV reducer's cycloid discs sit in polar joints, which mix
 translation and rotation: their x, y along the carrier's axes and their rotation take those joints' place
@@ -35,8 +37,9 @@ from contextlib import contextmanager
 import mujoco
 import numpy as np
 
-from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes
-from gearcheck.mbd_models.static_state import nominal_speeds
+from gearcheck.mbd_models.mjcf_text import AXIAL, ROTATION, TILT
+from gearcheck.mbd_models.static_state import nominal_speeds, world_turning
+from gearcheck.train.spec import TILTS
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult, modal_result, speed_modal_result
 from gearcheck.shared.modal import settling_time as shared_settling_time
@@ -173,9 +176,10 @@ def modes(mb) -> ModalResult:
 def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
     """(labels, T): the train's physical coordinates as MuJoCo moves them, T (n, nv) mapping a small joint
     motion to them, read from MuJoCo's own Jacobians at rest: each member's centre moves along x, y (a
-    planet or a crankshaft: along its radial and tangential axes), it turns about z, and in a helical stage it moves
-    along z.  The labels are ``member.x`` ... as the lumped model names its coordinates; a torsional member has
-    its rotation alone (its translations held or riding its pin), as the lumped model keeps it."""
+    planet or a crankshaft: along its radial and tangential axes), it turns about z, in a helical stage it moves
+    along z, and in a tilting stage it turns about its two translation axes.  The labels are ``member.x`` ... as
+    the lumped model names its coordinates; a torsional member has its rotation alone (its translations held or
+    riding its pin), as the lumped model keeps it."""
     m = mb.model
     d = mujoco.MjData(m)
     _set_rest(mb, d, m.qpos0)
@@ -193,6 +197,8 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
         moves = [(f"{mid}.{name}", axis @ jp) for name, axis in axes.items()] + [(f"{mid}.theta", jr[2])]
         if member.axial:
             moves.append((f"{mid}.z", jp[2]))
+        if member.tilting:  # about the same axes, absolute (a planet's as well)
+            moves += [(f"{mid}.{tilt}", axis @ jr) for tilt, axis in zip(TILTS[member.frame], axes.values())]
         for label, row in moves:
             if label.rsplit(".", 1)[1] in member.coordinates:  # a torsional member's translations are not its own
                 labels.append(label)
@@ -202,12 +208,14 @@ def physical_coordinates(mb) -> tuple[list[str], np.ndarray]:
 
 def _central(mb) -> tuple[list[int], list[int]]:
     """(translation, rotation) dofs of the central members; an axial slide goes with the rotation (a helical
-    mesh's axial force goes with its torque: Eritenel & Parker's rotational-axial modes).  A cycloid disc is a
-    planetary component, not a central member (:attr:`~gearcheck.train.spec.Member.central`)."""
-    central = [mid for mid, member in mb.spec.members.items() if member.central]
-    axial = [dof for mid in central if (dof := _axial_dof(mb, mid)) is not None]
-    return ([i for mid in central for a, i in mb.dadr[mid].items() if a != ROTATION],
-            [mb.dadr[mid][ROTATION] for mid in central] + axial)
+    mesh's axial force goes with its torque: Eritenel & Parker 2009's rotational-axial modes) and a tilt with the
+    translations (a bearing station's or an offset mesh's force moves and tilts a member together: their
+    translational-tilting modes).  A cycloid disc is a planetary component, not a central member
+    (:attr:`~gearcheck.train.spec.Member.central`)."""
+    central = [member for member in mb.spec.members.values() if member.central]
+    translation = [i for m in central for a, i in mb.dadr[m.id].items() if a != ROTATION]
+    rotation = [mb.dadr[m.id][ROTATION] for m in central]
+    return translation + mb.joint_dofs(central, TILT["axis"]), rotation + mb.joint_dofs(central, (AXIAL,))
 
 
 def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -232,12 +240,6 @@ def _disc_axes(mb, speed_ratio: float = 0.0) -> tuple[np.ndarray, np.ndarray, np
     return S, dS, ddS
 
 
-def _axial_dof(mb, mid: str) -> int | None:
-    """The dof address of member ``mid``'s axial slide (a helical stage's members have one), or None."""
-    joint = mujoco.mj_name2id(mb.model, mujoco.mjtObj.mjOBJ_JOINT, mb.spec.members[mid].label + "_z")
-    return int(mb.model.jnt_dofadr[joint]) if joint >= 0 else None
-
-
 def modes_at_speed(mb, input_speed: float) -> ModalResult:
     """The undamped modes of the twin turning with its input at ``input_speed`` (rad/s, 0 allowed), every
     mesh at its mean stiffness (solver "mujoco"; see the module doc)."""
@@ -259,12 +261,9 @@ def modes_at_speed(mb, input_speed: float) -> ModalResult:
         for c in mb.moving_contacts:  # the contacts of t = 0 frozen, undamped (an RV reducer's pins, needles)
             c.freeze(d)
             c.undamp()
-        P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides turning with its carrier
-        for mid, member in mb.spec.members.items():
-            if member.frame == "axis" and not member.torsional:
-                ix, iy = (mb.dadr[mid][a] for a in member_axes(member))
-                omega = ratio * mb.kin.speeds[f"{member.stage}.carrier"]
-                P[ix, iy], P[iy, ix] = -omega, omega
+        P = np.zeros((m.nv, m.nv))  # a central member's world-frame slides (and tilts) turning with its carrier
+        for (ix, iy), omega in world_turning(mb, ratio):
+            P[ix, iy], P[iy, ix] = -omega, omega
 
         def force(q, v):
             d.qpos[:], d.qvel[:], d.act[:], d.ctrl[:] = q, v, 0.0, 0.0

@@ -11,7 +11,8 @@ gives it there (:func:`nominal_places`).
 Per member, along its carrier's axes at the carrier's actual angle phi (its hinge's sensor, plus a planet's place
 angle psi), p the centre's position and p_nom(t) its nominal place: displacement d = R(-phi) (p - p_nom), velocity
 R(-phi) p', vibration velocity d' = R(-phi) (p' - p_nom') - phi' k x d, rotation theta = the x axis's angle less
-the nominal angle, angular velocity the sensor's, less the nominal one for theta'.
+the nominal angle, angular velocity the sensor's, less the nominal one for theta'; a tilting member's tilts about
+the carrier's axes R(-phi) (-z_y, z_x) from its body's z axis (to first order in the tilt, as the models keep it).
 
 The nominal motion enters through :func:`nominal_angle` alone: under an operating history every nominal speed is
 lambda(t) times its own and every nominal angle its speed times Lambda(t) (the nominal clock both models read,
@@ -102,7 +103,11 @@ def member_motion(mb, sensors: np.ndarray, t: np.ndarray):
         theta -= 2 * np.pi * np.round(theta[0] / (2 * np.pi))
         omega = read(f"{label}_angvel")[2]
         axial = np.stack([linacc[2], position[2] - z0, velocity[2]], axis=-1) if member.axial else None
+        tilt = None
+        if member.tilting:  # the z axis (z_x, z_y, .) of a body tilted by phi: phi_x = -z_y, phi_y = z_x
+            zaxis = read(f"{label}_zaxis")
+            tilt = along(-zaxis[1], zaxis[0])
         return MemberMotion(angle, along(linacc[0], linacc[1]), read(f"{label}_angacc")[2], displacement,
-                            along(velocity[0], velocity[1]), relative, theta, omega, omega - speed, axial)
+                            along(velocity[0], velocity[1]), relative, theta, omega, omega - speed, axial, tilt)
 
     return motion

@@ -1,6 +1,6 @@
 """MJCF text of a train: rigid bodies on joints, meshes as fixed tendons.
 
-Bodies and joints (all planar, gravity off):
+Bodies and joints (gravity off):
 
 * every member on a stage's axis (sun, ring, carrier) is a child of the world at the stage's axis, with
   world-frame slide joints ``<label>_x``, ``<label>_y`` and a hinge ``<label>_rz`` (absolute rotation);
@@ -10,9 +10,15 @@ Bodies and joints (all planar, gravity off):
   A compound planet is one body;
 * a member that slides axially (every member of a helical stage) also has ``<label>_z`` (central members
   along the world's z, members on pins relative to their carrier);
+* a member that tilts (every member of a tilting stage) also has two hinges through its centre of mass about its
+  slides' axes, ``<label>_rx``, ``<label>_ry`` (central members) or ``<label>_rradial``, ``<label>_rtangential``
+  (members on pins, relative to their carrier), after its slides and before its rotation's hinge, so that it spins
+  about its own tilted axis and MuJoCo gives it its gyroscopic moments; its inertia about a diameter is its
+  tilting inertia;
 * every part of the train (:attr:`gearcheck.train.spec.TrainSpec.parts`) adds what its element
   (:mod:`gearcheck.mbd_models.elements`) writes: supports and bearings the stiffness and damping of their
-  members' joints, meshes, couplings and splines fixed tendons, the drive its actuators, an RV reducer's
+  members' joints (and a tilting member's bearing stations as fixed tendons), meshes (first), couplings and
+  splines fixed tendons, the drive its actuators, an RV reducer's
   cycloid-pin stage its discs, pins, sites, needle-bearing actuators and pin tendons.
 
 Visuals (:mod:`gearcheck.mbd_models.gear_visuals`): every gear is an involute mesh asset (identical planets
@@ -60,12 +66,12 @@ def _hook(spec: TrainSpec, name: str, *args) -> list:
 
 
 def _springs(spec: TrainSpec) -> dict:
-    """{(member id, joint suffix): (stiffness, damping)}: what every part puts on the members' joints, added."""
+    """{(member id, joint suffix): :class:`~gearcheck.mbd_models.mjcf_text.Spring`}: what every part puts on the
+    members' joints, added."""
     springs = {}
     for part in spec.parts:
-        for key, (k, c) in ELEMENTS[part.element].joint_springs(part, spec).items():
-            k0, c0 = springs.get(key, (0.0, 0.0))
-            springs[key] = (k0 + k, c0 + c)
+        for key, spring in ELEMENTS[part.element].joint_springs(part, spec).items():
+            springs[key] = springs[key].plus(spring) if key in springs else spring
     return springs
 
 
@@ -156,13 +162,15 @@ def _worldbody(spec: TrainSpec, visuals: bool) -> list[str]:
 
 def _sensors(spec: TrainSpec) -> list[str]:
     """Every body's linear and angular acceleration, position, x axis (its angle), linear and angular velocity (all
-    in the world's frame), each carrier's angle and rate, the slides of the members on the stage axes and of those
-    on pins; then what each part reads of itself."""
+    in the world's frame) and a tilting body's z axis (its tilt), each carrier's angle and rate, the slides of the
+    members on the stage axes and of those on pins; then what each part reads of itself."""
     lines = ["  <sensor>"]
     for member in spec.members.values():
         for kind, suffix in (("framelinacc", "linacc"), ("frameangacc", "angacc"), ("framepos", "pos"),
                              ("framexaxis", "xaxis"), ("framelinvel", "linvel"), ("frameangvel", "angvel")):
             lines.append(f'    <{kind} name="{member.label}_{suffix}" objtype="body" objname="{member.label}"/>')
+        if member.tilting:
+            lines.append(f'    <framezaxis name="{member.label}_zaxis" objtype="body" objname="{member.label}"/>')
     for stage in spec.stages:
         label = spec.members[stage.carrier].label
         lines.append(f'    <jointpos name="{label}_angle" joint="{label}_rz"/>')
@@ -192,7 +200,7 @@ def document(spec: TrainSpec, header: list[str]) -> Template:
              '    <flag contact="disable"/>', "  </option>",
              '  <visual><map znear="0.001"/><headlight ambient="0.4 0.4 0.4" diffuse="0.6 0.6 0.6"/></visual>']
     lines += (_assets(spec) if VISUALS else []) + _worldbody(spec, VISUALS)
-    tendons = _hook(spec, "tendons", spec)
+    tendons = _hook(spec, "driven_tendons", spec) + _hook(spec, "tendons", spec)  # the driven ones first
     if tendons:
         lines += ["  <tendon>"] + tendons + ["  </tendon>"]
     lines += ["  <actuator>"] + _hook(spec, "actuators", spec) + ["  </actuator>"]

@@ -16,8 +16,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from gearcheck.mbd_models.gear_visuals import face_width
+from gearcheck.train.spec import AXIAL as AXIAL_DOF
+from gearcheck.train.spec import ROTATION as ROTATION_DOF
+from gearcheck.train.spec import TILTS, TRANSLATIONS
 
 RGBA = {
     "sun": "0.95 0.6 0.1 1",
@@ -36,24 +40,53 @@ VISUAL = 'contype="0" conaffinity="0" group="1"'  # visual geoms: no contact (no
 AXES = {"axis": ("x", "y"), "pin": ("radial", "tangential"), "eccentric": ("orbit", "radial")}
 ROTATION = "rz"  # the hinge of the member's rotation theta
 AXIAL = "z"  # the slide along the stage axis
+# The hinges of a tilting member's two tilts (:data:`gearcheck.train.spec.TILTS`), about the axes of its two
+# translations' slides, through its centre of mass
+TILT = {"axis": ("rx", "ry"), "pin": ("rradial", "rtangential")}
 
 
 def _joint_names(member) -> dict[str, str]:
     """Each of the member's :attr:`~gearcheck.train.spec.Member.dofs` -> the suffix of the joint that realises it."""
-    return dict(zip(member.dofs, AXES[member.frame] + (ROTATION, AXIAL)))
+    names = dict(zip(TRANSLATIONS[member.frame], AXES[member.frame]))
+    names.update({ROTATION_DOF: ROTATION, AXIAL_DOF: AXIAL})
+    names.update(zip(TILTS.get(member.frame, ()), TILT.get(member.frame, ())))
+    return {dof: names[dof] for dof in member.dofs}
+
+
+def _body_order(member) -> tuple[str, ...]:
+    """The suffixes of all the joints a member's body may have, in their order on the body: its slides, then
+    its rotation and axial slide (a member that does not tilt, as ever), or its slides, its tilts and then its
+    rotation (a tilting member: it spins about its own tilted axis, so MuJoCo gives it its gyroscopic moments)."""
+    slides = AXES[member.frame]
+    if member.tilting:
+        return slides + (AXIAL,) + TILT[member.frame] + (ROTATION,)
+    return slides + (ROTATION, AXIAL)
 
 
 def member_joints(member) -> tuple[str, ...]:
-    """The suffixes of all of a member's joints, one per free coordinate in the order of its
-    :attr:`~gearcheck.train.spec.Member.coordinates`: a torsional member has its hinge alone, and sits on its
-    parent (the world, or its carrier's pin)."""
-    names = _joint_names(member)
-    return tuple(names[d] for d in member.coordinates)
+    """The suffixes of all of a member's joints, one per free coordinate (its
+    :attr:`~gearcheck.train.spec.Member.coordinates`), in their order on its body (MuJoCo's order of their dofs):
+    a torsional member has its hinge alone, and sits on its parent (the world, or its carrier's pin)."""
+    own = {_joint_names(member)[d] for d in member.coordinates}
+    return tuple(j for j in _body_order(member) if j in own)
 
 
 def member_axes(member) -> tuple[str, ...]:
     """The suffixes of a member's joints of its two translations (:data:`AXES`; none for a torsional member)."""
     return tuple(j for j in member_joints(member) if j in AXES[member.frame])
+
+
+def member_tilts(member) -> tuple[str, ...]:
+    """The suffixes of a member's tilt hinges (:data:`TILT`; none unless it tilts and is not torsional)."""
+    return tuple(j for j in member_joints(member) if j in TILT.get(member.frame, ()))
+
+
+def world_pairs(member) -> list[tuple[str, str]]:
+    """The member's pairs of joints along and about the world's x and y (a central member's slides, and its tilts
+    when it tilts): a deflection pattern that turns with its carrier turns each pair as a vector."""
+    if member.frame != "axis" or member.torsional:
+        return []
+    return [AXES["axis"]] + ([TILT["axis"]] if member.tilting else [])
 
 
 def num(x) -> str:
@@ -135,19 +168,39 @@ class Template:
         return "".join(pieces)
 
 
-def joint(name: str, kind: str, axis, stiffness: float = 0.0, damping: float = 0.0, pos=(0.0, 0.0, 0.0)) -> str:
+class Spring(NamedTuple):
+    """What the parts put on a joint: a spring-damper, relaxed at the joint position ``rest`` (MuJoCo's
+    ``springref``: a misaligned pin's tilt)."""
+
+    stiffness: float = 0.0
+    damping: float = 0.0
+    rest: float = 0.0
+
+    def plus(self, other: "Spring") -> "Spring":
+        """Both springs on one joint: k1 (q - r1) + k2 (q - r2) = (k1 + k2) (q - r), r their stiffness-weighted rest."""
+        k = self.stiffness + other.stiffness
+        rest = (self.stiffness * self.rest + other.stiffness * other.rest) / k if k else 0.0
+        return Spring(k, self.damping + other.damping, rest)
+
+
+def joint(name: str, kind: str, axis, spring: Spring = Spring(), pos=(0.0, 0.0, 0.0)) -> str:
     attrs = [f'name="{name}"', f'type="{kind}"', f'axis="{vec(*axis)}"', f'pos="{vec(*pos)}"']
-    if stiffness:
-        attrs.append(f'stiffness="{num(stiffness)}"')
-    if damping:
-        attrs.append(f'damping="{num(damping)}"')
+    if spring.stiffness:
+        attrs.append(f'stiffness="{num(spring.stiffness)}"')
+    if spring.damping:
+        attrs.append(f'damping="{num(spring.damping)}"')
+    if spring.rest:
+        attrs.append(f'springref="{num(spring.rest)}"')
     return f"<joint {' '.join(attrs)}/>"
 
 
 def inertial(member) -> str:
+    """At the centre of mass, the polar inertia about the body's z; about a diameter the tilting inertia of a
+    tilting member (else half the polar inertia, which no joint of a member that does not tilt sees)."""
     polar = member.inertia
+    diameter = member.tilting_inertia if member.tilting else 0.5 * polar
     return (f'<inertial pos="0 0 0" mass="{num(member.mass)}" '
-            f'diaginertia="{vec(0.5 * polar, 0.5 * polar, polar)}"/>')
+            f'diaginertia="{vec(diameter, diameter, polar)}"/>')
 
 
 def site(name: str, pos) -> str:
@@ -182,21 +235,22 @@ def fixed(name: str, coefs: list[tuple[str, float]], stiffness: float, damping: 
     return lines
 
 
-def _joints(member, springs: dict, axes, indent: str) -> list[str]:
-    """The body's joints, (suffix, type, axis) each, with the springs its parts put on them, and its axial slide
-    when it slides axially."""
-    axes = axes + [(AXIAL, "slide", (0, 0, 1))]
-    return [f"{indent}  {joint(f'{member.label}_{name}', kind, axis, *springs.get((member.id, name), (0.0, 0.0)))}"
-            for name, kind, axis in axes if name in member_joints(member)]
+def _joints(member, springs: dict, first: tuple, second: tuple, indent: str) -> list[str]:
+    """The body's joints in their order (:func:`member_joints`), with the springs its parts put on them: its
+    translations' slides along the unit vectors ``first`` and ``second``, its tilts' hinges about them, its axial
+    slide and its rotation's hinge along the stage axis."""
+    kinds = dict(zip(AXES[member.frame], (("slide", first), ("slide", second))))
+    kinds.update(zip(TILT.get(member.frame, ()), (("hinge", first), ("hinge", second))))
+    kinds.update({AXIAL: ("slide", (0, 0, 1)), ROTATION: ("hinge", (0, 0, 1))})
+    return [f"{indent}  {joint(f'{member.label}_{name}', *kinds[name], springs.get((member.id, name), Spring()))}"
+            for name in member_joints(member)]
 
 
 def central_body(member, springs: dict, z_stage: float, indent: str, visuals: list[str],
                  children: list[str]) -> list[str]:
     """A member on the stage axis: a child of the world with world-frame slides and a hinge."""
-    x, y = AXES["axis"]
     lines = [f'{indent}<body name="{member.label}" pos="{vec(0, 0, z_stage)}">', f"{indent}  {inertial(member)}"]
-    lines += _joints(member, springs, [(x, "slide", (1, 0, 0)), (y, "slide", (0, 1, 0)),
-                                       (ROTATION, "hinge", (0, 0, 1))], indent)
+    lines += _joints(member, springs, (1, 0, 0), (0, 1, 0), indent)
     lines += [f"{indent}  {g}" for g in visuals]
     lines += children
     lines.append(f"{indent}</body>")
@@ -207,11 +261,9 @@ def pin_body(member, springs: dict, indent: str, visuals: list[str]) -> list[str
     """A member on a pin of its carrier (a planet, an RV reducer's crankshaft): a child of the carrier at its place,
     with slides along the carrier's radial and tangential axes and a hinge relative to the carrier."""
     c, s = math.cos(member.angle), math.sin(member.angle)
-    radial, tangential = AXES["pin"]
     lines = [f'{indent}<body name="{member.label}" pos="{vec(member.radius * c, member.radius * s, 0)}">',
              f"{indent}  {inertial(member)}"]
-    lines += _joints(member, springs, [(radial, "slide", (c, s, 0)), (tangential, "slide", (-s, c, 0)),
-                                       (ROTATION, "hinge", (0, 0, 1))], indent)
+    lines += _joints(member, springs, (c, s, 0), (-s, c, 0), indent)
     return lines + [f"{indent}  {g}" for g in visuals] + [f"{indent}</body>"]
 
 

@@ -45,7 +45,7 @@ from gearcheck.shared.modal import ModalResult, modal_result
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import transient_step
-from gearcheck.mbd_models.twin import rows_combined
+from gearcheck.mbd_models.jacobians import rows_combined
 
 FD_STEP = 1e-6
 CONTACT_BODIES = {"e": ("planet", None), "b": ("planet", "ring_b")}

@@ -10,14 +10,15 @@ At every stage of every RK4 step (fixed step h), from the stage's own state and 
 * the input speed w_in into the ``input_shaft`` integrated-velocity servo (whose activation
   is the reference angle, 0 at t = 0) and its ``input_shaft_damper``, the load torque T_out(t) and
   any input torque into the ``output_load`` / ``input_torque`` motors;
-* the mesh tendons' world-frame slide coefficients turned to the carrier's current angle
+* the mesh tendons' world-frame coefficients (slides, and tilts) turned to the carrier's current angle
   (:class:`~gearcheck.mbd_models.twin.TurningCoefficients`; the angle-0 values came from ``mj_jac``);
   an RV reducer's pin tendons set to the discs' current poses
   (:meth:`~gearcheck.mbd_models.elements.cycloid.CycloidTwin.refresh`);
 * the damping correction, a generalized force J^T g with g = c (de/dt - m): a fixed tendon's
   velocity J qvel misses the part m = (dc/dphi) phi' q of its coefficients turning with the carrier,
   and the transmission error's rate de/dt belongs to the mesh's damping force too, so the mesh
-  damping acts on the true deflection rate.
+  damping acts on the true deflection rate (and a tilting mesh's tilting damping on the true rate of its
+  tilting deflection).
 
 Integrator: RK4, because the mesh springs make the model stiff and no MuJoCo
 integrator except ``discrete`` treats spring stiffness implicitly: Euler and
@@ -70,6 +71,7 @@ import numpy as np
 from gearcheck.mbd_models import compiled
 from gearcheck.mbd_models.elements import base as elements
 from gearcheck.mbd_models.forces import ForceReader
+from gearcheck.mbd_models.jacobians import tendon_rows
 from gearcheck.mbd_models.member_motion import member_motion
 from gearcheck.mbd_models.static_state import DampingCorrection, StaticState, static_state
 from gearcheck.mbd_models.mjcf_text import ROTATION
@@ -191,7 +193,7 @@ class _Stepper:
         self.mb.refresh(d.qpos)
         length = np.add.reduceat(m.wrap_prm[sw.wraps] * d.qpos[sw.qadr], sw.starts[:-1]) if sw.wraps.size else []
         speed = np.add.reduceat(m.wrap_prm[sw.wraps] * d.qvel[sw.dofs], sw.starts[:-1]) if sw.wraps.size else []
-        speed = speed + tc.missing_rate(d.qpos[tc.carrier_qadr], d.qvel[tc.carrier_qadr], d.qpos[tc.slide_qadr],
+        speed = speed + tc.missing_rate(d.qpos[tc.carrier_qadr], d.qvel[tc.carrier_qadr], d.qpos[tc.joint_qadr],
                                         len(self.mb.mesh_tendon))[sw.tendons] if sw.wraps.size else speed
         _, _, e, de, pairs = drive
         g, rate = [], []
@@ -384,12 +386,13 @@ class _CompiledStepper(_Stepper):
             compiled.DataViews(d.qpos, d.qvel, d.act, d.qacc, d.act_dot, d.ctrl, d.qfrc_applied, d.sensordata,
                                d.qfrc_spring, d.qfrc_damper, d.energy, d.xpos, d.xmat, d.site_xpos, d.ten_length,
                                d.ten_velocity),
-            compiled.Turning(tc._make(np.ascontiguousarray(x) for x in tc), np.ascontiguousarray(mb.mesh_damping),
+            compiled.Turning(tc._make(np.ascontiguousarray(x) for x in tc), np.ascontiguousarray(mb.corrected_damping),
                              np.ascontiguousarray(mb.half_backlash)),
             compiled.Contacts(none, none, none, np.zeros(1, dtype=np.int64)) if c is None else compiled.Contacts(
                 *(np.ascontiguousarray(x, dtype=np.int64) for x in
                   (c.tendons, c.wraps, c.qadr, np.append(c.starts, len(c.wraps))))),
-            compiled.Work(mb.mesh_jacobian(), np.zeros(len(tc.wraps)), np.zeros(n), np.zeros(n)),
+            compiled.Work(tendon_rows(m, mb.corrected), np.zeros(len(tc.wraps)), np.zeros(len(mb.corrected)),
+                          np.zeros(len(mb.corrected))),
             compiled.Reader(np.ascontiguousarray(reader.dofs, dtype=np.int64),
                             np.ascontiguousarray(reader.slides, dtype=np.int64)),
             moving_groups(mb),
@@ -607,7 +610,7 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
         return S[:, [mb.sensor[f"{label}_{sensor}"][0] + axis for label in labels]]
 
     delta = columns("deflection", 0, [m.label for m in spec.meshes])
-    mesh_force, bearing_force = stepper.reader.forces(stepper.forces[:stepper.j])
+    mesh_force, mesh_moment, bearing_force = stepper.reader.forces(stepper.forces[:stepper.j])
     k = (mb.excitation.stiffness(t + STAGE_OFFSETS[0] * info["dt_s"]) if stepper.stiffness is None
          else stepper.stiffness[:stepper.j])
     raw = {}
@@ -623,7 +626,7 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
     pins = [stepper.pins[:stepper.j, at] for at in mb.moving_slices()]
     by_disc = np.concatenate([c.per_disc(f) for c, f in zip(mb.moving_contacts, pins)], axis=1) if pins else None
     result = train_result(spec, "mujoco", t, member_motion(mb, S, t), delta, mesh_force, k, static.mesh_force,
-                          static.bearing_force, bearing_force, settle, info, raw, by_disc, wanted)
+                          static.bearing_force, bearing_force, settle, info, raw, by_disc, wanted, mesh_moment)
     for c, forces, at in zip(mb.moving_contacts, pins, mb.moving_slices()):
         result = c.with_signals(result, forces, series, static.pin_force[at])
     return result

@@ -18,35 +18,38 @@ import mujoco
 import numpy as np
 
 from gearcheck.mbd_models.forces import ForceReader
-from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes
+from gearcheck.mbd_models.jacobians import tendon_rows
+from gearcheck.mbd_models.mjcf_text import ROTATION, member_axes, world_pairs
 from gearcheck.shared.errors import SolverError
 
 # --------------------------------------------------------------------------- damping correction
 
 
 class DampingCorrection:
-    """g = c (de/dt - m) per mesh as the generalized force J^T g (``qfrc_applied``), J the mesh tendons'
-    current coefficients, m the deflection rate their turning coefficients add
+    """g = c (de/dt - m) per corrected tendon (``MbdModel.corrected``: the meshes' and their tilting tendons'; a
+    transmission error's rate de/dt only on the meshes') as the generalized force J^T g (``qfrc_applied``), J those
+    tendons' current coefficients, m the deflection rate their turning coefficients add
     (see :mod:`gearcheck.mbd_models.runner`)."""
 
     def __init__(self, mb, d: mujoco.MjData):
         self.mb, self.d = mb, d
         tc = mb.turning
-        self.c = mb.mesh_damping
-        self.J = mb.mesh_jacobian()
-        self.c_wrap = np.zeros((len(mb.mesh_tendon), len(tc.wraps)))  # mesh damping per turning wrap
+        self.c = mb.corrected_damping
+        self.n_mesh = len(mb.mesh_tendon)
+        self.J = tendon_rows(mb.model, mb.corrected)
+        self.c_wrap = np.zeros((len(self.c), len(tc.wraps)))  # damping per turning wrap
         self.c_wrap[tc.tendon, np.arange(len(tc.wraps))] = self.c[tc.tendon]
         self.half = len(tc.wraps) // 2
-        self.g = np.zeros(len(mb.mesh_tendon))  # the last applied
+        self.g = np.zeros(len(self.c))  # the last applied
 
     def apply(self, de) -> None:
         tc, d, n = self.mb.turning, self.d, self.half
         coef = self.mb.model.wrap_prm[tc.wraps]
-        self.J[tc.tendon, tc.slide_dof] = coef
-        turned = np.concatenate([-coef[n:], coef[:n]])  # dc/dphi: the pair (x, y) turns as (-y, x)
-        g = -(self.c_wrap @ (turned * d.qvel[tc.carrier_qadr] * d.qpos[tc.slide_qadr]))
+        self.J[tc.tendon, tc.joint_dof] = coef
+        turned = np.concatenate([-coef[n:], coef[:n]])  # dc/dphi: a pair (first, second) turns as (-second, first)
+        g = -(self.c_wrap @ (turned * d.qvel[tc.carrier_qadr] * d.qpos[tc.joint_qadr]))
         if de is not None:
-            g += self.c * de
+            g[:self.n_mesh] += self.c[:self.n_mesh] * de
         d.qfrc_applied[:] = g @ self.J
         self.g = g
 
@@ -88,19 +91,25 @@ def _nominal(mb, q: np.ndarray):
     """State (qpos, qvel) and the steady-rotation acceleration of deflection q at t = 0.
 
     Every body turns at its nominal speed (:func:`nominal_speeds`), and a central member's world-frame
-    deflection turns with its carrier: x' = Omega k x x, x'' = -Omega^2 x.
+    deflection (its slides, and its tilts when it tilts: :func:`~gearcheck.mbd_models.mjcf_text.world_pairs`) turns
+    with its carrier: x' = Omega k x x, x'' = -Omega^2 x.
     """
-    spec, kin = mb.spec, mb.kin
     qvel = nominal_speeds(mb)
     target = np.zeros_like(q)
-    for mid, member in spec.members.items():
-        if member.frame != "axis" or member.torsional:
-            continue
-        ix, iy = (mb.dadr[mid][a] for a in member_axes(member))
-        omega = kin.speeds[f"{member.stage}.carrier"]
+    for (ix, iy), omega in world_turning(mb):
         qvel[ix], qvel[iy] = -omega * q[iy], omega * q[ix]
         target[ix], target[iy] = -omega**2 * q[ix], -omega**2 * q[iy]
     return q.copy(), qvel, target
+
+
+def world_turning(mb, speed_ratio: float = 1.0) -> list[tuple[tuple[int, int], float]]:
+    """((dof of x, dof of y), Omega) of every pair of world-frame joints (:func:`~gearcheck.mbd_models.mjcf_text.
+    world_pairs`), Omega its stage's carrier speed times ``speed_ratio``: the pairs that a deflection pattern
+    turning with the carrier turns as a vector."""
+    model = mb.model
+    return [(tuple(int(model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{member.label}_{a}")])
+                   for a in pair), speed_ratio * mb.kin.speeds[f"{member.stage}.carrier"])
+            for member in mb.spec.members.values() for pair in world_pairs(member)]
 
 
 def _set_static_drive(mb, d: mujoco.MjData, load_scale: float) -> None:
@@ -220,7 +229,7 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
         reader = ForceReader(mb, d)
         sample = np.empty((1, reader.width))
         reader.sample(sample[0])
-        force, bearing = (f[0] for f in reader.forces(sample))
+        force, _, bearing = (f[0] for f in reader.forces(sample))
         qpos, qvel, _ = _nominal(mb, q)
         touching, pin_force = (None, None) if pins is None else (pins.touching, pins.forces())
         return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res, touching, pin_force)

@@ -1,8 +1,8 @@
 """The compiled MuJoCo twin of a train: one compile, MuJoCo's own mesh coefficients, named indices.
 
 :func:`compile_train` writes the MJCF (:mod:`gearcheck.mbd_models.mjcf_builder`) with every mesh
-tendon over its nine joints and compiles it once.  The tendon coefficients are then taken from
-MuJoCo itself, d . (Jp_central(p) - Jp_planet(p)): the translation Jacobians (``mujoco.mj_jac``)
+tendon over the joints that move its pitch point and compiles it once.  The tendon coefficients are then
+taken from MuJoCo itself, d . (Jp_central(p) - Jp_planet(p)): the translation Jacobians (``mujoco.mj_jac``)
 of the two bodies at the pitch point p, projected on the line of action d of the train
 description (:func:`gearcheck.train.line_of_action.line_of_action`, given in the carrier frame and
 placed in the world with the carrier body's pose), and written into the compiled model's
@@ -12,9 +12,15 @@ and I from the compiled bodies.  Last, the default step comes from MuJoCo's own 
 (:mod:`gearcheck.mbd_models.linearise`) and is written into the model and the text, so the file
 runs stably in MuJoCo's viewer.
 
-The coefficients of the world-frame slides (central members and the carrier) depend on the
-carrier's angle; :class:`TurningCoefficients` keeps their angle-0 values so that the runner can turn
-them every step.
+Every part's late coefficients come the same way (:meth:`~gearcheck.mbd_models.elements.base.Element.late_rows`):
+in a tilting stage the meshes' rows at their centres of stiffness with the members' tilts in them, the meshes'
+tilting tendons (rotational Jacobians; their stiffness and damping the mesh's mean stiffness and damping times
+w^2/12, :mod:`gearcheck.mbd_models.elements.mesh`) and the bearing stations' tendons
+(:mod:`gearcheck.mbd_models.elements.stations`).
+
+The coefficients of the world-frame joints (central members' and the carrier's slides, and their tilts in a
+tilting stage) in the meshes' tendons depend on the carrier's angle; :class:`TurningCoefficients` keeps their
+angle-0 values so that the runner can turn them every step.
 
 An RV reducer's cycloid-pin stage (:mod:`gearcheck.mbd_models.elements.cycloid`) adds the splines between planets
 and crankshafts, its needle bearings and one pin tendon per pin and disc, whose coefficients of t = 0 come
@@ -56,51 +62,55 @@ import numpy as np
 
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import Kinematics, kinematics
-from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.elements import ELEMENTS
 from gearcheck.mbd_models.elements.base import group_order
-from gearcheck.mbd_models.elements.mesh import mesh_joints
+from gearcheck.mbd_models.elements.mesh import face_moment, tilt_joints, tilt_tendon
+from gearcheck.mbd_models.jacobians import named
+from gearcheck.mbd_models.jacobians import tendon_rows
 from gearcheck.mbd_models.mjcf_builder import document, header
-from gearcheck.mbd_models.mjcf_text import AXES, ROTATION, LateValues, member_axes
+from gearcheck.mbd_models.mjcf_text import ROTATION, LateValues, member_axes, member_joints, world_pairs
 from gearcheck.mbd_models.static_state import static_state
 from gearcheck.shared import stepping
 
 PLACEHOLDER_STEP = 1e-5  # s, the compiled model's step until its own default is known
+JOINT, BODY, TENDON = mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON
 
 
 class TurningCoefficients(NamedTuple):
-    """The mesh tendons' world-frame slide coefficients, which turn with their carrier (a named tuple of contiguous
-    arrays: the compiled kernels take it as it is, inside :class:`~gearcheck.mbd_models.compiled.Turning`).
-
-    Per wrap (x wraps of every mesh, then their y wraps): ``wraps`` the index into ``wrap_prm``;
-    ``base`` (2n, 2) such that the coefficient is base @ (cos phi, sin phi), phi the angle of the
-    carrier at qpos address ``carrier_qadr``; ``tendon`` the mesh it belongs to; ``slide_qadr`` and
-    ``slide_dof`` the slide it multiplies."""
+    """The coefficients of the world-frame joints in the tendons that turn with their carrier (a named tuple of
+    contiguous arrays: the compiled kernels take it as it is, inside :class:`~gearcheck.mbd_models.compiled.Turning`):
+    a central member's or a carrier's slides along the world's x and y and, when it tilts, its tilts about them, in
+    a mesh's tendon and its tilting tendon.  Each such pair (:func:`~gearcheck.mbd_models.mjcf_text.world_pairs`)
+    turns as a vector.  Per wrap (the first joints of every pair, then their second joints): ``wraps`` the index
+    into ``wrap_prm``; ``base`` (2n, 2) such that the coefficient is base @ (cos phi, sin phi), phi the angle of
+    the carrier at qpos address ``carrier_qadr``; ``tendon`` the tendon it belongs to (one of the corrected
+    tendons, :attr:`MbdModel.corrected`, which are the model's first); ``joint_qadr`` and ``joint_dof`` the joint
+    it multiplies."""
 
     wraps: np.ndarray
     base: np.ndarray
     carrier_qadr: np.ndarray
     tendon: np.ndarray
-    slide_qadr: np.ndarray
-    slide_dof: np.ndarray
+    joint_qadr: np.ndarray
+    joint_dof: np.ndarray
 
     def values(self, phi) -> np.ndarray:
         """The coefficients at carrier angles ``phi`` (one per wrap, or one scalar for all)."""
         return self.base[:, 0] * np.cos(phi) + self.base[:, 1] * np.sin(phi)
 
     def derivatives(self, phi) -> np.ndarray:
-        """d(coefficient)/d(phi): an (x, y) pair a cos - b sin, a sin + b cos turns as (-y, x)."""
+        """d(coefficient)/d(phi): a pair (a cos - b sin, a sin + b cos) turns as (-second, first)."""
         return self.base[:, 1] * np.cos(phi) - self.base[:, 0] * np.sin(phi)
 
-    def missing_rate(self, phi, phidot, slide, n_mesh: int) -> np.ndarray:
-        """The part of each mesh's deflection rate that a fixed tendon's J qvel misses: its turning
+    def missing_rate(self, phi, phidot, q, n_tendon: int) -> np.ndarray:
+        """The part of each tendon's deflection rate that a fixed tendon's J qvel misses: its turning
         coefficients give d/dt (c(phi) q) = c q' + (dc/dphi) phi' q.  Arguments per wrap (time along
-        axis 0 allowed): carrier angle, its rate, the slide's position.  Returns one rate per mesh."""
-        terms = self.derivatives(phi) * phidot * slide
-        out = np.zeros(np.shape(terms)[:-1] + (n_mesh,))
-        for t in range(n_mesh):
+        axis 0 allowed): carrier angle, its rate, the joint's position.  Returns one rate per tendon 0..n-1."""
+        terms = self.derivatives(phi) * phidot * q
+        out = np.zeros(np.shape(terms)[:-1] + (n_tendon,))
+        for t in range(n_tendon):
             out[..., t] = terms[..., self.tendon == t].sum(axis=-1)
         return out
 
@@ -124,6 +134,8 @@ class MbdModel:
     actuator: dict[str, int]
     sensor: dict[str, tuple[int, int]]  # name -> (address, dimension)
     turning: TurningCoefficients
+    tilt_tendon: np.ndarray  # the tilting meshes' tilting tendons (the next tendons of the model)
+    tilt_damping: np.ndarray
     moving_contacts: tuple = ()  # contacts whose tendons follow the bodies every step (an RV reducer's pins)
 
     @property
@@ -134,74 +146,48 @@ class MbdModel:
     def default_step(self) -> float:
         return stepping.default_step(self.limits, self.excitation.frequency)
 
+    @property
+    def corrected(self) -> np.ndarray:
+        """The tendons whose damping the runner corrects (:class:`~gearcheck.mbd_models.static_state.
+        DampingCorrection`), the model's first: the meshes' (their turning coefficients and a transmission error's
+        rate) and the meshes' tilting tendons (their turning coefficients)."""
+        return np.concatenate([self.mesh_tendon, self.tilt_tendon])
+
+    @property
+    def corrected_damping(self) -> np.ndarray:
+        return np.concatenate([self.mesh_damping, self.tilt_damping])
+
     def moving_slices(self) -> list[slice]:
         """Where each of :attr:`moving_contacts`' tendons lie in arrays over all of them, in their order."""
         stops = np.cumsum([len(c.tendons) for c in self.moving_contacts], dtype=int)
         return [slice(int(stop) - len(c.tendons), int(stop)) for c, stop in zip(self.moving_contacts, stops)]
 
     def refresh(self, qpos: np.ndarray) -> None:
-        """Turn the world-frame slide coefficients of every mesh tendon to the carriers' angles in ``qpos``."""
+        """Turn the world-frame coefficients of every turning tendon to the carriers' angles in ``qpos``."""
         self.model.wrap_prm[self.turning.wraps] = self.turning.values(qpos[self.turning.carrier_qadr])
+
+    def joint_dofs(self, members, suffixes) -> list[int]:
+        """The dof addresses of ``members``' joints (:func:`~gearcheck.mbd_models.mjcf_text.member_joints`) whose
+        suffixes are among ``suffixes``, member by member."""
+        return [int(self.model.jnt_dofadr[named(self.model, JOINT, f"{m.label}_{a}")])
+                for m in members for a in member_joints(m) if a in suffixes]
 
     def mesh_jacobian(self) -> np.ndarray:
         """(n_mesh, nv) coefficients of every mesh tendon as the model holds them now."""
-        m = self.model
-        J = np.zeros((len(self.mesh_tendon), m.nv))
-        for j, t in enumerate(self.mesh_tendon):
-            wraps = np.arange(m.tendon_adr[t], m.tendon_adr[t] + m.tendon_num[t])
-            J[j, m.jnt_dofadr[m.wrap_objid[wraps]]] = m.wrap_prm[wraps]
-        return J
+        return tendon_rows(self.model, self.mesh_tendon)
 
 
-def _id(model, kind, name: str) -> int:
-    i = mujoco.mj_name2id(model, kind, name)
-    if i < 0:
-        raise KeyError(f"no {kind} named {name!r} in the MuJoCo model")
-    return i
-
-
-def mesh_jacobian_row(spec: TrainSpec, kin: Kinematics, model: mujoco.MjModel, data: mujoco.MjData,
-                      mesh) -> np.ndarray:
-    """d . (Jp_central(p) - Jp_planet(p)) over all dofs, at ``data``'s current configuration.
-
-    ``data`` must have its kinematics computed (``mj_kinematics`` and ``mj_comPos``, or
-    ``mj_forward``).  p is the pitch point and d the line of action of the train
-    description, both given in the carrier frame and placed in the world with the
-    carrier body's current pose in ``data``.
-    """
-    stage = spec.stage_of(mesh.planet)
-    planet = spec.members[mesh.planet]
-    loa = line_of_action(mesh, planet.angle, stage.carrier_radius, kin.flanks[mesh.id])
-    carrier_label = spec.members[stage.carrier].label
-    carrier = _id(model, mujoco.mjtObj.mjOBJ_BODY, carrier_label)
-    central = _id(model, mujoco.mjtObj.mjOBJ_BODY, spec.members[mesh.central].label)
-    planet_body = _id(model, mujoco.mjtObj.mjOBJ_BODY, planet.label)
-    R = data.xmat[carrier].reshape(3, 3)
-    # the stage axis: the carrier frame's origin less the carrier's own slide displacement
-    slides = [_id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{carrier_label}_{a}")
-              for a in member_axes(spec.members[stage.carrier])]  # none: a torsional carrier stays on the axis
-    shift = [data.qpos[model.jnt_qposadr[j]] for j in slides]
-    origin = data.xpos[carrier] - np.array(shift + [0.0] * (3 - len(shift)))
-    point = origin + rows_combined((loa.pitch_point[0], loa.pitch_point[1], 0.0), R.T)
-    direction = rows_combined((loa.direction[0], loa.direction[1], loa.axial), R.T)
-    jac_c = np.zeros((3, model.nv))
-    jac_p = np.zeros((3, model.nv))
-    mujoco.mj_jac(model, data, jac_c, None, point, central)
-    mujoco.mj_jac(model, data, jac_p, None, point, planet_body)
-    return rows_combined(direction, jac_c - jac_p)
-
-
-def rows_combined(weights, rows: np.ndarray) -> np.ndarray:
-    """sum_i weights[i] rows[i], added in index order.
-
-    Written out rather than as a matrix product: BLAS picks its kernel (and with it the order of the
-    additions and the use of fused multiply-adds) by processor and environment, and the coefficients
-    written into the MJCF must come out the same to the last bit on every machine.
-    """
-    total = weights[0] * rows[0]
-    for weight, row in zip(weights[1:], rows[1:]):
-        total = total + weight * row
-    return total
+def _write_row(model: mujoco.MjModel, name: str, row: np.ndarray) -> list[tuple[str, float]]:
+    """The fixed tendon ``name``'s coefficients, each its joint's entry of ``row`` (over all dofs), into
+    ``wrap_prm``; returns them as (joint, coefficient) for the text."""
+    t = named(model, TENDON, name)
+    wraps = range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t])
+    coefs = []
+    for w in wraps:
+        joint = int(model.wrap_objid[w])
+        model.wrap_prm[w] = row[model.jnt_dofadr[joint]]
+        coefs.append((mujoco.mj_id2name(model, JOINT, joint), float(model.wrap_prm[w])))
+    return coefs
 
 
 def _mesh_damping(spec, mesh, model, row, k_mean) -> float:
@@ -212,8 +198,8 @@ def _mesh_damping(spec, mesh, model, row, k_mean) -> float:
     inv = 0.0
     for mid in (mesh.central, mesh.planet):
         label = spec.members[mid].label
-        arm = row[model.jnt_dofadr[_id(model, mujoco.mjtObj.mjOBJ_JOINT, label + "_rz")]]
-        inv += arm**2 / model.body_inertia[_id(model, mujoco.mjtObj.mjOBJ_BODY, label)][2]
+        arm = row[model.jnt_dofadr[named(model, JOINT, label + "_rz")]]
+        inv += arm**2 / model.body_inertia[named(model, BODY, label)][2]
     return 2.0 * mesh.damping_ratio * math.sqrt(k_mean / inv)
 
 
@@ -230,8 +216,14 @@ def _stiffness_values(spec: TrainSpec, exc: Excitation, stiffness) -> np.ndarray
     return values
 
 
+def _tilting(spec: TrainSpec, exc: Excitation) -> list[tuple]:
+    """(mesh, its tilting tendon, its mean stiffness) of every mesh of a tilting stage, in the meshes' order."""
+    return [(mesh, tilt_tendon(mesh), float(k)) for mesh, k in zip(spec.meshes, exc.mean_stiffness)
+            if tilt_joints(spec, mesh)]
+
+
 def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
-    """Compile the MuJoCo twin of ``spec`` (once), with its mesh coefficients from MuJoCo's Jacobians.
+    """Compile the MuJoCo twin of ``spec`` (once), with its tendons' coefficients from MuJoCo's Jacobians.
 
     stiffness: "mean" (default), "max" (cycle maximum) or one value per mesh (N/m): the tendons'
     constant stiffness in the file (the runner drives k(t) every step whatever it is).
@@ -239,29 +231,28 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     kin = kinematics(spec)
     exc = Excitation(spec, kin)
     k = _stiffness_values(spec, exc, stiffness)
-    joints = [mesh_joints(spec, mesh) for mesh in spec.meshes]
+    tilting = _tilting(spec, exc)
     stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
     text = document(spec, header(spec, stiffness_label))  # written once; its late numbers are slots
     values = LateValues(PLACEHOLDER_STEP, stiffness={mesh.label: value for mesh, value in zip(spec.meshes, k)})
+    values.stiffness.update({name: k_mean * face_moment(mesh) for mesh, name, k_mean in tilting})
     model = mujoco.MjModel.from_xml_string(text.fill(values))  # coefficients 0, no mesh damping, a placeholder step
 
     # MuJoCo's own coefficients at the reference configuration, into the compiled model
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    damping = []
-    for t, (mesh, names, k_mean) in enumerate(zip(spec.meshes, joints, exc.mean_stiffness)):
-        row = mesh_jacobian_row(spec, kin, model, data, mesh)
-        dofs = {name: int(model.jnt_dofadr[_id(model, mujoco.mjtObj.mjOBJ_JOINT, name)]) for name in names}
-        coefs = sorted(((name, float(row[dofs[name]])) for name in names), key=lambda c: dofs[c[0]])
-        adr = model.tendon_adr[t]
-        for i, (name, value) in enumerate(coefs):
-            assert model.wrap_objid[adr + i] == _id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
-            model.wrap_prm[adr + i] = value
-        damping.append(_mesh_damping(spec, mesh, model, row, float(k_mean)))
-        values.coefficients[mesh.label], values.damping[mesh.label] = coefs, damping[-1]
-    model.tendon_damping[:len(spec.meshes)] = damping
+    for part in spec.parts:
+        for name, row in ELEMENTS[part.element].late_rows(part, spec, kin, model, data):
+            values.coefficients[name] = _write_row(model, name, row)
+    rows = tendon_rows(model, range(len(spec.meshes)))
+    damping = {mesh.label: _mesh_damping(spec, mesh, model, row, float(k_mean))
+               for mesh, row, k_mean in zip(spec.meshes, rows, exc.mean_stiffness)}
+    damping.update({name: damping[mesh.label] * face_moment(mesh) for mesh, name, _ in tilting})
+    for name, c in damping.items():
+        model.tendon_damping[named(model, TENDON, name)] = c
+    values.damping.update(damping)
 
-    mb = _indices(spec, kin, exc, model)
+    mb = _indices(spec, kin, exc, model, [name for _, name, _ in tilting])
     kinds = dict.fromkeys(part.element for part in spec.parts)
     contacts = (ELEMENTS[kind].contacts(spec, model) for kind in kinds)
     mb.moving_contacts = tuple(sorted((c for c in contacts if c is not None), key=group_order))
@@ -280,47 +271,51 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     return mb
 
 
-def _indices(spec, kin, exc, model) -> MbdModel:
-    """Named indices of the compiled model (its xml and step limits are filled in by the caller)."""
-    J, B, T, A, S = (mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON,
-                     mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR)
-    body, qadr, dadr = {}, {}, {}
-    for mid, member in spec.members.items():
-        body[mid] = _id(model, B, member.label)
-        joints = {a: _id(model, J, f"{member.label}_{a}") for a in member_axes(member) + (ROTATION,)}
-        qadr[mid] = {a: int(model.jnt_qposadr[j]) for a, j in joints.items()}
-        dadr[mid] = {a: int(model.jnt_dofadr[j]) for a, j in joints.items()}
-    mesh_tendon = np.array([_id(model, T, m.label) for m in spec.meshes], dtype=int)
-    assert np.array_equal(mesh_tendon, np.arange(len(spec.meshes))), "mesh tendons must come first"
-    actuator = {name: i for name in ("input_shaft", "input_shaft_damper", "input_torque", "output_load")
-                if (i := mujoco.mj_name2id(model, A, name)) >= 0}
-    sensor = {mujoco.mj_id2name(model, S, i): (int(model.sensor_adr[i]), int(model.sensor_dim[i]))
-              for i in range(model.nsensor)}
-    # world-frame slide pairs in every mesh tendon: x wraps, then y wraps
-    x_wraps, y_wraps, carrier, tendon, slide_x, slide_y = [], [], [], [], [], []
-    for t, mesh in enumerate(spec.meshes):
+def _turning(spec, model, tendons, qadr) -> TurningCoefficients:
+    """The world-frame joints' wraps in ``tendons`` ((tendon id, mesh) each), pair by pair
+    (:func:`~gearcheck.mbd_models.mjcf_text.world_pairs` of the mesh's central member and carrier)."""
+    first, second, carrier, tendon = [], [], [], []
+    for t, mesh in tendons:
         adr, n = model.tendon_adr[t], model.tendon_num[t]
         wrap_of = {int(model.wrap_objid[adr + i]): adr + i for i in range(n)}
         stage = spec.stage_of(mesh.planet)
         for mid in (mesh.central, stage.carrier):
-            if spec.members[mid].torsional:  # no world-frame slides
-                continue
             label = spec.members[mid].label
-            x_wraps.append(wrap_of[_id(model, J, label + "_x")])
-            y_wraps.append(wrap_of[_id(model, J, label + "_y")])
-            carrier.append(qadr[stage.carrier][ROTATION])
-            tendon.append(t)
-            slide_x.append(mid)
-            slide_y.append(mid)
-    wraps = np.array(x_wraps + y_wraps, dtype=int)
-    c0x, c0y = model.wrap_prm[x_wraps].copy(), model.wrap_prm[y_wraps].copy()
-    base = np.stack([np.concatenate([c0x, c0y]), np.concatenate([-c0y, c0x])], axis=1)
-    x, y = AXES["axis"]
-    slide_qadr = np.array([qadr[mid][x] for mid in slide_x] + [qadr[mid][y] for mid in slide_y], dtype=int)
-    slide_dof = np.array([dadr[mid][x] for mid in slide_x] + [dadr[mid][y] for mid in slide_y], dtype=int)
-    carrier_qadr = np.array(carrier + carrier, dtype=int)
-    turning = TurningCoefficients(wraps, base, carrier_qadr, np.array(tendon + tendon, dtype=int), slide_qadr,
-                                  slide_dof)
+            for a, b in world_pairs(spec.members[mid]):
+                ja, jb = named(model, JOINT, f"{label}_{a}"), named(model, JOINT, f"{label}_{b}")
+                if ja in wrap_of:
+                    first.append((wrap_of[ja], ja))
+                    second.append((wrap_of[jb], jb))
+                    carrier.append(qadr[stage.carrier][ROTATION])
+                    tendon.append(t)
+    wraps, joints = (np.array([w for w, _ in first + second], dtype=int),
+                     np.array([j for _, j in first + second], dtype=int))
+    c0a, c0b = model.wrap_prm[wraps[:len(first)]].copy(), model.wrap_prm[wraps[len(first):]].copy()
+    base = np.stack([np.concatenate([c0a, c0b]), np.concatenate([-c0b, c0a])], axis=1)
+    return TurningCoefficients(wraps, base, np.array(carrier + carrier, dtype=int),
+                               np.array(tendon + tendon, dtype=int), model.jnt_qposadr[joints].astype(int),
+                               model.jnt_dofadr[joints].astype(int))
+
+
+def _indices(spec, kin, exc, model, tilt_names) -> MbdModel:
+    """Named indices of the compiled model (its xml and step limits are filled in by the caller)."""
+    A, S = mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR
+    body, qadr, dadr = {}, {}, {}
+    for mid, member in spec.members.items():
+        body[mid] = named(model, BODY, member.label)
+        joints = {a: named(model, JOINT, f"{member.label}_{a}") for a in member_axes(member) + (ROTATION,)}
+        qadr[mid] = {a: int(model.jnt_qposadr[j]) for a, j in joints.items()}
+        dadr[mid] = {a: int(model.jnt_dofadr[j]) for a, j in joints.items()}
+    mesh_tendon = np.array([named(model, TENDON, m.label) for m in spec.meshes], dtype=int)
+    assert np.array_equal(mesh_tendon, np.arange(len(spec.meshes))), "mesh tendons must come first"
+    tilt_tendon = np.array([named(model, TENDON, name) for name in tilt_names], dtype=int)
+    assert np.array_equal(tilt_tendon, len(mesh_tendon) + np.arange(len(tilt_names))), "tilting tendons come next"
+    actuator = {name: i for name in ("input_shaft", "input_shaft_damper", "input_torque", "output_load")
+                if (i := mujoco.mj_name2id(model, A, name)) >= 0}
+    sensor = {mujoco.mj_id2name(model, S, i): (int(model.sensor_adr[i]), int(model.sensor_dim[i]))
+              for i in range(model.nsensor)}
+    tilting = [mesh for mesh in spec.meshes if tilt_joints(spec, mesh)]
+    turning = _turning(spec, model, list(enumerate(spec.meshes)) + list(zip(tilt_tendon, tilting)), qadr)
     return MbdModel(spec, kin, exc, "", model, None, body, qadr, dadr, mesh_tendon,
                     model.tendon_damping[mesh_tendon].copy(), model.tendon_lengthspring[mesh_tendon, 1].copy(),
-                    actuator, sensor, turning)
+                    actuator, sensor, turning, tilt_tendon, model.tendon_damping[tilt_tendon].copy())

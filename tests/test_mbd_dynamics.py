@@ -272,7 +272,7 @@ def test_mesh_forces_are_mujocos_own():
     carrier = spec.members[spec.stages[0].carrier].label
     slides = {mb.qadr[mid][axis]: f"{spec.members[mid].label}_{axis}_pos" for mid, m in spec.members.items()
               if not m.is_planet for axis in "xy"}
-    slide = np.column_stack([raw[slides[q]] for q in tc.slide_qadr])
+    slide = np.column_stack([raw[slides[q]] for q in tc.joint_qadr])
     phi = np.repeat(raw[f"{carrier}_angle"][:, None], len(tc.wraps), axis=1)
     phidot = np.repeat(raw[f"{carrier}_angle_rate"][:, None], len(tc.wraps), axis=1)
     rate = np.column_stack([raw[f"{m.label}_rate"] for m in spec.meshes])

@@ -18,7 +18,8 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.train.loader import load_train, preset_names
 from gearcheck.lumped.modal import modes
 from gearcheck.train.variants import chained, edited
-from gearcheck.mbd_models.twin import compile_train, mesh_jacobian_row
+from gearcheck.mbd_models.elements.mesh import mesh_jacobian_row
+from gearcheck.mbd_models.twin import compile_train
 
 RELATIVE_TOLERANCE = 1e-6
 RIGID_HZ = 1e-3  # below this a frequency is a rigid-body mode (0 in both)

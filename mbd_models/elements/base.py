@@ -17,12 +17,24 @@ class Element:
     """The MJCF of one kind of part (hooks get the part and the :class:`~gearcheck.train.spec.TrainSpec`)."""
 
     def joint_springs(self, part, spec) -> dict:
-        """{(member id, joint suffix): (stiffness, damping)} the part puts on its members' joints."""
+        """{(member id, joint suffix): :class:`~gearcheck.mbd_models.mjcf_text.Spring`} the part puts on its members'
+        joints."""
         return {}
+
+    def driven_tendons(self, part, spec) -> list[str]:
+        """The part's tendons whose stiffness the runner drives every step (a mesh's), as :meth:`tendons`: the
+        file writes every part's before any other tendon, so that they come first in the model."""
+        return []
 
     def tendons(self, part, spec) -> list[str]:
         """The part's tendons; a number known only once the twin is compiled is
         :data:`~gearcheck.mbd_models.mjcf_text.LATE` (see :func:`~gearcheck.mbd_models.mjcf_text.fixed`)."""
+        return []
+
+    def late_rows(self, part, spec, kin, model, data) -> list[tuple]:
+        """(tendon name, row over all dofs) of each of the part's tendons whose coefficients are late: MuJoCo's own
+        Jacobians (:mod:`gearcheck.mbd_models.jacobians`) in the compiled ``model`` at ``data``'s reference
+        configuration (``kin``: the train's :class:`~gearcheck.train.kinematics.Kinematics`)."""
         return []
 
     def actuators(self, part, spec) -> list[str]:

@@ -210,3 +210,20 @@ def test_pin_tilts_are_one_pair_per_planet():
         tilting((r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, 0.0]]"))
     with pytest.raises(TrainFileError, match=r"stages\[0\].planet.pin_tilts_urad\[0\]: needs 2 entries, got 3"):
         tilting((r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, 0.0, 1.0]]"))
+
+
+def test_a_published_mesh_states_its_tilting_stiffness_and_centre():
+    """A model from a paper may give the mesh's tilting stiffness and centre of stiffness instead of the face: they
+    replace k w^2/12 and the overlap's middle (the damping spread like the stiffness); a centre off the face is
+    refused."""
+    stated = (r"^(\[stages.mesh\])", "\\1\ntilting_stiffness = 4.0e4\ncentre_offset_mm = 6.0")
+    model = build_model(tilting(stated))
+    mesh = model.spec.meshes[0]
+    assert (mesh.axial_centre, mesh.contact_width) == (pytest.approx(6e-3), pytest.approx(40e-3))
+    row = next(r for r in model.rows if r.name == f"{mesh.id}.tilt")
+    assert row.stiffness == 4.0e4 and row.damping == pytest.approx(model.mesh_damping[0] * 4.0e4 / 8.0e8)
+    default = next(r for r in build_model(tilting()).rows if r.name == f"{mesh.id}.tilt")
+    assert default.stiffness == pytest.approx(8.0e8 * 0.04**2 / 12)
+    with pytest.raises(TrainFileError, match=r"stages\[0\].sun.mesh.centre_offset_mm: 25 mm is off the faces' "
+                                             r"overlap, -20 to 20 mm"):
+        tilting((r"^(\[stages.mesh\])", "\\1\ncentre_offset_mm = 25.0"))

@@ -51,7 +51,8 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
         _check_held(member.support if member.support is not None else member.bearing, support_path, fail)
         out[mid] = replace(member, tilting=True, tilting_inertia=_tilting_inertia(member, raw))
         if member.is_planet and pins:
-            out[mid] = replace(out[mid], bearing=replace(member.bearing, rest_tilt=tuple(pins[int(mid.rsplit(".planet", 1)[1]) - 1])))
+            pin = pins[int(mid.rsplit(".planet", 1)[1]) - 1]
+            out[mid] = replace(out[mid], bearing=replace(member.bearing, rest_tilt=tuple(pin)))
     return out, [_placed(mesh, path, fail) for mesh in meshes]
 
 

@@ -227,3 +227,23 @@ def test_a_published_mesh_states_its_tilting_stiffness_and_centre():
     with pytest.raises(TrainFileError, match=r"stages\[0\].sun.mesh.centre_offset_mm: 25 mm is off the faces' "
                                              r"overlap, -20 to 20 mm"):
         tilting((r"^(\[stages.mesh\])", "\\1\ncentre_offset_mm = 25.0"))
+
+
+def test_the_mesh_tilting_stiffness_is_the_thin_slices_moment():
+    """Cut the face into n thin slices (the thin-slice model of the helical mesh, Velex & Maatar 1996): over a mesh
+    cycle every slice has the same mean stiffness k_mean/n, so the slices' second moment about the face centre,
+    sum k_i z_i^2, averages k_mean b^2/12 (1 - 1/n^2) and their centre of stiffness the face centre: the tilting row's
+    k_mean w^2/12.  Within the cycle the contact lines sweep the face, and the moment varies about that mean (the
+    centre row carries the variation of k; the tilting row keeps the mean)."""
+    from gearcheck.train.helical_mesh import contact_pairs
+
+    eps_a, eps_b, pitch, b, n = 1.605, 1.246, 2.566e-3, 16e-3, 200
+    xi = (np.arange(4096) + 0.5) / 4096
+    k = contact_pairs(xi, eps_a, eps_b, pitch, b, lambda s: np.full(np.shape(s), 1.4e10), n)[0]
+    k = k.reshape(xi.size, n, -1).sum(axis=-1)  # each slice's stiffness over the cycle
+    z = ((np.arange(n) + 0.5) / n - 0.5) * b
+    k_mean = k.sum(axis=1).mean()
+    assert np.allclose(k.mean(axis=0), k_mean / n, rtol=1e-6)
+    assert (k @ z).mean() == pytest.approx(0.0, abs=1e-9 * k_mean * b)
+    assert (k @ z**2).mean() == pytest.approx(k_mean * b**2 / 12 * (1 - 1 / n**2), rel=1e-6)
+    assert np.ptp(k @ z**2) / (k @ z**2).mean() > 0.05  # it does move within the cycle

@@ -210,3 +210,40 @@ def test_pin_tilts_are_one_pair_per_planet():
         tilting((r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, 0.0]]"))
     with pytest.raises(TrainFileError, match=r"stages\[0\].planet.pin_tilts_urad\[0\]: needs 2 entries, got 3"):
         tilting((r"^\[stages.planet\]", "[stages.planet]\npin_tilts_urad = [[40.0, 0.0, 1.0]]"))
+
+
+def test_a_published_mesh_states_its_tilting_stiffness_and_centre():
+    """A model from a paper may give the mesh's tilting stiffness and centre of stiffness instead of the face: they
+    replace k w^2/12 and the overlap's middle (the damping spread like the stiffness); a centre off the face is
+    refused."""
+    stated = (r"^(\[stages.mesh\])", "\\1\ntilting_stiffness = 4.0e4\ncentre_offset_mm = 6.0")
+    model = build_model(tilting(stated))
+    mesh = model.spec.meshes[0]
+    assert (mesh.axial_centre, mesh.contact_width) == (pytest.approx(6e-3), pytest.approx(40e-3))
+    row = next(r for r in model.rows if r.name == f"{mesh.id}.tilt")
+    assert row.stiffness == 4.0e4 and row.damping == pytest.approx(model.mesh_damping[0] * 4.0e4 / 8.0e8)
+    default = next(r for r in build_model(tilting()).rows if r.name == f"{mesh.id}.tilt")
+    assert default.stiffness == pytest.approx(8.0e8 * 0.04**2 / 12)
+    with pytest.raises(TrainFileError, match=r"stages\[0\].sun.mesh.centre_offset_mm: 25 mm is off the faces' "
+                                             r"overlap, -20 to 20 mm"):
+        tilting((r"^(\[stages.mesh\])", "\\1\ncentre_offset_mm = 25.0"))
+
+
+def test_the_mesh_tilting_stiffness_is_the_thin_slices_moment():
+    """Cut the face into n thin slices (the thin-slice model of the helical mesh, Velex & Maatar 1996): over a mesh
+    cycle every slice has the same mean stiffness k_mean/n, so the slices' second moment about the face centre,
+    sum k_i z_i^2, averages k_mean b^2/12 (1 - 1/n^2) and their centre of stiffness the face centre: the tilting row's
+    k_mean w^2/12.  Within the cycle the contact lines sweep the face, and the moment varies about that mean (the
+    centre row carries the variation of k; the tilting row keeps the mean)."""
+    from gearcheck.train.helical_mesh import contact_pairs
+
+    eps_a, eps_b, pitch, b, n = 1.605, 1.246, 2.566e-3, 16e-3, 200
+    xi = (np.arange(4096) + 0.5) / 4096
+    k = contact_pairs(xi, eps_a, eps_b, pitch, b, lambda s: np.full(np.shape(s), 1.4e10), n)[0]
+    k = k.reshape(xi.size, n, -1).sum(axis=-1)  # each slice's stiffness over the cycle
+    z = ((np.arange(n) + 0.5) / n - 0.5) * b
+    k_mean = k.sum(axis=1).mean()
+    assert np.allclose(k.mean(axis=0), k_mean / n, rtol=1e-6)
+    assert (k @ z).mean() == pytest.approx(0.0, abs=1e-9 * k_mean * b)
+    assert (k @ z**2).mean() == pytest.approx(k_mean * b**2 / 12 * (1 - 1 / n**2), rel=1e-6)
+    assert np.ptp(k @ z**2) / (k @ z**2).mean() > 0.05  # it does move within the cycle

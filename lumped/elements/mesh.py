@@ -56,8 +56,8 @@ def mesh_row(mesh, build: Build) -> Contribution:
         arm = np.append(loa.pitch_point - centre, mesh.axial_centre)
         _add_tilts(a, dofs, spec.members[member], axes, sign * np.cross(arm, n))
         _add_tilts(tilt, dofs, spec.members[member], axes, sign * np.cross([0.0, 0.0, 1.0], n))
-    slices = mesh.contact_width**2 / 12.0  # sum of z^2 over the face's slices per unit stiffness, z from its centre
-    row = Row(f"{mesh.id}.tilt", "mesh", tilt, k_mean * slices, damping * slices)
+    k_tilt = mesh.tilting_stiffness(k_mean)
+    row = Row(f"{mesh.id}.tilt", "mesh", tilt, k_tilt, damping * k_tilt / k_mean)  # damping spread like stiffness
     return Contribution(rows=[row], mesh=(a, damping))
 
 

@@ -470,6 +470,12 @@ MESH = Table(
         "backlash_um": NonNegative("total backlash 2b along the line of action (dead zone ±b)", "µm", None,
                                    bound("displacement", UM)),
         "ste": TableList(STE, "static transmission error: harmonic series at the mesh frequency", default=()),
+        "tilting_stiffness": Positive("the mesh's stiffness against the gears' relative tilt across the face (a "
+                                      "tilting stage; default k_mean w²/12, its mean stiffness spread evenly over "
+                                      "the w of the faces' overlap)", "N·m/rad", None, bound("stiffness")),
+        "centre_offset_mm": Number("axial position of the mesh's centre of stiffness from the members' centres of "
+                                   "mass (a tilting stage; default the middle of the faces' overlap, which it must "
+                                   "lie in)", "mm", None, -bound("length", MM), False, bound("length", MM)),
     },
     "mesh properties; a stage-level [stages.mesh] gives defaults for its central gears",
     default=None,

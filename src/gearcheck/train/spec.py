@@ -183,6 +183,13 @@ class MeshSpec(Part):
     planet_index: int
     axial_centre: float = 0.0  # a tilting stage: its centre of stiffness from the members' centres of mass, m
     contact_width: float = 0.0  # a tilting stage: the length of the two faces' overlap, m
+    stated_tilt: tuple = (None, None)  # a tilting stage: its tilting stiffness and centre as the file states them
+
+    def tilting_stiffness(self, mean_stiffness: float) -> float:
+        """Its stiffness against the gears' relative tilt across the face, N m/rad: as stated, or its mean stiffness
+        spread evenly over the contact width, k w^2/12 (slices of k/w dz at z in [-w/2, w/2] about the centre)."""
+        stated = self.stated_tilt[0]
+        return mean_stiffness * self.contact_width**2 / 12.0 if stated is None else stated
 
     @property
     def internal(self) -> bool:
@@ -1050,6 +1057,7 @@ def _stage_meshes(st: dict, centrals: dict, planet_gears: dict, geoms: dict, pla
                 planet_gear=planet_gears[pg], geometry=geoms[key], stiffness=dict(mesh["stiffness"]),
                 damping_ratio=damping["ratio"], damping_coefficient=damping["coefficient"],
                 backlash=mesh["backlash"] or 0.0, ste=ste, planet_index=k,
+                stated_tilt=(mesh.get("tilting_stiffness"), mesh.get("centre_offset")),
             ))
     return meshes
 

@@ -9,7 +9,8 @@ axial distance p from the centre of mass turns into a moment p F and a tilting s
 be misaligned in the carrier (``pin_tilts_urad``): its bearing then holds the planet at the pin's tilt, and the
 meshes meet a tilted gear, whose load moves along the face.  A mesh acts at its
 centre of stiffness, the middle of the two faces' overlap (a gear's face may be offset axially from its member's
-centre of mass), and resists the members' relative tilt across the face by its slices.
+centre of mass), and resists the members' relative tilt across the face by its slices; a published model may state
+its tilting stiffness and its centre of stiffness instead.
 
 A stage that does not tilt keeps its members and meshes as they are: a tilting key given there is set aside with
 a note, where a file may keep it to switch the flag on and off.
@@ -34,7 +35,7 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
     (a tilting key given there noted and set aside)."""
     holders = _holders(st, centrals, path)
     if not st[FLAG]:
-        return _set_aside(members, holders, path, st["name"], st["planet"]["pin_tilts"]), meshes
+        return _set_aside(members, meshes, holders, path, st["name"], st["planet"]["pin_tilts"]), meshes
     if rv:
         raise fail(f"{path}.{FLAG}", "an RV reducer's stage does not tilt here (its cycloid discs and pins are "
                                      "planar): remove it")
@@ -50,7 +51,8 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
         _check_held(member.support if member.support is not None else member.bearing, support_path, fail)
         out[mid] = replace(member, tilting=True, tilting_inertia=_tilting_inertia(member, raw))
         if member.is_planet and pins:
-            out[mid] = replace(out[mid], bearing=replace(member.bearing, rest_tilt=tuple(pins[int(mid.rsplit(".planet", 1)[1]) - 1])))
+            pin = pins[int(mid.rsplit(".planet", 1)[1]) - 1]
+            out[mid] = replace(out[mid], bearing=replace(member.bearing, rest_tilt=tuple(pin)))
     return out, [_placed(mesh, path, fail) for mesh in meshes]
 
 
@@ -64,7 +66,7 @@ def _holders(st: dict, centrals: dict, path: str) -> dict:
     return out
 
 
-def _set_aside(members: dict, holders: dict, path: str, name: str, st_pins) -> dict:
+def _set_aside(members: dict, meshes: list, holders: dict, path: str, name: str, st_pins) -> dict:
     """The members of a stage that does not tilt, with any tilting key of their supports set aside (noted)."""
     out, ignored = dict(members), [f"{path}.planet.pin_tilts_urad"] if st_pins else []
     for mid, (raw, raw_path, support_path) in holders.items():
@@ -77,6 +79,8 @@ def _set_aside(members: dict, holders: dict, path: str, name: str, st_pins) -> d
                 ignored.append(f"{support_path}'s tilting stiffness and stations")
                 out[mid] = replace(out[mid], **{attr: replace(support, tilting_stiffness=0.0, tilting_damping=0.0,
                                                                  stations=())})
+    if any(value is not None for mesh in meshes for value in mesh.stated_tilt):
+        ignored.append(f"{path}'s mesh tilting_stiffness and centre_offset_mm")
     if ignored:
         warnings.warn(f"{path} ({name}): {', '.join(dict.fromkeys(ignored))} ignored: the stage does not tilt "
                       "(give it `tilting = true`)", TrainNote, stacklevel=4)
@@ -114,9 +118,13 @@ def _placed(mesh, path: str, fail):
     faces = [(g.axial_offset - 0.5 * g.face_width, g.axial_offset + 0.5 * g.face_width)
              for g in (mesh.central_gear, mesh.planet_gear)]
     low, high = max(f[0] for f in faces), min(f[1] for f in faces)
+    key = mesh.id.split(".")[-1]
     if not high > low or not math.isfinite(high - low):
-        key = mesh.id.split(".")[-1]
         raise fail(f"{path}.{key}.axial_offset_mm", f"the faces of {mesh.central_gear.name} and the planet's "
                                                     f"{mesh.planet_gear.name} do not overlap "
                                                     "(a tilting mesh needs face widths that meet)")
-    return replace(mesh, axial_centre=0.5 * (low + high), contact_width=high - low)
+    centre = mesh.stated_tilt[1]
+    if centre is not None and not low <= centre <= high:
+        raise fail(f"{path}.{key}.mesh.centre_offset_mm", f"{centre * 1e3:.6g} mm is off the faces' overlap, "
+                                                          f"{low * 1e3:.6g} to {high * 1e3:.6g} mm")
+    return replace(mesh, axial_centre=0.5 * (low + high) if centre is None else centre, contact_width=high - low)

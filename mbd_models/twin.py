@@ -14,8 +14,8 @@ runs stably in MuJoCo's viewer.
 
 Every part's late coefficients come the same way (:meth:`~gearcheck.mbd_models.elements.base.Element.late_rows`):
 in a tilting stage the meshes' rows at their centres of stiffness with the members' tilts in them, the meshes'
-tilting tendons (rotational Jacobians; their stiffness and damping the mesh's mean stiffness and damping times
-w^2/12, :mod:`gearcheck.mbd_models.elements.mesh`) and the bearing stations' tendons
+tilting tendons (rotational Jacobians; their stiffness the mesh's tilting stiffness and their damping the mesh's in
+the same proportion, :mod:`gearcheck.mbd_models.elements.mesh`) and the bearing stations' tendons
 (:mod:`gearcheck.mbd_models.elements.stations`).
 
 The coefficients of the world-frame joints (central members' and the carrier's slides, and their tilts in a
@@ -66,7 +66,7 @@ from gearcheck.train.spec import TrainSpec
 from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.elements import ELEMENTS
 from gearcheck.mbd_models.elements.base import group_order
-from gearcheck.mbd_models.elements.mesh import face_moment, tilt_joints, tilt_tendon
+from gearcheck.mbd_models.elements.mesh import tilt_joints, tilt_tendon
 from gearcheck.mbd_models.jacobians import named
 from gearcheck.mbd_models.jacobians import tendon_rows
 from gearcheck.mbd_models.mjcf_builder import document, header
@@ -235,7 +235,7 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     stiffness_label = "mean" if isinstance(stiffness, str) and stiffness == "mean" else "given"
     text = document(spec, header(spec, stiffness_label))  # written once; its late numbers are slots
     values = LateValues(PLACEHOLDER_STEP, stiffness={mesh.label: value for mesh, value in zip(spec.meshes, k)})
-    values.stiffness.update({name: k_mean * face_moment(mesh) for mesh, name, k_mean in tilting})
+    values.stiffness.update({name: mesh.tilting_stiffness(k_mean) for mesh, name, k_mean in tilting})
     model = mujoco.MjModel.from_xml_string(text.fill(values))  # coefficients 0, no mesh damping, a placeholder step
 
     # MuJoCo's own coefficients at the reference configuration, into the compiled model
@@ -247,7 +247,9 @@ def compile_train(spec: TrainSpec, stiffness="mean") -> MbdModel:
     rows = tendon_rows(model, range(len(spec.meshes)))
     damping = {mesh.label: _mesh_damping(spec, mesh, model, row, float(k_mean))
                for mesh, row, k_mean in zip(spec.meshes, rows, exc.mean_stiffness)}
-    damping.update({name: damping[mesh.label] * face_moment(mesh) for mesh, name, _ in tilting})
+    # a tilting tendon's damping: the mesh's in the proportion of their stiffnesses
+    damping.update({name: damping[mesh.label] * mesh.tilting_stiffness(k_mean) / k_mean
+                    for mesh, name, k_mean in tilting})
     for name, c in damping.items():
         model.tendon_damping[named(model, TENDON, name)] = c
     values.damping.update(damping)

@@ -11,8 +11,9 @@ In a tilting stage the pitch point is the mesh's centre of stiffness, moved alon
 (Eritenel & Parker 2009): slices of stiffness k/w dz at z in [-w/2, w/2] about the centre deflect by
 g + z h, and sum k_j (g + z_j h)(g + z_j h)^T = k g g^T + k w^2/12 h h^T, h = (phi_central - phi_planet) .
 (e_z x n) the rate at which the slices' deflection grows along the face (phi the gears' rotation vectors, n the
-normal line of action).  Its stiffness is the mean mesh stiffness times w^2/12 and its damping the mesh's times
-w^2/12, constant (not driven), its coefficients MuJoCo's rotational Jacobians (:func:`mesh_tilt_row`)."""
+normal line of action).  Its stiffness is the mean mesh stiffness times w^2/12, or as the train file states it
+(:meth:`~gearcheck.train.spec.MeshSpec.tilting_stiffness`), and its damping the mesh's in the same proportion,
+constant (not driven); its coefficients are MuJoCo's rotational Jacobians (:func:`mesh_tilt_row`)."""
 
 from __future__ import annotations
 
@@ -38,11 +39,6 @@ def mesh_joints(spec, mesh) -> list[str]:
 def tilt_tendon(mesh) -> str:
     """The name of a tilting mesh's tilting tendon."""
     return f"{mesh.label}_tilt"
-
-
-def face_moment(mesh) -> float:
-    """w^2/12: the slices' second moment about the centre of stiffness per unit stiffness (w the contact width)."""
-    return mesh.contact_width**2 / 12.0
 
 
 def tilt_joints(spec, mesh) -> list[str]:
@@ -89,7 +85,7 @@ def mesh_tilt_row(spec, kin, model, data, mesh) -> np.ndarray:
 
 HEADER = [
     "A tilting stage's members tilt on hinges inside their spin hinges; its meshes act at their centres of stiffness",
-    "and each has a tilting tendon <mesh>_tilt (k_mean w^2/12: the face's slices), whose world-frame tilt",
+    "and each has a tilting tendon <mesh>_tilt (k_mean w^2/12, or as stated), whose world-frame tilt",
     "coefficients are also those of carrier angle 0.",
 ]
 

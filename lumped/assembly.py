@@ -48,7 +48,7 @@ import numpy as np
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, DofMap, Row
 from gearcheck.lumped.constraints import torsional
-from gearcheck.lumped.elements.bearing import pin_rows
+from gearcheck.lumped.elements.bearing import carrier_tilts, pin_rows
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import Kinematics, kinematics
 from gearcheck.train.spec import AXIAL, ROTATION, TILTS, TrainSpec
@@ -194,6 +194,8 @@ def build_model(spec: TrainSpec, rotating_frame_terms: bool = True) -> LumpedMod
                 member.radius * np.outer(e_c, e_c) + np.outer(e_c, s_t) + np.outer(s_t, e_c))
             # the Euler load -m Omega' r_c along the turned tangent, in carrier coordinates: m Omega' r_c theta_c s_r
             K_euler += member.mass * omega * member.radius * (np.outer(e_c, s_r) + np.outer(s_r, e_c))
+            if member.tilting:
+                _orbit_tilt_terms(spec, dofs, member, omega, K_cent, K_euler)
         elif member.support:  # (its circulatory damping: the support's element)
             F[ith] -= member.support.torsional_damping * kin.speeds[mid]  # drag of a turning member
 
@@ -236,6 +238,23 @@ def _tilt_terms(member, tilts: list[int], omega: float, spin: float, M, G, K_cen
     K_cent[i1, i1] = K_cent[i2, i2] = member.inertia * spin * omega - inertia * omega**2
     K_euler[i1, i2] -= inertia * omega
     K_euler[i2, i1] += inertia * omega
+
+
+def _orbit_tilt_terms(spec, dofs, member, omega: float, K_cent, K_euler) -> None:
+    """The orbit's potential and Euler load where the carrier tilts, into K_cent and K_euler.
+
+    A carrier tilt phi (components phi_r, phi_t about the orbiting member's radial and tangential axes) turns its
+    pin r_c e_r to r_c (cos phi_t e_r - sin phi_t e_z) and the member's offset s from the pin with it.  Written in
+    those coordinates, in which the bearing is linear (as the planar orbit's terms are), the centripetal potential
+    -1/2 m Omega^2 |r_perp|^2 gains 1/2 m Omega^2 r_c^2 phi_t^2 - m Omega^2 r_c phi_t s_z, and the Euler load
+    -m Omega' r_c e_t does work m Omega' r_c phi_r s_z; with s_z = z - z_c + r_c phi_t (the pin's axial motion)
+    they are -1/2 m r_c^2 Omega^2 phi_t^2 - m r_c Omega^2 phi_t (z - z_c) and -m Omega' r_c phi_r s_z."""
+    carrier = f"{member.stage}.carrier"
+    phi_r, phi_t = carrier_tilts(spec, dofs, member.id)
+    s_z = dofs.unit((member.id, AXIAL, 1.0), (carrier, AXIAL, -1.0)) + member.radius * phi_t
+    m, r = member.mass, member.radius
+    K_cent -= m * r * omega**2 * (np.outer(phi_t, s_z) + np.outer(s_z, phi_t) - r * np.outer(phi_t, phi_t))
+    K_euler -= m * r * omega * (np.outer(phi_r, s_z) + np.outer(s_z, phi_r))
 
 
 def frozen_at(model: LumpedModel, t: float, touching=None) -> LumpedModel:

@@ -29,10 +29,10 @@ from gearcheck.train.variants import edited
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "helical-tilting.toml"
 TILT = (r"^planets = (\d)", r"planets = \1\ntilting = true")
-HELD = (r"^(support|bearing) = \{ (.*) \}$", r"\1 = { \2, tilting_stiffness = 2.0e5 }")
+HELD = (r"^(support|bearing) = \{ (.*) \}$",
+        r"\1 = { \2, axial_stiffness = 5.0e8, axial_damping = 500.0, tilting_stiffness = 2.0e5 }")
 HELIX = [(r"^face_width_mm = 40.0$", "face_width_mm = 40.0\nhelix_angle_deg = 15.0"),
-         (r'model = "rectangular"', 'model = "constant"'),
-         (r"^(support|bearing) = \{ (.*) \}$", r"\1 = { \2, axial_stiffness = 5.0e8, axial_damping = 500.0 }")]
+         (r'model = "rectangular"', 'model = "constant"')]
 
 
 def tilting(*pairs, base="demo-3p"):
@@ -86,7 +86,7 @@ def test_no_helix_and_no_offsets_is_the_planar_model_to_the_bit():
 def test_stations_and_offsets_couple_translation_and_tilt():
     """A carrier on two stations at p1, p2 sharing k: its (x, tilt_y) block is k [[1, p], [p, p^2]] summed (the
     station at p deflects by x + p tilt_y), so the tilting stiffness is sum s_i k p_i^2 about the stations."""
-    pairs = [(r"^support = \{ radial_stiffness = 1.0e9, radial_damping = 2000.0, (tilting_stiffness = .*) \}$",
+    pairs = [(r"^support = \{ radial_stiffness = 1.0e9, radial_damping = 2000.0, (axial_stiffness = .*) \}$",
               r"support = { radial_stiffness = 1.0e9, radial_damping = 2000.0, \1, stations = "
               "[{ position_mm = -30.0, share = 0.25 }, { position_mm = 50.0, share = 0.75 }] }")]
     model = build_model(tilting(*pairs))
@@ -152,8 +152,7 @@ def test_a_stage_that_does_not_tilt_notes_and_sets_aside_its_tilting_keys():
 
 
 @pytest.mark.parametrize("pairs, expected", [
-    ([(r"^support = \{ radial_stiffness = 1.0e8, radial_damping = 500.0, tilting_stiffness = 2.0e5 \}$",
-       "support = { radial_stiffness = 1.0e8, radial_damping = 500.0 }")],
+    ([(r"^(support = \{ radial_stiffness = 1.0e8, .*), tilting_stiffness = 2.0e5 \}$", r"\1 }")],
      r"stages\[0\].sun.support.tilting_stiffness: a tilting stage needs it > 0, or stations at two axial positions"),
     ([(r"^(bearing = \{.*), tilting_stiffness = 2.0e5 \}$",
        r"\1, stations = [{ position_mm = -5.0, share = 0.5 }, { position_mm = 5.0, share = 0.4 }] }")],
@@ -164,7 +163,11 @@ def test_a_stage_that_does_not_tilt_notes_and_sets_aside_its_tilting_keys():
      r"stages\[0\].carrier.torsional: a tilting stage's members move in three dimensions"),
     ([(r"^\[stages.sun\]", "[stages.sun]\naxial_offset_mm = 45.0")],
      r"stages\[0\].sun.axial_offset_mm: the faces of sun and the planet's planet do not overlap"),
-], ids=["unheld", "shares", "one station", "torsional", "faces apart"])
+    ([(r"^(\[stages.carrier\])", "\\1\ntilting_inertia = 1.0e-3")],
+     r"stages\[0\].carrier.tilting_inertia: 0.001 kg·m² is below half the polar inertia \(0.009625 kg·m²\)"),
+    ([(r"^(bearing = \{ radial_stiffness = 2.0e8, radial_damping = 500.0), axial_stiffness = 5.0e8", r"\1")],
+     r"stages\[0\].planet.bearing.axial_stiffness: a tilting stage needs it > 0"),
+], ids=["unheld", "shares", "one station", "torsional", "faces apart", "inertia", "axial"])
 def test_bad_tilting_input_names_the_field(pairs, expected):
     with pytest.raises(TrainFileError, match=expected):
         tilting(*pairs)

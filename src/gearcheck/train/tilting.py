@@ -1,8 +1,9 @@
 """Tilting stages: the train file's ``tilting`` flag, checked, and what it adds to the members and meshes.
 
 Every member of a tilting stage gains two tilts, small rotations about its two translation axes
-(:data:`~gearcheck.train.spec.TILTS`), beside its translations, rotation and axial motion: the 3-D model of
-Eritenel & Parker (2009), whose members' centres of mass lie in the stage's plane.  What holds a tilt is the
+(:data:`~gearcheck.train.spec.TILTS`), beside its translations, rotation and axial motion (which it has even with
+spur gears: a tilting carrier carries its planets' pins along the axis): the 3-D model of Eritenel & Parker (2009),
+whose members' centres of mass lie in the stage's plane.  What holds a tilt is the
 member's support (a central member on the housing) or bearing (a planet on its carrier's pin): a tilting stiffness,
 and the bearing stations along the axis over which the radial stiffness is shared, which a radial spring at an
 axial distance p from the centre of mass turns into a moment p F and a tilting stiffness p^2 k.  A planet's pin may
@@ -48,8 +49,13 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
         if member.torsional:
             raise fail(f"{raw_path}.torsional", "a tilting stage's members move in three dimensions; a torsional "
                                                 "member only turns: remove one of the two flags")
-        _check_held(member.support if member.support is not None else member.bearing, support_path, fail)
-        out[mid] = replace(member, tilting=True, tilting_inertia=_tilting_inertia(member, raw))
+        support = member.support if member.support is not None else member.bearing
+        if not support.axial_stiffness:
+            raise fail(f"{support_path}.axial_stiffness", "a tilting stage needs it > 0: its members move along the "
+                                                         "axis (a tilting carrier carries its planets' pins with it)")
+        _check_held(support, support_path, fail)
+        out[mid] = replace(member, axial=True, tilting=True,
+                           tilting_inertia=_tilting_inertia(member, raw, f"{raw_path}.tilting_inertia", fail))
         if member.is_planet and pins:
             pin = pins[int(mid.rsplit(".planet", 1)[1]) - 1]
             out[mid] = replace(out[mid], bearing=replace(member.bearing, rest_tilt=tuple(pin)))
@@ -101,11 +107,16 @@ def _check_held(support, path: str, fail) -> None:
                                                 "nothing else holds the member's tilt")
 
 
-def _tilting_inertia(member, raw: dict) -> float:
+def _tilting_inertia(member, raw: dict, path: str, fail) -> float:
     """As given, or I/2 + m w^2/12 about a diameter of a uniform annulus of polar inertia I, mass m and width w
-    (its thickness, a gear's face width; 0 for a carrier given neither: a thin disc)."""
-    if raw.get("tilting_inertia") is not None:
-        return raw["tilting_inertia"]
+    (its thickness, a gear's face width; 0 for a carrier given neither: a thin disc).  A given one below I/2 is
+    refused: a rigid body's inertias about two perpendicular diameters add up to at least its polar one."""
+    given = raw.get("tilting_inertia")
+    if given is not None:
+        if given < 0.5 * member.inertia:
+            raise fail(path, f"{given:.6g} kg·m² is below half the polar inertia ({0.5 * member.inertia:.6g} kg·m²), "
+                             "which no rigid body has")
+        return given
     width = raw.get("thickness")
     if width is None:
         width = max((g.face_width for g in member.gears.values()), default=0.0)

@@ -57,12 +57,12 @@ def _example(*pairs):
 
 
 def _tilting_demo(sun_support: str):
-    """demo-3p (spur, faces centred: no mesh row sees a tilt) tilting, every member held by a tilting stiffness but
-    the sun, held by ``sun_support``'s extra keys."""
+    """demo-3p (spur, faces centred: no mesh row sees a tilt) tilting, every member held axially and by a tilting
+    stiffness but the sun, held by ``sun_support``'s extra keys."""
     held = (r"^(support|bearing) = \{ (radial_stiffness = 1.0e9|radial_stiffness = 2.0e8)(.*) \}$",
-            r"\1 = { \2\3, tilting_stiffness = 2.0e6 }")
+            r"\1 = { \2\3, axial_stiffness = 5.0e8, tilting_stiffness = 2.0e6 }")
     sun = (r"^support = \{ radial_stiffness = 1.0e8, radial_damping = 500.0 \}$",
-           f"support = {{ radial_stiffness = 1.0e8, radial_damping = 500.0, {sun_support} }}\n"
+           f"support = {{ radial_stiffness = 1.0e8, radial_damping = 500.0, axial_stiffness = 5.0e8, {sun_support} }}\n"
            "tilting_inertia = 4.0e-4")
     return _edited(preset_text("demo-3p"), [(r"^planets = 3", "planets = 3\ntilting = true"), held, sun], "demo")
 

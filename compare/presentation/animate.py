@@ -75,14 +75,19 @@ def renderer(model: mujoco.MjModel, width: int, height: int) -> mujoco.Renderer:
                              ) from None
 
 
-def top_camera(model: mujoco.MjModel) -> mujoco.MjvCamera:
-    """A free camera looking down the gear axis (z) at the whole train."""
+OBLIQUE_ELEVATION = -35.0  # deg: a tilting train seen from the side, where its members' tilts show
+
+
+def top_camera(model: mujoco.MjModel, spec: TrainSpec | None = None) -> mujoco.MjvCamera:
+    """A free camera looking down the gear axis (z) at the whole train; obliquely, from OBLIQUE_ELEVATION, at a
+    train whose members tilt (the tilts move the gears' rims along the axis, which the axis's view cannot show)."""
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     cam.lookat[:] = model.stat.center
     cam.lookat[2] = 0.0
     cam.distance = 1.6 * model.stat.extent
-    cam.azimuth, cam.elevation = 90.0, -90.0
+    tilting = spec is not None and any(stage.tilting for stage in spec.stages)
+    cam.azimuth, cam.elevation = 90.0, OBLIQUE_ELEVATION if tilting else -90.0
     return cam
 
 
@@ -277,7 +282,7 @@ def animate(train, path, duration: float = 4.0, fps: float = 15.0, magnify: floa
                 progress(0.8 * (i + 1) / n)
     force = player.mesh_forces()[:, mesh]
     label = mb.spec.meshes[mesh].id
-    shown, cam = mujoco.MjData(mb.model), top_camera(mb.model)
+    shown, cam = mujoco.MjData(mb.model), top_camera(mb.model, mb.spec)
     hinge0 = player.static.qpos
     frames = []
     for i, q in enumerate(player.qpos):
@@ -357,7 +362,7 @@ def animate_mode(train, path, mode: int, solver: str = "mujoco", modal: ModalRes
     shape, freq, kind = mode_shape(mb, mode, solver, modal)
     amplitude = _shape_scale(mb, shape)
     rend = renderer(mb.model, width, height)
-    shown, cam = mujoco.MjData(mb.model), top_camera(mb.model)
+    shown, cam = mujoco.MjData(mb.model), top_camera(mb.model, mb.spec)
     per_period = period * fps
     frames = []
     for i in range(n):

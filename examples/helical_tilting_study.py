@@ -67,22 +67,25 @@ def main(out: Path) -> None:
                 lines.append(f"| {model} | {name} | {solver} | " + " / ".join(f"{x:.3f}" for x in s["dte"]) + " | "
                              + " / ".join(f"{x:.4f}" for x in s["kv"]) + f" | {khb} |")
     (out / "tilting.md").write_text("\n".join(lines) + "\n")
-    fig = Figure(figsize=(10, 6.5))
-    axes = fig.subplots(2, 1, sharex=True)
-    for ax, name in zip(axes, MESHES):
-        for model, style in (("planar+axial", "-"), ("3-D", "--")):
-            run = runs[model]["lumped"]
-            window = run.t >= DURATION - 0.005
-            ax.plot(1e3 * run.t[window], 1e6 * run[f"{MESHES[name]}.dte"][window], style, label=f"{model} (lumped)")
-            twin = runs[model]["mujoco"]
-            window = twin.t >= DURATION - 0.005
-            ax.plot(1e3 * twin.t[window], 1e6 * twin[f"{MESHES[name]}.dte"][window], ":", lw=2.5, alpha=0.6,
-                    label=f"{model} (MuJoCo)")
-        ax.set_ylabel(f"{name} mesh DTE (µm)")
+    fig = Figure(figsize=(10, 8))
+    axes = fig.subplots(3, 1, sharex=True)
+    mesh = MESHES["sun"]
+    for ax, what, label in zip(axes, ("dte", "kv", "khb"), ("DTE (µm)", "Kv = F / F_static", "face load factor K_Hβ")):
+        for model, colour in (("planar+axial", "tab:blue"), ("3-D", "tab:red")):
+            if what == "khb" and model != "3-D":
+                continue
+            for solver, style in (("lumped", "-"), ("mujoco", ":")):
+                run = runs[model][solver]
+                window = run.t >= STEADY_FROM
+                ax.plot(1e3 * run.t[window], run[f"{mesh}.{what}"][window] * SCALE[what], style, color=colour,
+                        lw=1.2 if solver == "lumped" else 2.5, alpha=1.0 if solver == "lumped" else 0.6,
+                        label=f"{model} ({'MuJoCo' if solver == 'mujoco' else solver})")
+        ax.set_ylabel(f"sun mesh {label}")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, ncol=2)
     axes[-1].set_xlabel("time (ms)")
-    fig.suptitle("Mo et al. (2024) helical stage, 5 µm eccentricity: planet 1's meshes, planar+axial vs 3-D")
+    fig.suptitle("Mo et al. (2024) helical stage, 5 µm eccentricity on sun and planets: planet 1's sun mesh,\n"
+                 "planar+axial against 3-D (tilting), both solvers")
     fig.savefig(out / "tilting.png", dpi=110, metadata={"Software": None})
 
 

@@ -8,6 +8,7 @@ and their time runs pass the cross-check, tilts and the meshes' tilting moments 
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
@@ -18,6 +19,7 @@ import gearcheck
 from gearcheck.lumped.side import LumpedSide
 from gearcheck.mbd_models.side import MujocoSide
 from gearcheck.shared.errors import TrainNote
+from gearcheck.shared.results import train_signals
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "helical-tilting.toml"
 TILT = (r"^planets = (\d)", r"planets = \1\ntilting = true")
@@ -93,3 +95,25 @@ def test_the_cross_check_passes_on_tilts_and_moments(name):
         assert "stage1.carrier.az" in held and any("second order" in note for note in result.notes)
     else:
         assert not held
+
+
+def test_an_idealised_train_states_its_meshes_tilt():
+    """A published model without teeth or faces (Lin & Parker 1999's example, made tilting) gives each mesh's
+    tilting stiffness and centre of stiffness; both solvers take them, at rest and turning; no face, no face load
+    factor; without them the file is refused in one line."""
+    text = (EXAMPLE.parent / "lin-parker-1999.toml").read_text(encoding="utf-8")
+    text = re.sub(r"^(pressure_angle_deg = 24.6)$", r"\1\ntilting = true", text, flags=re.M)
+    text = re.sub(r"^(support|bearing) = \{ (.*) \}$",
+                  r"\1 = { \2, axial_stiffness = 1.0e8, tilting_stiffness = 1.0e6 }", text, flags=re.M)
+    with pytest.raises(gearcheck.TrainFileError, match=r"stages\[0\].sun.mesh.tilting_stiffness: an idealised mesh "
+                                                       r"without face widths needs it"):
+        gearcheck.load_text(text, "lin-parker tilting")
+    stated = 'mean = 5.0e8 }\ntilting_stiffness = 3.0e5\ncentre_offset_mm = 2.0'
+    spec = gearcheck.load_text(text.replace("mean = 5.0e8 }", stated), "lin-parker tilting")
+    assert all(m.axial_centre == pytest.approx(2e-3) and m.contact_width == 0.0 for m in spec.meshes)
+    for speed in (0.0, 300.0):
+        lumped, twin = LumpedSide(spec).modes_at_speed(speed), MujocoSide(spec).modes_at_speed(speed)
+        assert lumped.frequencies[0] == twin.frequencies[0] == 0.0  # the sun turns freely: no input shaft
+        assert np.allclose(twin.frequencies[1:], lumped.frequencies[1:], rtol=1e-9, atol=0.0)
+    names = [s.name for s in train_signals(spec)]
+    assert "stage1.planet1.sun.moment" in names and not any(n.endswith(".khb") for n in names)

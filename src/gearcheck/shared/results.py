@@ -257,10 +257,11 @@ def train_signals(spec) -> list[Signal]:
                     Signal(f"{mesh.id}.kv", "dynamic_factor", "1", f"{mesh.id} dynamic load factor F/F_static", False),
                     Signal(f"{mesh.id}.stiffness", "mesh_stiffness", "N/m", f"{mesh.id} mesh stiffness", False)]
     for mesh in tilting_meshes(spec):
-        signals += [Signal(f"{mesh.id}.moment", "mesh_moment", "N·m", f"{mesh.id} mesh tilting moment across the "
-                           "face"),
-                    Signal(f"{mesh.id}.khb", "face_load_factor", "1", f"{mesh.id} face load factor: largest load per "
-                           "unit face width over the mean, 1 + 6|M|/(F w)", False)]
+        signals.append(Signal(f"{mesh.id}.moment", "mesh_moment", "N·m", f"{mesh.id} mesh tilting moment across "
+                              "the face"))
+        if mesh.contact_width:  # (an idealised mesh's face has no width)
+            signals.append(Signal(f"{mesh.id}.khb", "face_load_factor", "1", f"{mesh.id} face load factor: "
+                                  "largest load per unit face width over the mean, 1 + 6|M|/(F w)", False))
     signals += [Signal(f"{name}.force", "bearing_force", "N", f"{name} force") for name in bearing_names(spec)]
     for disc in disc_names(spec):
         signals += [Signal(f"{disc}.pin_force_max", "pin_force", "N", f"{disc}: largest pin contact force"),
@@ -373,8 +374,9 @@ def train_result(spec, solver: str, t, motion, mesh_deflection, mesh_force, mesh
     forces = {mesh.id: mesh_force[:, i] for i, mesh in enumerate(spec.meshes)}
     for i, mesh in enumerate(tilting_meshes(spec)):
         moment = mesh_moment[:, i]
-        put({f"{mesh.id}.moment": moment,
-             f"{mesh.id}.khb": 1.0 + 6.0 * np.abs(moment) / (np.abs(forces[mesh.id]) * mesh.contact_width)})
+        put({f"{mesh.id}.moment": moment})
+        if mesh.contact_width:
+            put({f"{mesh.id}.khb": 1.0 + 6.0 * np.abs(moment) / (np.abs(forces[mesh.id]) * mesh.contact_width)})
     put({f"{name}.force": bearing_force[:, i] for i, name in enumerate(bearing_names(spec))})
     for i, disc in enumerate(disc_names(spec)):
         put({f"{disc}.pin_force_max": pin_force[:, i].max(axis=-1), f"{disc}.pins_loaded": (pin_force[:, i] > 0).sum(

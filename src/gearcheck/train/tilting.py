@@ -125,16 +125,22 @@ def _tilting_inertia(member, raw: dict, path: str, fail) -> float:
 
 def _placed(mesh, path: str, fail):
     """``mesh`` with its centre of stiffness and contact width: the overlap of the two gears' faces, each
-    face_width long about its axial offset."""
-    faces = [(g.axial_offset - 0.5 * g.face_width, g.axial_offset + 0.5 * g.face_width)
-             for g in (mesh.central_gear, mesh.planet_gear)]
-    low, high = max(f[0] for f in faces), min(f[1] for f in faces)
+    face_width long about its axial offset (an idealised mesh without faces: width 0, its tilting stiffness and
+    centre as stated)."""
+    gears = (mesh.central_gear, mesh.planet_gear)
     key = mesh.id.split(".")[-1]
+    stiffness, centre = mesh.stated_tilt
+    if not all(g.face_width for g in gears):  # an idealised gear without a face: the file states the mesh's tilt
+        if stiffness is None:
+            raise fail(f"{path}.{key}.mesh.tilting_stiffness", "an idealised mesh without face widths needs it "
+                                                                "(no face to derive it from)")
+        return replace(mesh, axial_centre=centre or 0.0, contact_width=0.0)
+    faces = [(g.axial_offset - 0.5 * g.face_width, g.axial_offset + 0.5 * g.face_width) for g in gears]
+    low, high = max(f[0] for f in faces), min(f[1] for f in faces)
     if not high > low or not math.isfinite(high - low):
         raise fail(f"{path}.{key}.axial_offset_mm", f"the faces of {mesh.central_gear.name} and the planet's "
                                                     f"{mesh.planet_gear.name} do not overlap "
                                                     "(a tilting mesh needs face widths that meet)")
-    centre = mesh.stated_tilt[1]
     if centre is not None and not low <= centre <= high:
         raise fail(f"{path}.{key}.mesh.centre_offset_mm", f"{centre * 1e3:.6g} mm is off the faces' overlap, "
                                                           f"{low * 1e3:.6g} to {high * 1e3:.6g} mm")

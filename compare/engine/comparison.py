@@ -579,6 +579,9 @@ def _quantities(a, names, series, window, fs, plan, tolerances, errors, own) -> 
         for other, factor in plan.scale_from(n):
             scale[other] = max(scale.get(other, 0.0), rms * factor)
     comparisons = []
+    lines = {n: [(label, f) for label, f in plan.lines(n, np.count_nonzero(window) / fs) if f < 0.45 * fs]
+             for n in names}
+    projected = _own_lines(names, lines, plan, own)
     for n in names:
         s = a.signal(n)
         xa, xb = series[n][0][window], series[n][1][window]
@@ -586,33 +589,42 @@ def _quantities(a, names, series, window, fs, plan, tolerances, errors, own) -> 
         if n in own and all(_uniform(run.t) for run in own[n][:2]):
             metrics |= statistics(*(run[n][run.t >= own[n][2]] for run in own[n][:2]))
         metrics["integration_error"] = {"reference": errors[n][0], "test": errors[n][1]}
-        lines = [(label, f) for label, f in plan.lines(n, xa.size / fs) if f < 0.45 * fs]
         tol = tolerances.lookup(n, s.kind, "nrmse")
         floor = plan.floors.get(s.kind, 0.0) / (tol or 1.0)  # round-off a tolerance's share of the signal
         kind_scale = max(NEGLIGIBLE * scale[s.kind], floor) / NEGLIGIBLE
         status = verdict(metrics, tol, kind_scale)
-        spectrum = spectral_metrics(*_lines(n, xa, xb, fs, lines, plan, own.get(n)), lines)
+        freqs = [f for _, f in lines[n]]
+        amp_a, amp_b = projected.get(n) or (spectral_amplitude(xa, fs, freqs), spectral_amplitude(xb, fs, freqs))
+        spectrum = spectral_metrics(amp_a, amp_b, lines[n])
         comparisons.append(QuantityComparison(n, s.kind, s.unit, s.description, status, metrics, spectrum, tol,
                                               second_order=second_order(metrics, kind_scale)))
     return comparisons
 
 
-def _lines(name, xa, xb, fs, lines, plan, own) -> tuple[np.ndarray, np.ndarray]:
-    """Both sides' amplitudes of ``name`` at the lines' frequencies.  From each run's own uniform samples over its
-    steady window (``own``: the two runs and the window's start), the jumps of a switching mesh stiffness projected
-    exactly (:func:`~gearcheck.compare.engine.line_projection.harmonics`, as the sweep reads its lines): a jump
-    sampled at a step aliases onto every line, which the anti-aliased common grid would smear instead.  Else (a
-    signal a sensor chain filters, a recording, no switches) from the common grid's series ``xa``, ``xb``."""
-    freqs = [f for _, f in lines]
-    runs = [] if own is None or plan.switch_times is None else [run for run in own[:2] if _uniform(run.t)]
-    if len(runs) < 2:
-        return spectral_amplitude(xa, fs, freqs), spectral_amplitude(xb, fs, freqs)
-    out = []
-    for run in runs:
-        window = run.t >= own[2]
-        t, x = run.t[window], run[name][window]
-        out.append(np.abs(harmonics(t, x, freqs, _rate(t), plan.switch_times(t[0], t[-1]))[:, 0]))
-    return tuple(out)
+def _own_lines(names, lines: dict, plan, own: dict) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """name -> both sides' amplitudes at its lines' frequencies (``lines``: name -> (label, Hz)), from each run's
+    own uniform samples over its steady window (``own``: name -> the two runs and the window's start), the jumps of
+    a switching mesh stiffness projected exactly (:func:`~gearcheck.compare.engine.line_projection.harmonics`, as
+    the sweep reads its lines): a jump sampled at a step aliases onto every line, which the anti-aliased common
+    grid would smear instead.  The quantities that share their runs and lines are projected together.  A name not
+    in it (a signal a sensor chain filters, a recording, no switches) takes the common grid's series."""
+    if plan.switch_times is None:
+        return {}
+    groups: dict[tuple, list[str]] = {}
+    for n in names:
+        if n in own and all(_uniform(run.t) for run in own[n][:2]):
+            key = (id(own[n][0]), id(own[n][1]), own[n][2], tuple(f for _, f in lines[n]))
+            groups.setdefault(key, []).append(n)
+    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for (_, _, start, freqs), group in groups.items():
+        amplitudes = []
+        for run in own[group[0]][:2]:
+            window = run.t >= start
+            t = run.t[window]
+            x = np.column_stack([run[n][window] for n in group])
+            amplitudes.append(np.abs(harmonics(t, x, freqs, _rate(t), plan.switch_times(t[0], t[-1]))))
+        out.update({n: (amplitudes[0][:, j], amplitudes[1][:, j]) for j, n in enumerate(group)})
+    return out
 
 
 def _uniform(t: np.ndarray) -> bool:

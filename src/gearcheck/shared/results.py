@@ -394,7 +394,8 @@ def member_columns(mid: str, m: MemberMotion) -> dict[str, dict[str, np.ndarray]
     ``"rotation"`` (alpha, theta, omega, omega.relative), ``"axial"`` (az, z, vz) and ``"tilt"`` (tilt_x, tilt_y
     along the world's and the carrier's axes) when ``m`` has them."""
     c, s = np.cos(m.angle), np.sin(m.angle)
-    translation, tilt = {}, {}
+    translation: dict[str, np.ndarray] = {}
+    tilt: dict[str, np.ndarray] = {}
     vectors = [("a{}", m.acceleration, translation), ("{}", m.displacement, translation),
                ("v{}", m.velocity, translation)] + ([("tilt_{}", m.tilt, tilt)] if m.tilt is not None else [])
     for name, vector, out in vectors:

@@ -25,7 +25,8 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "helical-tilting.to
 TILT = (r"^planets = (\d)", r"planets = \1\ntilting = true")
 HELD = (r"^(support|bearing) = \{ (.*) \}$",
         r"\1 = { \2, axial_stiffness = 5.0e8, axial_damping = 500.0, tilting_stiffness = 2.0e5 }")
-# the sun overhung on two stations, the carrier on two unequal ones, offset faces, two misaligned pins
+# the sun overhung on two stations, the carrier on two unequal ones, offset faces, two misaligned pins, and the
+# ring's seat tilted in the housing (its offsets turn in the carrier's frame)
 LAYOUT = [(r"^(support = \{ radial_stiffness = 1.0e8, radial_damping = 500.0, .*) \}$",
            r"\1, stations = [{ position_mm = -40.0, share = 0.5 }, { position_mm = -90.0, share = 0.5 }] }"),
           (r"^(support = \{ radial_stiffness = 1.0e9, radial_damping = 2000.0, axial.*) \}$",
@@ -33,7 +34,9 @@ LAYOUT = [(r"^(support = \{ radial_stiffness = 1.0e8, radial_damping = 500.0, .*
           (r"^(\[stages.sun\])", "\\1\naxial_offset_mm = 4.0"),
           (r"^(bearing = \{ radial_stiffness = 2.0e8, .*) \}$",
            r"\1, stations = [{ position_mm = -10.0, share = 0.5 }, { position_mm = 14.0, share = 0.5 }] }"),
-          (r"^(\[stages.planet\])", "\\1\npin_tilts_urad = [[30.0, -20.0], [0.0, 15.0], [0.0, 0.0]]")]
+          (r"^(\[stages.planet\])", "\\1\npin_tilts_urad = [[30.0, -20.0], [0.0, 15.0], [0.0, 0.0]]"),
+          (r"^(support = \{ radial_stiffness = 1.0e9, radial_damping = 2000.0, torsional.*) \}$",
+           r"\1, tilt_urad = [40.0, -25.0] }")]
 
 
 def spur(*pairs):
@@ -61,7 +64,7 @@ def test_both_solvers_agree_on_every_mode(name, times):
 def test_misaligned_pins_load_both_solvers_alike():
     """The static state of the spur train with misaligned pins: each mesh's force and tilting moment, each
     station's force, in both solvers (the lumped rows' rest deflections, the twin's spring lengths and references)."""
-    spec = spur(*LAYOUT)
+    spec = spur(*LAYOUT[:-1])  # (a seat misaligned in the housing turns in the carrier's frame: no static state)
     lumped, twin = (gearcheck.simulate(spec, solver=s, duration=2e-3) for s in ("lumped", "mujoco"))
     names = [f"{m.id}.{what}" for m in spec.meshes for what in ("force", "moment")]
     names += [n for n in lumped.names() if "station" in n and n.endswith(".force")]
@@ -91,7 +94,12 @@ def test_the_cross_check_passes_on_tilts_and_moments(name):
     assert len(tilts) == 4 * 3
     held = [q.name for q in result.quantities if q.second_order is not None]
     if name.startswith("spur"):
-        assert set(tilts.status) == {"pass"} and np.all(tilts.value < 0.1 * tilts.tolerance)
+        # the ring, held tilted by its misaligned seat, carries its planets' mesh forces at that tilt: the twin's
+        # exact geometry turns them a little (preload times tilt), which the linear model leaves out: its tilts part
+        # by 2.4e-3 to 7.6e-3 (NRMSE), 2.4e-4 to 7.9e-4 at a tenth of the load; the others' by 2e-4
+        assert set(tilts.status) == {"pass"}
+        others = tilts[~tilts.quantity.str.startswith("stage1.ring")]
+        assert len(others) == 8 and np.all(others.value < 0.1 * others.tolerance)
         assert "stage1.carrier.az" in held and any("second order" in note for note in result.notes)
     else:
         assert not held

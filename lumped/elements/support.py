@@ -5,16 +5,20 @@ A tilting member's radial stiffness may be shared over bearing stations along th
 from the centre of mass deflects by the member's translation plus phi x (p e_z) = p (phi_2, -phi_1), phi_1 and
 phi_2 its tilts about its two translation axes.  Its damping acts on the velocity relative to the housing, which
 the rotating coordinates see as q' + Omega k x q: beside -c q' the circulatory term -c Omega k x q of every pair of
-perpendicular rows (whirl damping; Lin & Parker 1999's frame)."""
+perpendicular rows (whirl damping; Lin & Parker 1999's frame).  A seat tilted in the housing (``tilt_urad``) holds
+the member where its rows' deflections rest, fixed in the housing and so turning in the carrier's frame
+(:class:`MisalignedSupport`)."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from gearcheck.lumped.elements import ELEMENTS
-from gearcheck.lumped.elements.base import Build, Contribution, Row
+from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning, compiled_group
 from gearcheck.train.spec import AXIAL, ROTATION, TILTS
 
 
@@ -23,18 +27,21 @@ def support_rows(part, build: Build) -> Contribution:
     mid, s, dofs = part.member, part.support, build.dofs
     member = build.spec.members[mid]
     u, v = member.dofs[:2]
+    gamma_1, gamma_2 = s.rest_tilt  # a misaligned seat's tilt about the housing's axes
+    # pairs of perpendicular rows: names, rows, stiffness, damping, and the pair's rest deflection in the housing
     pairs = [(f"{mid}.support_{u}", dofs.unit((mid, u, 1.0)), f"{mid}.support_{v}", dofs.unit((mid, v, 1.0)),
-              s.radial_stiffness, s.radial_damping)]
+              s.radial_stiffness, s.radial_damping, (0.0, 0.0))]
     if member.tilting:
         tilt_u, tilt_v = TILTS[member.frame]
         pairs = [(f"{mid}.support_{u}.station{i + 1}", dofs.unit((mid, u, 1.0), (mid, tilt_v, st.position)),
                   f"{mid}.support_{v}.station{i + 1}", dofs.unit((mid, v, 1.0), (mid, tilt_u, -st.position)),
-                  st.radial_stiffness, st.radial_damping) for i, st in enumerate(s.stations)] or pairs
+                  st.radial_stiffness, st.radial_damping, (st.position * gamma_2, -st.position * gamma_1))
+                 for i, st in enumerate(s.stations)] or pairs
         if s.tilting_stiffness or s.tilting_damping:
             pairs.append((f"{mid}.support_{tilt_u}", dofs.unit((mid, tilt_u, 1.0)), f"{mid}.support_{tilt_v}",
-                          dofs.unit((mid, tilt_v, 1.0)), s.tilting_stiffness, s.tilting_damping))
-    rows = [Row(name, "support", a, k, c) for name_u, a_u, name_v, a_v, k, c in pairs
-            for name, a in ((name_u, a_u), (name_v, a_v))]
+                          dofs.unit((mid, tilt_v, 1.0)), s.tilting_stiffness, s.tilting_damping, (gamma_1, gamma_2)))
+    rows = [Row(name, "support", a, k, c, rest) for name_u, a_u, name_v, a_v, k, c, rests in pairs
+            for name, a, rest in ((name_u, a_u, rests[0]), (name_v, a_v, rests[1]))]
     if s.torsional_stiffness or s.torsional_damping:
         rows.append(Row(f"{mid}.support_{ROTATION}", "support", dofs.unit((mid, ROTATION, 1.0)),
                         s.torsional_stiffness, s.torsional_damping))
@@ -42,5 +49,74 @@ def support_rows(part, build: Build) -> Contribution:
         rows.append(Row(f"{mid}.support_{AXIAL}", "support", dofs.unit((mid, AXIAL, 1.0)), s.axial_stiffness,
                         s.axial_damping))
     omega = build.kin.speeds[f"{member.stage}.carrier"]
-    circulatory = sum(c * omega * (np.outer(a_v, a_u) - np.outer(a_u, a_v)) for _, a_u, _, a_v, _, c in pairs)
-    return Contribution(rows, place=lambda model: replace(model, K_circulatory=model.K_circulatory + circulatory))
+    circulatory = sum(c * omega * (np.outer(a_v, a_u) - np.outer(a_u, a_v)) for _, a_u, _, a_v, _, c, _ in pairs)
+    turning = []
+    if any(s.rest_tilt) and omega:  # the seat's offsets turn at -Omega in the carrier's frame
+        turning.append(MisalignedSupport(
+            sum(k * (a_u * r[0] + a_v * r[1]) for _, a_u, _, a_v, k, _, r in pairs),
+            sum(k * (a_u * r[1] - a_v * r[0]) for _, a_u, _, a_v, k, _, r in pairs), omega))
+    return Contribution(rows, turning=turning,
+                        place=lambda model: replace(model, K_circulatory=model.K_circulatory + circulatory))
+
+
+class MisalignedSupports(NamedTuple):
+    """Misaligned supports on the housing, one row each: ``cos`` and ``sin`` (S, n) their loads' parts, ``omega``
+    (S,) their carriers' speeds (:class:`MisalignedSupport`)."""
+
+    cos: np.ndarray
+    sin: np.ndarray
+    omega: np.ndarray
+
+    @classmethod
+    def of(cls, supports) -> "MisalignedSupports":
+        if not supports:
+            return cls(np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0))
+        return cls(np.array([e.cos for e in supports], dtype=float), np.array([e.sin for e in supports], dtype=float),
+                   np.array([e.omega for e in supports], dtype=float))
+
+
+@dataclass(frozen=True, eq=False)
+class MisalignedSupport(Turning):
+    """A support whose seat is tilted in the housing: its rows' rest deflections are fixed in the housing and turn
+    at -Omega in the carrier's frame, R(-Omega t) r, so the load they exert, sum k (a . R(-Omega t) r) a, is
+    cos(Omega t) ``cos`` + sin(Omega t) ``sin``.  The rows hold the rest of t = 0 (the model's static load holds
+    that load, as the modal and static analyses take the rows of t = 0); the time solvers take the load at every
+    stage, the harmonic methods as an orbit load on the carrier's clock."""
+
+    cos: np.ndarray
+    sin: np.ndarray
+    omega: float
+    rows = ()  # its rows stay the model's: only their rest turns
+    compiled = MisalignedSupports
+    words = "a support misaligned in the housing, its offsets turning in the carrier's frame"
+
+    @property
+    def clock_speed(self) -> float:
+        return self.omega
+
+    @property
+    def static_load(self) -> np.ndarray:
+        return self.cos
+
+    def orbit_force(self, t) -> np.ndarray:
+        phase = self.omega * np.asarray(t, dtype=float)[..., None]
+        return np.cos(phase) * self.cos + np.sin(phase) * self.sin
+
+    def forces(self, t, q, v) -> np.ndarray:
+        """Its load less the static load the model holds (the compiled steps' form adds the whole load to the static
+        load less :attr:`static_load`)."""
+        return (self.orbit_force(t) - self.static_load) * np.ones_like(q)
+
+
+@njit(inline="always")
+def misaligned_forces(supports, at) -> None:
+    """The compiled steps' form of :meth:`MisalignedSupport.forces`, added into ``out`` of ``at`` = (x, u, t, out)."""
+    t, out = at[2], at[3]
+    cos, sin, omega = supports
+    for i in range(omega.size):
+        c, s = np.cos(omega[i] * t), np.sin(omega[i] * t)
+        for j in range(out.size):
+            out[j] += c * cos[i, j] + s * sin[i, j]
+
+
+compiled_group(MisalignedSupports, misaligned_forces)

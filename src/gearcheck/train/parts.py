@@ -11,6 +11,7 @@ are written here from the members that carry them, the splines from the cycloid-
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -53,6 +54,11 @@ class SupportPart(Part):
     member: str
     support: object  # gearcheck.train.spec.Support
     axial: bool
+
+    def turning_frequencies(self, spec, speeds: dict) -> list[float]:
+        """A seat misaligned in the housing (``Support.rest_tilt``) turns in its member's carrier frame at -Omega."""
+        omega = speeds[f"{spec.members[self.member].stage}.carrier"]
+        return [abs(omega) / (2 * math.pi)] if any(self.support.rest_tilt) and omega else []
 
 
 @dataclass(frozen=True)

@@ -415,6 +415,9 @@ SUPPORT = Table(
                                        bound("stiffness")),
         "axial_damping": NonNegative("axial damping to the housing", "N·s/m", 0.0, bound("damping")),
         **_tilting("to the housing"),
+        "tilt_urad": ListOf(Number("tilt", "µrad", REQUIRED, -MAX_TILT_URAD, False, MAX_TILT_URAD),
+                            "misalignment of its seat in the housing, [about x, about y] (a tilting stage): the "
+                            "support holds the member there", (), min_length=2, max_length=2, unit="µrad"),
     },
     "support of a central member (sun, ring, carrier) on the housing",
 )

@@ -59,8 +59,8 @@ class Station:
 class Support:
     """A member's support on the housing (central members) or bearing on its carrier's pin (planets).  A tilting
     member's tilt is held by ``tilting_stiffness`` and by its ``stations`` along the axis, over which the radial
-    stiffness and damping are shared (none: all at the centre of mass); a planet's misaligned pin holds it at the
-    ``rest_tilt`` the pin has in the carrier."""
+    stiffness and damping are shared (none: all at the centre of mass); a misaligned seat (a planet's pin in the
+    carrier, a central member's seat in the housing) holds it at its ``rest_tilt``."""
 
     radial_stiffness: float
     radial_damping: float = 0.0
@@ -71,7 +71,8 @@ class Support:
     tilting_stiffness: float = 0.0
     tilting_damping: float = 0.0
     stations: tuple[Station, ...] = ()
-    rest_tilt: tuple[float, float] = (0.0, 0.0)  # a misaligned pin's tilt about the planet's radial, tangential axes
+    rest_tilt: tuple[float, float] = (0.0, 0.0)  # a misaligned seat's tilt: a planet's pin about its radial and
+    # tangential axes, a central member's seat about the housing's x and y
 
 
 @dataclass(frozen=True)
@@ -795,7 +796,7 @@ def _support(raw: dict) -> Support:
     stations = tuple(Station(s["position"], s["share"] * k, s["share"] * c) for s in raw["stations"])
     return Support(k, c, raw.get("torsional_stiffness", 0.0), raw.get("torsional_damping", 0.0),
                    raw["axial_stiffness"], raw["axial_damping"], raw["tilting_stiffness"], raw["tilting_damping"],
-                   stations)
+                   stations, tuple(raw.get("tilt") or (0.0, 0.0)))
 
 
 def _merge_mesh(stage_mesh: dict | None, gear_mesh: dict | None) -> dict:

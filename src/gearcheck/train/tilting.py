@@ -7,8 +7,9 @@ whose members' centres of mass lie in the stage's plane.  What holds a tilt is t
 member's support (a central member on the housing) or bearing (a planet on its carrier's pin): a tilting stiffness,
 and the bearing stations along the axis over which the radial stiffness is shared, which a radial spring at an
 axial distance p from the centre of mass turns into a moment p F and a tilting stiffness p^2 k.  A planet's pin may
-be misaligned in the carrier (``pin_tilts_urad``): its bearing then holds the planet at the pin's tilt, and the
-meshes meet a tilted gear, whose load moves along the face.  A mesh acts at its
+be misaligned in the carrier (``pin_tilts_urad``), a central member's seat in the housing (its support's
+``tilt_urad``): the bearing or support then holds the member at that tilt, and the meshes meet a tilted gear, whose
+load moves along the face.  A mesh acts at its
 centre of stiffness, the middle of the two faces' overlap (a gear's face may be offset axially from its member's
 centre of mass), and resists the members' relative tilt across the face by its slices; a published model may state
 its tilting stiffness and its centre of stiffness instead.
@@ -81,10 +82,10 @@ def _set_aside(members: dict, meshes: list, holders: dict, path: str, name: str,
             ignored.append(f"{raw_path}.tilting_inertia")
         for attr in ("support", "bearing"):
             support = getattr(member, attr)
-            if support is not None and any(getattr(support, key) for key in TILTING):
-                ignored.append(f"{support_path}'s tilting stiffness and stations")
+            if support is not None and (any(getattr(support, key) for key in TILTING) or any(support.rest_tilt)):
+                ignored.append(f"{support_path}'s tilting stiffness, stations and tilt")
                 out[mid] = replace(out[mid], **{attr: replace(support, tilting_stiffness=0.0, tilting_damping=0.0,
-                                                                 stations=())})
+                                                                 stations=(), rest_tilt=(0.0, 0.0))})
     if any(value is not None for mesh in meshes for value in mesh.stated_tilt):
         ignored.append(f"{path}'s mesh tilting_stiffness and centre_offset_mm")
     if ignored:

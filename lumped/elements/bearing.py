@@ -10,6 +10,7 @@ import numpy as np
 
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, Contribution, DofMap, Row
+from gearcheck.lumped.elements.holding import holding_pairs, pair_rows
 from gearcheck.train.spec import AXIAL, ROTATION, TILTS
 
 
@@ -45,29 +46,17 @@ def bearing_rows(part, build: Build) -> Contribution:
     """The pin point at p along the axis moves with the carrier by phi_c x (r_c e_r + p e_z), the member's point
     there by phi x (p e_z) = p (phi_t e_r - phi_r e_t): a station deflects radially by the centres' difference plus
     p times the relative tangential tilt, tangentially minus p times the relative radial one, and the pin moves
-    axially by -r_c times the carrier's tangential tilt (Eritenel & Parker 2009's 3-D bearing).  A misaligned pin
-    (tilted by gamma in the carrier) holds the member at rest where its stations are off by gamma x (p e_z) and its
-    tilt by gamma: the rows' rest deflections."""
+    axially by -r_c times the carrier's tangential tilt (Eritenel & Parker 2009's 3-D bearing); a misaligned pin
+    holds it where the rows rest (:mod:`~gearcheck.lumped.elements.holding`)."""
     spec, dofs = build.spec, build.dofs
     mid, b = part.member, part.bearing
     member = spec.members[mid]
-    radial, tangential = pin_rows(spec, dofs, mid)
-    stations = [("", radial, tangential, b.radial_stiffness, b.radial_damping, 0.0)]
-    pin_r, pin_t = b.rest_tilt  # a misaligned pin's tilt: its point at p is off by p (pin_t e_r - pin_r e_t)
-    if member.tilting:
-        tilt_r, tilt_t = relative_tilts(spec, dofs, mid)
-        stations = [(f".station{i + 1}", radial + st.position * tilt_t, tangential - st.position * tilt_r,
-                     st.radial_stiffness, st.radial_damping, st.position) for i, st in enumerate(b.stations)] \
-            or stations
-    rows = [Row(f"{mid}.bearing_{direction}{label}", "bearing", a, k, c, rest)
-            for label, a_r, a_t, k, c, p in stations
-            for direction, a, rest in (("radial", a_r, p * pin_t), ("tangential", a_t, -p * pin_r))]
+    tilts = relative_tilts(spec, dofs, mid) if member.tilting else (None, None)
+    rows = pair_rows(holding_pairs(f"{mid}.bearing_", ("radial", "tangential"), pin_rows(spec, dofs, mid),
+                                   TILTS.get(member.frame), tilts, b, member.tilting), "bearing")
     if part.axial:
         axial = build.dofs.unit((mid, AXIAL, 1.0), (part.carrier, AXIAL, -1.0))
         if member.tilting:
             axial = axial + member.radius * carrier_tilts(spec, dofs, mid)[1]
         rows.append(Row(f"{mid}.bearing_axial", "bearing", axial, b.axial_stiffness, b.axial_damping))
-    if member.tilting and (b.tilting_stiffness or b.tilting_damping):
-        rows += [Row(f"{mid}.bearing_{t}", "bearing", a, b.tilting_stiffness, b.tilting_damping, rest)
-                 for t, a, rest in zip(TILTS[member.frame], relative_tilts(spec, dofs, mid), b.rest_tilt)]
     return Contribution(rows)

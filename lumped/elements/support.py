@@ -1,9 +1,8 @@
 """A member on the housing: a spring-damper on each translation, on the rotation when it has torsional
 stiffness or damping, along the axis when the member slides axially, and on each tilt when it tilts.
 
-A tilting member's radial stiffness may be shared over bearing stations along the axis: the station at p
-from the centre of mass deflects by the member's translation plus phi x (p e_z) = p (phi_2, -phi_1), phi_1 and
-phi_2 its tilts about its two translation axes.  Its damping acts on the velocity relative to the housing, which
+A tilting member's radial stiffness may be shared over bearing stations along the axis
+(:mod:`~gearcheck.lumped.elements.holding`).  Its damping acts on the velocity relative to the housing, which
 the rotating coordinates see as q' + Omega k x q: beside -c q' the circulatory term -c Omega k x q of every pair of
 perpendicular rows (whirl damping; Lin & Parker 1999's frame).  A seat tilted in the housing (``tilt_urad``) holds
 the member where its rows' deflections rest, fixed in the housing and so turning in the carrier's frame
@@ -19,6 +18,7 @@ from numba import njit
 
 from gearcheck.lumped.elements import ELEMENTS
 from gearcheck.lumped.elements.base import Build, Contribution, Row, Turning, compiled_group
+from gearcheck.lumped.elements.holding import holding_pairs, pair_rows
 from gearcheck.train.spec import AXIAL, ROTATION, TILTS
 
 
@@ -26,22 +26,11 @@ from gearcheck.train.spec import AXIAL, ROTATION, TILTS
 def support_rows(part, build: Build) -> Contribution:
     mid, s, dofs = part.member, part.support, build.dofs
     member = build.spec.members[mid]
-    u, v = member.dofs[:2]
-    gamma_1, gamma_2 = s.rest_tilt  # a misaligned seat's tilt about the housing's axes
-    # pairs of perpendicular rows: names, rows, stiffness, damping, and the pair's rest deflection in the housing
-    pairs = [(f"{mid}.support_{u}", dofs.unit((mid, u, 1.0)), f"{mid}.support_{v}", dofs.unit((mid, v, 1.0)),
-              s.radial_stiffness, s.radial_damping, (0.0, 0.0))]
-    if member.tilting:
-        tilt_u, tilt_v = TILTS[member.frame]
-        pairs = [(f"{mid}.support_{u}.station{i + 1}", dofs.unit((mid, u, 1.0), (mid, tilt_v, st.position)),
-                  f"{mid}.support_{v}.station{i + 1}", dofs.unit((mid, v, 1.0), (mid, tilt_u, -st.position)),
-                  st.radial_stiffness, st.radial_damping, (st.position * gamma_2, -st.position * gamma_1))
-                 for i, st in enumerate(s.stations)] or pairs
-        if s.tilting_stiffness or s.tilting_damping:
-            pairs.append((f"{mid}.support_{tilt_u}", dofs.unit((mid, tilt_u, 1.0)), f"{mid}.support_{tilt_v}",
-                          dofs.unit((mid, tilt_v, 1.0)), s.tilting_stiffness, s.tilting_damping, (gamma_1, gamma_2)))
-    rows = [Row(name, "support", a, k, c, rest) for name_u, a_u, name_v, a_v, k, c, rests in pairs
-            for name, a, rest in ((name_u, a_u, rests[0]), (name_v, a_v, rests[1]))]
+    tilt_names = TILTS.get(member.frame)
+    tilts = [dofs.unit((mid, t, 1.0)) for t in tilt_names] if member.tilting else (None, None)
+    pairs = holding_pairs(f"{mid}.support_", member.dofs[:2], [dofs.unit((mid, u, 1.0)) for u in member.dofs[:2]],
+                          tilt_names, tilts, s, member.tilting)
+    rows = pair_rows(pairs, "support")
     if s.torsional_stiffness or s.torsional_damping:
         rows.append(Row(f"{mid}.support_{ROTATION}", "support", dofs.unit((mid, ROTATION, 1.0)),
                         s.torsional_stiffness, s.torsional_damping))
@@ -49,12 +38,13 @@ def support_rows(part, build: Build) -> Contribution:
         rows.append(Row(f"{mid}.support_{AXIAL}", "support", dofs.unit((mid, AXIAL, 1.0)), s.axial_stiffness,
                         s.axial_damping))
     omega = build.kin.speeds[f"{member.stage}.carrier"]
-    circulatory = sum(c * omega * (np.outer(a_v, a_u) - np.outer(a_u, a_v)) for _, a_u, _, a_v, _, c, _ in pairs)
+    circulatory = sum(p.damping * omega * (np.outer(p.rows[1], p.rows[0]) - np.outer(p.rows[0], p.rows[1]))
+                      for p in pairs)
     turning = []
     if any(s.rest_tilt) and omega:  # the seat's offsets turn at -Omega in the carrier's frame
         turning.append(MisalignedSupport(
-            sum(k * (a_u * r[0] + a_v * r[1]) for _, a_u, _, a_v, k, _, r in pairs),
-            sum(k * (a_u * r[1] - a_v * r[0]) for _, a_u, _, a_v, k, _, r in pairs), omega))
+            sum(p.stiffness * (p.rows[0] * p.rest[0] + p.rows[1] * p.rest[1]) for p in pairs),
+            sum(p.stiffness * (p.rows[0] * p.rest[1] - p.rows[1] * p.rest[0]) for p in pairs), omega))
     return Contribution(rows, turning=turning,
                         place=lambda model: replace(model, K_circulatory=model.K_circulatory + circulatory))
 

@@ -829,14 +829,20 @@ def _build_stage(st: dict, path: str, fail):
     cycloids = (_cycloid_stage(st, members, angles, carrier_radius, path, fail),) if rv else ()
     meshes = _stage_meshes(st, centrals, planet_gears, geoms, planet_ids, path, fail)
     helical = any(g.helix_angle for g in list(planet_gears.values()) + [c[0] for c in centrals.values()])
+    if st["tilting"] and rv:
+        raise fail(f"{path}.tilting", "an RV reducer's stage does not tilt here (its cycloid discs and pins are "
+                                      "planar): remove it")
     if helical:
         _check_helical(st, centrals, meshes, path, fail)
+    elif st["tilting"]:
+        _check_axial(st, centrals, path, fail, "a tilting stage needs it > 0: its members move along the axis (a "
+                                               "tilting carrier carries its planets' pins with it)")
     if helical and rv:
         raise fail(f"{path}.helix_angle_deg", "an RV reducer's first stage is modelled with spur gears")
-    if helical:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
+    if helical or st["tilting"]:  # the axial degree of freedom of every member (Eritenel & Parker 2009)
         members = {mid: replace(m, axial=True) for mid, m in members.items()}
     members = torsional_members(st, centrals, members, rv, path, fail)
-    members, meshes = tilting_stage(st, centrals, members, meshes, rv, path, fail)
+    members, meshes = tilting_stage(st, centrals, members, meshes, path, fail)
     stage = Stage(name, carrier_radius, angles, equally, tuple(f"{name}.{k}" for k in centrals), planet_ids,
                   f"{name}.carrier", helical, idealised, st["tilting"])
     return members, stage, meshes, cycloids
@@ -1129,13 +1135,9 @@ SPUR_ONLY_STIFFNESS = {"rectangular": "its wave counts tooth pairs from the tran
 def _check_helical(st: dict, centrals, meshes, path: str, fail) -> None:
     """A helical stage's members move axially: each needs an axial support (else its axial motion is free and
     the meshes' axial forces push it away), and its meshes a stiffness model that sees the helix."""
-    for key in list(centrals) + ["carrier"]:
-        if not st[key]["support"]["axial_stiffness"]:
-            raise fail(f"{path}.{key}.support.axial_stiffness", "a helical stage needs it > 0: the meshes' axial "
-                                                                "forces act on every member")
-    if not st["planet"]["bearing"]["axial_stiffness"]:
-        raise fail(f"{path}.planet.bearing.axial_stiffness", "a helical stage needs it > 0: the sun and ring meshes "
-                                                             "push each planet axially")
+    _check_axial(st, centrals, path, fail, "a helical stage needs it > 0: the meshes' axial forces act on every "
+                                           "member", "a helical stage needs it > 0: the sun and ring meshes push "
+                                                     "each planet axially")
     for mesh in meshes:
         model = mesh.stiffness["model"]
         if model in SPUR_ONLY_STIFFNESS:
@@ -1143,6 +1145,16 @@ def _check_helical(st: dict, centrals, meshes, path: str, fail) -> None:
             raise fail(f"{path}.{key}.mesh.stiffness.model", f"{model!r} is for spur gears "
                                                             f"({SPUR_ONLY_STIFFNESS[model]}); a helical mesh "
                                                             "needs 'contact-line' or 'constant'")
+
+
+def _check_axial(st: dict, centrals, path: str, fail, why: str, planet_why: str | None = None) -> None:
+    """Every member of a stage whose members slide axially has an axial support or bearing (else that motion is
+    free): refused naming the first without, and ``why`` (``planet_why`` for the planets' bearing)."""
+    for key in list(centrals) + ["carrier"]:
+        if not st[key]["support"]["axial_stiffness"]:
+            raise fail(f"{path}.{key}.support.axial_stiffness", why)
+    if not st["planet"]["bearing"]["axial_stiffness"]:
+        raise fail(f"{path}.planet.bearing.axial_stiffness", planet_why or why)
 
 
 def _check_small(value: float, limit: float, module: float, path: str, what: str, fail) -> None:

@@ -31,16 +31,13 @@ SHARE_TOLERANCE = 1e-9  # the stations' shares of a support must sum to 1 within
 TILTING = ("tilting_stiffness", "tilting_damping", "stations")  # of a Support
 
 
-def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: bool, path: str, fail):
+def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, path: str, fail):
     """(members, meshes) of the stage ``st``: tilting members with their tilting inertias and every tilt held,
-    and meshes with their centres of stiffness and contact widths, when the stage tilts; as they are otherwise
-    (a tilting key given there noted and set aside)."""
+    and meshes with their centres of stiffness and contact widths, when the stage tilts (its layout and axial
+    supports checked by the stage); as they are otherwise (a tilting key given there noted and set aside)."""
     holders = _holders(st, centrals, path)
     if not st[FLAG]:
         return _set_aside(members, meshes, holders, path, st["name"], st["planet"]["pin_tilts"]), meshes
-    if rv:
-        raise fail(f"{path}.{FLAG}", "an RV reducer's stage does not tilt here (its cycloid discs and pins are "
-                                     "planar): remove it")
     pins = st["planet"]["pin_tilts"]
     if pins and len(pins) != st["planets"]:
         raise fail(f"{path}.planet.pin_tilts_urad", f"needs one pair per planet ({st['planets']}), got {len(pins)}")
@@ -50,12 +47,8 @@ def tilting_stage(st: dict, centrals: dict, members: dict, meshes: list, rv: boo
         if member.torsional:
             raise fail(f"{raw_path}.torsional", "a tilting stage's members move in three dimensions; a torsional "
                                                 "member only turns: remove one of the two flags")
-        support = member.support if member.support is not None else member.bearing
-        if not support.axial_stiffness:
-            raise fail(f"{support_path}.axial_stiffness", "a tilting stage needs it > 0: its members move along the "
-                                                         "axis (a tilting carrier carries its planets' pins with it)")
-        _check_held(support, support_path, fail)
-        out[mid] = replace(member, axial=True, tilting=True,
+        _check_held(member.support if member.support is not None else member.bearing, support_path, fail)
+        out[mid] = replace(member, tilting=True,
                            tilting_inertia=_tilting_inertia(member, raw, f"{raw_path}.tilting_inertia", fail))
         if member.is_planet and pins:
             pin = pins[int(mid.rsplit(".planet", 1)[1]) - 1]

@@ -28,12 +28,12 @@ import copy
 
 import mujoco
 import numpy as np
+from scipy.linalg import block_diag
 
 from gearcheck.mbd_models.elements.stations import station_names, station_tendon, stations
 from gearcheck.mbd_models.jacobians import named, tendon_rows
 from gearcheck.mbd_models.mjcf_text import TILT, member_axes
 from gearcheck.shared.errors import SolverError
-
 
 TILTS = TILT["axis"] + TILT["pin"]  # every tilt hinge's suffix
 
@@ -99,12 +99,7 @@ class ForceReader:
             dofs += read
             J_S = tendon_rows(m, [named(m, mujoco.mjtObj.mjOBJ_TENDON, name) for name in names])[:, read]
             blocks.append(np.linalg.pinv(J_S.T))
-        width = sum(b.shape[1] for b in blocks)
-        out, row, col = np.zeros((sum(b.shape[0] for b in blocks), width)), 0, 0
-        for b in blocks:
-            out[row:row + b.shape[0], col:col + b.shape[1]] = b
-            row, col = row + b.shape[0], col + b.shape[1]
-        return np.array(dofs, dtype=int), out
+        return np.array(dofs, dtype=int), block_diag(*blocks) if blocks else np.zeros((0, 0))
 
     @property
     def width(self) -> int:

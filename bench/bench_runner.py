@@ -3,9 +3,12 @@
 1. Per-step cost of ``simulate_mujoco`` against a bare ``mj_step`` loop on the same model
    (same RK4 integrator, same sensors, same step), side by side in one run: the per-step loop in
    Python (``engine="python"``, before issue 15) and in C (``engine="compiled"``, the default), for
-   1, 2 and 3 planetary stages (demo-3p's stage chained, carrier k -> sun k+1 by a spline coupling).
+   1, 2 and 3 planetary stages (demo-3p's stage chained, carrier k -> sun k+1 by a spline coupling) and
+   hub-drive (the sweeps' train: backlash, two turning carriers).
    The bare loop is timed both from Python (``mujoco.mj_step`` per step) and in C
-   (``mujoco.rollout``, no Python per step).  Target: runner / bare Python mj_step <= 1.3.
+   (``mujoco.rollout``, no Python per step).  Targets: runner / bare Python mj_step <= 1.3, runner / bare C
+   (rollout) <= 1.1 (the runner does more than a bare step: the drive at every stage, contact events located,
+   the mesh forces read at every sample).
 2. Several twins at once (``simulate_mujoco_many``, threads): wall time per step per twin.
 3. With ``--convergence``: normalised RMS differences between MuJoCo and the lumped RK4 run of
    demo-3p as the step shrinks.
@@ -28,6 +31,7 @@ from gearcheck.train.loader import load_train
 from gearcheck.lumped.time_solver import simulate
 from gearcheck.train.variants import chained
 from gearcheck.mbd_models.runner import simulate_mujoco, simulate_mujoco_many
+from gearcheck.mbd_models.mjcf_text import ROTATION
 from gearcheck.mbd_models.twin import compile_train
 from gearcheck.shared.settings import RunSettings
 
@@ -39,7 +43,7 @@ def turning_data(mb, dt: float):
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     d = mujoco.MjData(m)
     for mid, speed in mb.kin.speeds.items():
-        d.qvel[mb.dadr[mid][2]] = speed
+        d.qvel[mb.dadr[mid][ROTATION]] = speed
     return m, d
 
 
@@ -86,8 +90,9 @@ def cost_table(n_steps: int, twins: int, repeats: int = 5):
     print(f"{'train':<10} {'bodies':>6} {'tendons':>7} {'dt [s]':>10} {'python':>9} {'C':>9} {'python':>11} "
           f"{'compiled':>11} {'before':>8} {'after':>8} {'us/step':>8} {'/bare':>8}")
     rows = []
-    for n_stages in (1, 2, 3):
-        spec = load_train("demo-3p") if n_stages == 1 else chained(n_stages)
+    for n_stages in (1, 2, 3, "hub-drive"):
+        spec = load_train(n_stages) if isinstance(n_stages, str) else (
+            load_train("demo-3p") if n_stages == 1 else chained(n_stages))
         mb = compile_train(spec)
         dt = mb.model.opt.timestep  # the default step written into the MJCF
         runner_step_cost(mb, 100, dt, "compiled")  # load the compiled loop
@@ -98,12 +103,13 @@ def cost_table(n_steps: int, twins: int, repeats: int = 5):
                           many_step_cost(mb, n_steps, dt, twins, threads)))
         bare, bare_c, before, after, many = np.min(costs, axis=0)
         rows.append((n_stages, bare, bare_c, before, after, many))
-        label = f"{n_stages} stage" + ("s" if n_stages > 1 else "")
+        label = n_stages if isinstance(n_stages, str) else f"{n_stages} stage" + ("s" if n_stages > 1 else "")
         print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>9.2f} "
               f"{bare_c * 1e6:>9.2f} {before * 1e6:>11.2f} {after * 1e6:>11.2f} {before / bare:>8.3f} "
               f"{after / bare:>8.3f} {many * 1e6:>8.2f} {many / bare:>8.3f}")
-    print("runner/bare C (compiled): " + ", ".join(f"{r[0]} stage{'s' if r[0] > 1 else ''} {r[4] / r[2]:.3f}"
-                                                   for r in rows))
+    print("runner/bare C (compiled): " + ", ".join(
+        f"{r[0] if isinstance(r[0], str) else f'{r[0]} stage' + ('s' if r[0] > 1 else '')} {r[4] / r[2]:.3f}"
+        for r in rows))
     return rows
 
 

@@ -25,6 +25,7 @@ from gearcheck.compare.studies.sensitivity import field_sensitivity
 from gearcheck.lumped.export import reference_linear_model, write_matrix_file
 from gearcheck.lumped.linear_run import simulate_linear
 from gearcheck.session import SOLVERS, Train
+from gearcheck.train.compiled_excitation import compile_now as compile_transmission_error
 from gearcheck.train.loader import load_train, preset_names, read_train_text
 from gearcheck.train.spec import TrainSpec, with_profiles
 from gearcheck.train.schema import parse_measurements_file
@@ -321,6 +322,7 @@ def compile_kernels() -> None:
     for solver in SOLVERS:
         train.simulate(solver, duration=0.003)
     simulate_linear(reference_linear_model(train.spec), RunSettings(0.003))
+    compile_transmission_error()  # demo-3p has none
 
 
 def describe(train) -> dict:

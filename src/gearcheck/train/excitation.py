@@ -50,6 +50,8 @@ class Excitation:
         self._pairs = [ToothPairs(meshes[j], self.mean_stiffness[j]) for j in self.relieved]
         self._ste = [(i, h, a, p) for i, m in enumerate(meshes) for (h, a, p) in m.ste]
         self._eccentric = list(self._eccentric_terms(spec, kin))
+        self._terms = (np.array(self._ste, dtype=float).reshape(-1, 4),  # the compiled sums' rows
+                       np.array(self._eccentric, dtype=float).reshape(-1, 6))
         op = spec.operating
         # torque ripple harmonics: (member "input" | "output", amplitude, angular frequency rad/s, phase rad)
         self.ripple = [(r.member, r.amplitude, self._ripple_omega(r), r.phase) for r in op.ripple]
@@ -196,16 +198,14 @@ class Excitation:
         t = np.asarray(t, dtype=float)
         e = np.zeros(t.shape + (len(self.mesh_ids),))
         de = np.zeros_like(e)
+        if not self.has_transmission_error:
+            return e, de
+        from gearcheck.train.compiled_excitation import add_terms
+
         angle = self.nominal_time(t)  # the angles turn at lambda times their speeds
-        scale = 1.0 if self.clock is None else self.clock.scale(t)
-        for i, h, amp, phi in self._ste:
-            arg = 2 * np.pi * h * (self.frequency[i] * angle - self.phase[i]) + phi
-            e[..., i] += amp * np.cos(arg)
-            de[..., i] -= amp * 2 * np.pi * h * self.frequency[i] * scale * np.sin(arg)
-        for i, amp, omega, beta0, dx, dy in self._eccentric:
-            beta = omega * angle + beta0
-            e[..., i] += amp * (np.cos(beta) * dx + np.sin(beta) * dy)
-            de[..., i] += amp * omega * scale * (-np.sin(beta) * dx + np.cos(beta) * dy)
+        scale = np.ones(t.shape) if self.clock is None else np.broadcast_to(self.clock.scale(t), t.shape)
+        add_terms(np.ravel(angle), np.ravel(scale), self.frequency, self.phase, *self._terms,
+                  e.reshape(-1, e.shape[-1]), de.reshape(-1, de.shape[-1]))
         return e, de
 
     @staticmethod

@@ -142,7 +142,10 @@ class EnergyMethodStiffness(MeshStiffness):
         x = cycle_fraction(xi)
         if len(self._parts) == 1:
             return self._parts[0](x)
-        return np.where(x < self.multi_fraction, self._parts[0](x), self._parts[1](x))
+        multi = x < self.multi_fraction
+        k = np.empty_like(x)
+        k[multi], k[~multi] = self._parts[0](x[multi]), self._parts[1](x[~multi])  # each part where it holds
+        return k
 
     @property
     def maximum(self) -> float:

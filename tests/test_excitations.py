@@ -8,6 +8,7 @@ from gearcheck.lumped.assembly import build_model
 from gearcheck.train.line_of_action import line_of_action
 from gearcheck.train.loader import load_train
 from gearcheck.lumped.time_solver import simulate
+from gearcheck.train.spec import with_profiles
 from gearcheck.train.variants import edited
 from gearcheck.shared.errors import GearcheckError
 from gearcheck.shared.settings import RunSettings
@@ -75,6 +76,28 @@ def test_torque_profile_from_a_csv_file(tmp_path):
     bad.write_text(edited_text("demo-3p", [(r"^input_shaft_damping = .*", 'torque_csv = "missing.csv"')]))
     with pytest.raises(GearcheckError, match="operating.torque_csv: .*missing.csv: no such torque profile"):
         load_train(bad)
+
+
+def test_transmission_error_harmonics_in_closed_form_and_along_a_run_up():
+    """The compiled sums of the transmission error's harmonics (ISO's e = sum_h A_h cos(2 pi h xi + phi_h), xi the
+    mesh cycles elapsed) against the closed form on a steady train, and along a run-up, where xi is no longer f t,
+    de/dt against the derivative of e itself (the clock's rate in the chain rule)."""
+    spec = edited("demo-3p", EXCITED[:1], "transmission error")
+    exc = build_model(spec).excitation
+    t = np.linspace(0.0, 0.01, 4001)
+    e, de = exc.transmission_error(t)
+    for j in range(len(spec.meshes)):
+        xi = exc.frequency[j] * t - exc.phase[j]
+        arg1, arg2 = 2 * np.pi * xi, 4 * np.pi * xi + np.radians(30.0)
+        np.testing.assert_allclose(e[:, j], 4e-6 * np.cos(arg1) + 1e-6 * np.cos(arg2), rtol=0, atol=1e-18)
+        rate = -2 * np.pi * exc.frequency[j] * (4e-6 * np.sin(arg1) + 2e-6 * np.sin(arg2))
+        np.testing.assert_allclose(de[:, j], rate, rtol=0, atol=1e-12 * np.abs(rate).max())
+    ramped = build_model(with_profiles(spec, "0:300,0.02:3000")).excitation
+    t = np.linspace(0.001, 0.019, 36001)
+    e, de = ramped.transmission_error(t)
+    slope = np.gradient(e, t, axis=0)[1:-1]
+    np.testing.assert_allclose(de[1:-1], slope, rtol=0, atol=1e-5 * np.abs(de).max())
+    assert np.abs(de[-1]).max() > 5 * np.abs(de[0]).max()  # the rate grows with the speed
 
 
 def test_installation_errors_turn_with_their_mounts():

@@ -24,7 +24,8 @@ def add_terms(angle, scale, frequency, phase, harmonics, eccentric, e, de):
     """Add the transmission error terms to e and de (rows: samples; columns: meshes), at the nominal angles
     ``angle`` (the time a constant speed would take) and the clock's rates ``scale`` (one per sample).
 
-    harmonics: rows (mesh, harmonic h, amplitude, phase phi) of e = amp cos(2 pi h (f xi - phase_mesh) + phi);
+    harmonics: rows (mesh, harmonic h, amplitude, phase phi) of e = amp cos(2 pi h (f angle - phase_mesh) + phi),
+    f and phase_mesh the mesh's frequency and phase;
     eccentric: rows (mesh, amplitude, omega, beta0, dx, dy) of e = amp (cos(beta) dx + sin(beta) dy),
     beta = omega angle + beta0 (:meth:`~gearcheck.train.excitation.Excitation.transmission_error`)."""
     for row in range(harmonics.shape[0]):
@@ -37,8 +38,8 @@ def add_terms(angle, scale, frequency, phase, harmonics, eccentric, e, de):
             de[j, i] -= amp * 2 * math.pi * h * f * scale[j] * math.sin(arg)
     for row in range(eccentric.shape[0]):
         i = int(eccentric[row, 0])
-        amp, omega, beta0, dx, dy = eccentric[row, 1], eccentric[row, 2], eccentric[row, 3], eccentric[row, 4], \
-            eccentric[row, 5]
+        amp, omega, beta0 = eccentric[row, 1], eccentric[row, 2], eccentric[row, 3]
+        dx, dy = eccentric[row, 4], eccentric[row, 5]
         for j in range(angle.size):
             beta = omega * angle[j] + beta0
             c, s = math.cos(beta), math.sin(beta)

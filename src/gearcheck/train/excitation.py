@@ -200,7 +200,7 @@ class Excitation:
         de = np.zeros_like(e)
         if not self.has_transmission_error:
             return e, de
-        from gearcheck.train.compiled_excitation import add_terms
+        from gearcheck.train.compiled_excitation import add_terms  # numba on first use, not when a file is read
 
         angle = self.nominal_time(t)  # the angles turn at lambda times their speeds
         scale = np.ones(t.shape) if self.clock is None else np.broadcast_to(self.clock.scale(t), t.shape)

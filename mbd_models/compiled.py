@@ -6,8 +6,9 @@ that every stage gets its own drive.  At each of the four stages, from that stag
 tendons' world-frame coefficients with their carriers (``wrap_prm``), sets an RV reducer's pin tendons to
 the discs' poses, drives the stage (mesh stiffness, controls, spring lengths of a transmission error and a
 backlash, the relieved meshes' tooth pairs in contact, the damping correction J^T g into ``qfrc_applied``) with
-the excitation at the stage's time (t, t + h/2, t + h/2, t + h), and calls ``mj_forward`` (``mj_forwardSkip``
-without sensors after the first, as ``mj_RungeKutta`` does); the state then advances by RK4's weights
+the excitation at the stage's time (t, t + h/2, t + h/2, t + h), and calls ``mj_forward`` at a sampled step's
+first stage, ``mj_forwardSkip`` without sensors at every other stage (``mj_RungeKutta`` computes them at every
+step's first; they feed nothing back, and cost 10 % of a hub-drive step); the state then advances by RK4's weights
 (``mj_integratePos`` for the positions).  A step inside which a mesh stiffness jumps is taken as RK4 sub-steps
 ended there.  The drive itself -- the excitation functions of the train at every stage time -- is computed
 beforehand in arrays, a chunk of steps at a time, by the runner.  Every force law stays MuJoCo's: the kernel only
@@ -266,7 +267,7 @@ def _copy(dst, src):
         dst[i] = src[i]
 
 
-@numba.njit(cache=True, _nrt=False)
+@numba.njit(cache=True, inline="always", _nrt=False)
 def _refresh(qpos, wrap_prm, coefficients, coef):
     """The world-frame coefficients (:class:`TurningCoefficients`) turned to the carriers' angles
     (``MbdModel.refresh``).  A carrier's cosine and sine are taken once for the run of wraps that follow it (the
@@ -295,7 +296,7 @@ def _turning_rates(qpos, qvel, turning, coef, out):
         out[tendon[w]] += turned * qvel[carrier_qadr[w]] * qpos[joint_qadr[w]]
 
 
-@numba.njit(cache=True, _nrt=False)
+@numba.njit(cache=True, inline="always", _nrt=False)
 def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, contacts, work):
     """``_Stepper.set_stage``: stiffness, controls, spring lengths, tooth contacts, damping correction."""
     stiffness, lengthspring, wrap_prm = model.tendon_stiffness, model.tendon_lengthspring, model.wrap_prm
@@ -347,7 +348,7 @@ def _set_stage(k, u, e, de, pairs, has_te, has_pairs, model, data, turning, cont
             applied[v] += gi * J[i, v]
 
 
-@numba.njit(cache=True, _nrt=False)
+@numba.njit(cache=True, inline="always", _nrt=False)
 def _sample(j, passive, pointers, model, data, reader, outputs, flags, moving):
     """``_Stepper.sample``: sensordata, the force reader's generalized forces (``ForceReader.sample``), and
     optionally the stiffness used, MuJoCo's energy and the moving contacts' forces, into row ``j``."""
@@ -419,13 +420,12 @@ def _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stag
                 act[i] = act0[i] + AD[stage - 1, i] * a * h
         _drive_stage(STAGE_TIMES[stage], r, drive, kinematics, com_pos, jac, pointers, model, data, turning,
                      contacts, work, moving, flags)
-        if stage == 0:
+        if stage == 0 and sample:
             forward(m, d)
-            if sample:
-                _sample(j, passive, pointers, model, data, reader, outputs, flags, moving)
-                j += 1
+            _sample(j, passive, pointers, model, data, reader, outputs, flags, moving)
+            j += 1
         else:
-            forward_skip(m, d, 0, 1)  # mjSTAGE_NONE, no sensors
+            forward_skip(m, d, 0, 1)  # mjSTAGE_NONE, no sensors: nothing reads them
         _copy(V[stage], qvel)
         _copy(A[stage], qacc)
         _copy(AD[stage], act_dot)
@@ -504,7 +504,7 @@ def _part_of(drive, r, a, b, part) -> None:
     samples_between(drive.pairs[r], a, b, part.pairs[0])
 
 
-@numba.njit(cache=True, _nrt=False)
+@numba.njit(cache=True, inline="always", _nrt=False)
 def _step(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, r, h, flags, outputs,
           sample, j, switches, events):
     """One (sub-)step of length h with the drive of row ``r`` (:func:`_rk4`), its contact events located where

@@ -17,6 +17,7 @@ from gearcheck.mbd_models import linearise
 from gearcheck.mbd_models.published_twin import PublishedTwin, build_twin, simulate_twin, twin_modes
 from gearcheck.mbd_models.periodic_state import periodic_state
 from gearcheck.mbd_models.runner import simulate_mujoco
+from gearcheck.mbd_models.static_state import StaticState, static_state
 from gearcheck.mbd_models.twin import MbdModel, compile_train
 from gearcheck.shared import stepping
 from gearcheck.shared.modal import ModalResult
@@ -43,6 +44,11 @@ class MujocoSide(Side):
     def model(self) -> MbdModel:
         return compile_train(self.spec)
 
+    @cached_property
+    def static(self) -> StaticState:
+        """The twin's static state, found once for all its runs."""
+        return static_state(self.model)
+
     def modes(self) -> ModalResult:
         return linearise.modes(self.model)
 
@@ -59,13 +65,14 @@ class MujocoSide(Side):
         return labels, T_inv.T @ linearise.mass_matrix(self.model) @ T_inv, T @ modal.shapes
 
     def run(self, settings: RunSettings, progress=None) -> TimeResult:
-        return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock)
+        return simulate_mujoco(self.model, settings, progress=progress, stiffness_clock=self.stiffness_clock,
+                               static=self.static)
 
     def run_from(self, settings: RunSettings, state: RunState | None = None) -> tuple[TimeResult, RunState]:
         """From the joints' positions, the input servo's reference angle and the joints' velocities of ``state``."""
         initial = None if state is None else (state.coordinates[0], state.rates[0], state.coordinates[1])
         result, (qpos, qvel, act) = simulate_mujoco(self.model, settings, stiffness_clock=self.stiffness_clock,
-                                                    initial_state=initial, return_state=True)
+                                                    initial_state=initial, return_state=True, static=self.static)
         return result, RunState(float(result.t[-1]), (qpos, act), (qvel,))
 
     def stable_step(self) -> float:
@@ -82,7 +89,8 @@ class MujocoSide(Side):
 
     def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
         steady = periodic_state(self.model, dt=settings.dt)
-        options = {"initial_state": steady.initial_state, "stiffness_clock": self.stiffness_clock}
+        options = {"initial_state": steady.initial_state, "stiffness_clock": self.stiffness_clock,
+                   "static": self.static}
         run = simulate_mujoco(self.model, replace(settings, dt=steady.dt), progress=progress, **options)
         check = simulate_mujoco(self.model, replace(settings, dt=check_step(steady.dt), output_dt=None,
                                                     signals=tuple(run.names(compared=True))), **options)

@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import hashlib
 import importlib.metadata
 import io
@@ -146,6 +147,7 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
 }
 
 
+@functools.lru_cache(maxsize=1)
 def version() -> str:
     return importlib.metadata.version("gearcheck")
 

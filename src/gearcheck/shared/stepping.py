@@ -12,6 +12,7 @@ model's, or MuJoCo's own linearisation.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -88,11 +89,18 @@ class StepLimits:
     @classmethod
     def of(cls, M: np.ndarray, K: np.ndarray, D: np.ndarray) -> "StepLimits":
         """The limits of M q'' + D q' + K q = 0 (D: damping and gyroscopic terms)."""
-        w2 = sla.eigh(0.5 * (K + K.T), M, eigvals_only=True)
-        n = M.shape[0]
-        MinvK, MinvD = np.linalg.solve(M, K), np.linalg.solve(M, D)
-        J = np.block([[np.zeros((n, n)), np.eye(n)], [-MinvK, -MinvD]])
-        return cls(float(np.sqrt(max(w2.max(), 0.0))), rk4_stable_step(np.linalg.eigvals(J)))
+        return _limits(M.shape[0], np.concatenate([np.asarray(x, dtype=float).ravel() for x in (M, K, D)]).tobytes())
+
+
+@functools.lru_cache(maxsize=64)
+def _limits(n: int, matrices: bytes) -> StepLimits:
+    """:meth:`StepLimits.of` of M, K, D given by their bytes: kept for the next ask of the same matrices (every run
+    of a model checks its step, and a sweep point runs its model several times; 8 ms each on hub-drive)."""
+    M, K, D = np.frombuffer(matrices).reshape(3, n, n).copy()
+    w2 = sla.eigh(0.5 * (K + K.T), M, eigvals_only=True)
+    MinvK, MinvD = np.linalg.solve(M, K), np.linalg.solve(M, D)
+    J = np.block([[np.zeros((n, n)), np.eye(n)], [-MinvK, -MinvD]])
+    return StepLimits(float(np.sqrt(max(w2.max(), 0.0))), rk4_stable_step(np.linalg.eigvals(J)))
 
 
 def rk4_growth(z) -> np.ndarray:

@@ -126,7 +126,8 @@ def gear_mesh(gear: Gear, flank_points: int = FLANK_POINTS) -> tuple[np.ndarray,
     """Closed, outward-oriented triangle mesh of the gear (vertices in m, faces), centred on z = 0.
 
     An external gear is a solid toothed disc (end faces fanned from the axis: the section is star-shaped about
-    it); an internal one an annulus (rim ``RIM`` modules outside the root circle) with its teeth on the inside.  A helical gear is extruded in ``HELIX_SLICES`` twisted slices.
+    it); an internal one an annulus (rim ``RIM`` modules outside the root circle) with its teeth on the inside.  A
+    helical gear is extruded in ``HELIX_SLICES`` twisted slices.
     """
     r, phi = section(gear, flank_points)
     n = len(r)

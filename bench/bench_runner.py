@@ -8,7 +8,9 @@
    The bare loop is timed both from Python (``mujoco.mj_step`` per step) and in C
    (``mujoco.rollout``, no Python per step).  Targets: runner / bare Python mj_step <= 1.3, runner / bare C
    (rollout) <= 1.1 (the runner does more than a bare step: the drive at every stage, contact events located,
-   the mesh forces read at every sample).
+   the mesh forces read at every sample).  Also without samples, as a sweep point's settling stretch runs: the
+   runner sampling only its run's ends (its steps then go without MuJoCo's sensors) against ``rollout`` with
+   the sensors disabled.
 2. Several twins at once (``simulate_mujoco_many``, threads): wall time per step per twin.
 3. With ``--convergence``: normalised RMS differences between MuJoCo and the lumped RK4 run of
    demo-3p as the step shrinks.
@@ -56,20 +58,29 @@ def bare_step_cost(mb, n_steps: int, dt: float) -> float:
     return (time.perf_counter() - started) / n_steps
 
 
-def rollout_step_cost(mb, n_steps: int, dt: float) -> float:
-    """A bare mj_step loop in C: ``mujoco.rollout`` with the controls held, sensors recorded."""
+def rollout_step_cost(mb, n_steps: int, dt: float, sensors: bool = True) -> float:
+    """A bare mj_step loop in C: ``mujoco.rollout`` with the controls held, sensors recorded (or, ``sensors``
+    False, disabled: ``mjDSBL_SENSOR``)."""
     m, d = turning_data(mb, dt)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(m, spec))
     mujoco.mj_getState(m, d, state, spec)
     control = np.zeros((1, n_steps, m.nu))
-    started = time.perf_counter()
-    rollout.rollout(m, d, state[None], control)
-    return (time.perf_counter() - started) / n_steps
+    flags = m.opt.disableflags
+    m.opt.disableflags = flags | (0 if sensors else int(mujoco.mjtDisableBit.mjDSBL_SENSOR))
+    try:
+        started = time.perf_counter()
+        rollout.rollout(m, d, state[None], control)
+        return (time.perf_counter() - started) / n_steps
+    finally:
+        m.opt.disableflags = flags
 
 
-def runner_step_cost(mb, n_steps: int, dt: float, engine: str) -> float:
-    res = simulate_mujoco(mb, RunSettings(n_steps * dt, dt), engine=engine)
+def runner_step_cost(mb, n_steps: int, dt: float, engine: str, sampled: bool = True) -> float:
+    """Per step of ``simulate_mujoco``, sampling every step (or, ``sampled`` False, only the run's two ends: a
+    sweep point's settling stretch, whose steps go without MuJoCo's sensors)."""
+    res = simulate_mujoco(mb, RunSettings(n_steps * dt, dt, output_dt=None if sampled else n_steps * dt),
+                          engine=engine)
     assert res.info.engine == f"mujoco-{engine}"
     return res.info.wall_s / res.info.steps
 
@@ -100,16 +111,20 @@ def cost_table(n_steps: int, twins: int, repeats: int = 5):
         for _ in range(repeats):  # interleaved, so that a change in the machine's load touches every column
             costs.append((bare_step_cost(mb, n_steps, dt), rollout_step_cost(mb, n_steps, dt),
                           runner_step_cost(mb, n_steps, dt, "python"), runner_step_cost(mb, n_steps, dt, "compiled"),
-                          many_step_cost(mb, n_steps, dt, twins, threads)))
-        bare, bare_c, before, after, many = np.min(costs, axis=0)
-        rows.append((n_stages, bare, bare_c, before, after, many))
+                          many_step_cost(mb, n_steps, dt, twins, threads),
+                          rollout_step_cost(mb, n_steps, dt, sensors=False),
+                          runner_step_cost(mb, n_steps, dt, "compiled", sampled=False)))
+        bare, bare_c, before, after, many, quiet_c, quiet = np.min(costs, axis=0)
+        rows.append((n_stages, bare, bare_c, before, after, many, quiet_c, quiet))
         label = n_stages if isinstance(n_stages, str) else f"{n_stages} stage" + ("s" if n_stages > 1 else "")
         print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>9.2f} "
               f"{bare_c * 1e6:>9.2f} {before * 1e6:>11.2f} {after * 1e6:>11.2f} {before / bare:>8.3f} "
               f"{after / bare:>8.3f} {many * 1e6:>8.2f} {many / bare:>8.3f}")
-    print("runner/bare C (compiled): " + ", ".join(
-        f"{r[0] if isinstance(r[0], str) else f'{r[0]} stage' + ('s' if r[0] > 1 else '')} {r[4] / r[2]:.3f}"
-        for r in rows))
+    names = [r[0] if isinstance(r[0], str) else f"{r[0]} stage" + ("s" if r[0] > 1 else "") for r in rows]
+    print("runner/bare C (compiled, sampled at every step): " + ", ".join(
+        f"{name} {r[4] / r[2]:.3f}" for name, r in zip(names, rows)))
+    print("without samples (a sweep's settling stretch), runner / bare C without sensors: " + ", ".join(
+        f"{name} {r[7] * 1e6:.2f} / {r[6] * 1e6:.2f} us = {r[7] / r[6]:.3f}" for name, r in zip(names, rows)))
     return rows
 
 

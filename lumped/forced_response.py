@@ -22,7 +22,7 @@ from dataclasses import replace
 import numpy as np
 
 from gearcheck.lumped.assembly import LumpedModel, contact_sets, frozen_at
-from gearcheck.lumped.fourier_response import ParametricProblem
+from gearcheck.lumped.fourier_response import ParametricProblem, grid_angles
 from gearcheck.lumped.static import mean_load
 from gearcheck.shared.errors import SolverError
 
@@ -56,7 +56,7 @@ def parametric_problem(model: LumpedModel, mesh_grid: int = 4096, eccentric_grid
     base = replace(model, rows=[r for r in model.rows if r.name not in owned])
     K_const = base.K_b + model.K_frame + model.K_mesh(np.where(varies, 0.0, exc.mean_stiffness))
     contacts = {} if contacts is None else contacts
-    parts = [_mesh_part(model, omega, group) if kind == "mesh" else _turning_part(model, omega, contacts)
+    parts = [_mesh_part(model, omega, group, mesh_grid) if kind == "mesh" else _turning_part(model, omega, contacts)
              for kind, omega, group in clocks]  # each angle -> (K, C) of its rows
     F = mean_load(model) - sum((e.static_load for e in turning), np.zeros(model.n))
     orbit = None
@@ -105,14 +105,19 @@ def _mesh_groups(frequencies, varies) -> list[list[int]]:
     return groups
 
 
-def _mesh_part(model: LumpedModel, omega: float, group: list[int]):
+def _mesh_part(model: LumpedModel, omega: float, group: list[int], grid: int):
     """(K, C) of the meshes of one group as a function of their clock's angle (their damping is constant: in
-    the problem's C)."""
+    the problem's C).  The stiffness at the ``grid`` angles the problem samples is taken in one call (each
+    sample the same number as alone)."""
     rows = model.mesh_rows[group]
     zero = np.zeros((model.n, model.n))
+    angles = grid_angles(grid)
+    sampled = dict(zip(angles.tolist(), model.excitation.stiffness(angles / omega)[:, group]))
 
     def part(theta: float) -> tuple[np.ndarray, np.ndarray]:
-        k = model.excitation.stiffness(np.array([theta / omega]))[0][group]
+        k = sampled.get(theta)
+        if k is None:
+            k = model.excitation.stiffness(np.array([theta / omega]))[0][group]
         return rows.T @ (k[:, None] * rows), zero
     return part
 

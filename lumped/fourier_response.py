@@ -29,6 +29,11 @@ from scipy.sparse.linalg import splu
 from gearcheck.shared.errors import SolverError
 
 
+def grid_angles(points: int) -> np.ndarray:
+    """The angles at which :class:`ParametricProblem` samples a clock's turn: 2 pi j / ``points``."""
+    return 2 * np.pi * np.arange(points) / points
+
+
 @dataclass(frozen=True)
 class ParametricProblem:
     """M q'' + C q' + K_of(theta(t)) q = F, theta_k = omegas[k] t + phases[k], with K_of((theta_1[, theta_2]))
@@ -121,7 +126,7 @@ class ParametricProblem:
         """(h, X_h) rows over the FFT grid of the matrix function ``of``: the whole torus, or only its axes when
         separable, X(theta) = sum_k X_k(theta_k), whose mean is the sum of the axes' means less (d - 1) X(0)."""
         g, d = self.grids[0], self.dim
-        angles = 2 * np.pi * np.arange(g) / g
+        angles = grid_angles(g)
         freq = np.fft.fftfreq(g, 1 / g).astype(int)
         if not self.separable or d == 1:
             samples = np.array([of(theta) for theta in itertools.product(angles, repeat=d)], dtype=float)
@@ -136,7 +141,7 @@ class ParametricProblem:
                               "separable=False")
         axes, h = [], [np.zeros((1, d), int)]
         for k, g in enumerate(self.grids):
-            angles = 2 * np.pi * np.arange(g) / g
+            angles = grid_angles(g)
             axes.append(np.fft.fft([of(tuple(a * (j == k) for j in range(d))) for a in angles], axis=0) / g)
             h.append(np.outer(np.fft.fftfreq(g, 1 / g).astype(int)[1:], np.eye(d, dtype=int)[k]))
         h = np.concatenate(h)

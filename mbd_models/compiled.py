@@ -23,7 +23,10 @@ kind's group in one tuple, and its functions on the hooks :data:`~gearcheck.mbd_
 which the kernel calls without naming a kind.  The kernel is compiled on first use and cached by numba next to
 its file, without numba's reference-counted runtime (``_nrt=False``; it allocates nothing): a call that passes
 tens of arrays otherwise counts references to each with atomic instructions, about 3 us of hub-drive's 34 us step.
-The stages' drive and switching functions are inlined into their callers for the same reason.
+Even without the counts, a call passes every array of its groups as several machine words: the functions called
+once a stage or a step (the stage's drive and :func:`_set_stage`, :func:`_refresh`, :func:`_sample`,
+:func:`_step`, the switching functions) are inlined into their callers; :func:`_rk4`, called from three places,
+stays a function.
 """
 
 from __future__ import annotations

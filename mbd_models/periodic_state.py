@@ -38,7 +38,7 @@ import mujoco
 import numpy as np
 
 from gearcheck.mbd_models.runner import simulate_mujoco
-from gearcheck.mbd_models.static_state import nominal_speeds, static_state
+from gearcheck.mbd_models.static_state import StaticState, nominal_speeds, static_state
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import stepping
 from gearcheck.shared.anderson import anderson
@@ -96,12 +96,14 @@ def nominal_advance(mb: MbdModel, duration: float) -> np.ndarray:
 
 
 def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = TOLERANCE, initial_state=None,
-                   max_mesh_periods: int = MAX_MESH_PERIODS, engine: str = "auto") -> PeriodicState:
+                   max_mesh_periods: int = MAX_MESH_PERIODS, engine: str = "auto",
+                   static: StaticState | None = None) -> PeriodicState:
     """The T_M-periodic steady state of the twin ``mb`` (see the module docstring).
 
     dt: the RK4 step, made a whole fraction of T_M (default: ``mb.default_step``, rounded down to one); tolerance:
     on the residual; initial_state: the first guess (qpos, qvel) (default: the static state); max_mesh_periods: the
-    longest drive period sought (:func:`~gearcheck.train.periods.common_period`); engine: the runner's.
+    longest drive period sought (:func:`~gearcheck.train.periods.common_period`); engine: the runner's; static:
+    the twin's static state where the caller has it (found here otherwise), which every run of the shooting shares.
     Raises SolverError where there is no period, for a twin with moving contacts, and where Anderson acceleration
     has not converged in ``MAX_ANDERSON_RUNS`` runs."""
     name = mb.spec.name
@@ -116,9 +118,9 @@ def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = TOL
     steps = max(1, math.ceil(period / h - 1e-9))
     h = period / steps
     advance, nominal = nominal_advance(mb, period), nominal_speeds(mb)
+    static = static_state(mb) if static is None else static
     if initial_state is None:
-        start = static_state(mb)
-        initial_state = start.qpos, start.qvel
+        initial_state = static.qpos, static.qvel
     qpos0, qvel0 = (np.asarray(x, dtype=float) for x in initial_state)
     nq = qpos0.size
     # the map on the deviation from nominal motion, qvel over omega_max, both over the first guess's largest
@@ -130,7 +132,8 @@ def periodic_state(mb: MbdModel, dt: float | None = None, tolerance: float = TOL
     def period_map(z: np.ndarray) -> np.ndarray:
         y = z * scale / w + offset
         result, (qpos, qvel, _) = simulate_mujoco(mb, RunSettings(period, dt=h, output_dt=period),
-                                               initial_state=(y[:nq], y[nq:]), engine=engine, return_state=True)
+                                               initial_state=(y[:nq], y[nq:]), engine=engine, return_state=True,
+                                               static=static)
         runs.append(result.info)
         return (np.concatenate([qpos - advance, qvel]) - offset) * w / scale
 

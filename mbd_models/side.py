@@ -88,7 +88,7 @@ class MujocoSide(Side):
         return linearise.settling_time(self.model, fraction)
 
     def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
-        steady = periodic_state(self.model, dt=settings.dt)
+        steady = periodic_state(self.model, dt=settings.dt, static=self.static)
         options = {"initial_state": steady.initial_state, "stiffness_clock": self.stiffness_clock,
                    "static": self.static}
         run = simulate_mujoco(self.model, replace(settings, dt=steady.dt), progress=progress, **options)

@@ -115,16 +115,14 @@ def cost_table(n_steps: int, twins: int, repeats: int = 5):
                           rollout_step_cost(mb, n_steps, dt, sensors=False),
                           runner_step_cost(mb, n_steps, dt, "compiled", sampled=False)))
         bare, bare_c, before, after, many, quiet_c, quiet = np.min(costs, axis=0)
-        rows.append((n_stages, bare, bare_c, before, after, many, quiet_c, quiet))
         label = n_stages if isinstance(n_stages, str) else f"{n_stages} stage" + ("s" if n_stages > 1 else "")
+        rows.append((label, bare, bare_c, before, after, many, quiet_c, quiet))
         print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>9.2f} "
               f"{bare_c * 1e6:>9.2f} {before * 1e6:>11.2f} {after * 1e6:>11.2f} {before / bare:>8.3f} "
               f"{after / bare:>8.3f} {many * 1e6:>8.2f} {many / bare:>8.3f}")
-    names = [r[0] if isinstance(r[0], str) else f"{r[0]} stage" + ("s" if r[0] > 1 else "") for r in rows]
-    print("runner/bare C (compiled, sampled at every step): " + ", ".join(
-        f"{name} {r[4] / r[2]:.3f}" for name, r in zip(names, rows)))
+    print("runner/bare C (compiled, sampled at every step): " + ", ".join(f"{r[0]} {r[4] / r[2]:.3f}" for r in rows))
     print("without samples (a sweep's settling stretch), runner / bare C without sensors: " + ", ".join(
-        f"{name} {r[7] * 1e6:.2f} / {r[6] * 1e6:.2f} us = {r[7] / r[6]:.3f}" for name, r in zip(names, rows)))
+        f"{r[0]} {r[7] * 1e6:.2f} / {r[6] * 1e6:.2f} us = {r[7] / r[6]:.3f}" for r in rows))
     return rows
 
 

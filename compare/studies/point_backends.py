@@ -2,9 +2,10 @@
 executor, or a Dask cluster.
 
 Each backend takes ``run`` (a module-level function of one point), the points (picklable; on Dask with a
-``key``) and ``finished(point, result)``, called in this process as each point ends.  The local pool starts fresh processes from a fork server that preloads ``run``'s module, never runs the calling
-script again, and ends cleanly on Ctrl-C (its workers leave the signal to the parent); a Dask worker runs each
-point with glibc's malloc thresholds as a plain process has them.
+``key``) and ``finished(point, result)``, called in this process as each point ends.  The local pool starts fresh
+processes from a fork server that preloads ``run``'s module, never runs the calling script again, and ends
+cleanly on Ctrl-C (its workers leave the signal to the parent); a Dask worker runs each point with glibc's
+malloc thresholds as a plain process has them.
 """
 
 from __future__ import annotations
@@ -68,12 +69,15 @@ def run_pool(run, pending, workers: int, finished) -> None:
         run_futures(pool, run, pending, finished, start=_workers_starting)
     except BaseException:
         processes = list((getattr(pool, "_processes", None) or {}).values())
+        manager = getattr(pool, "_executor_manager_thread", None)  # shutdown() forgets it
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:  # the pool's own workers, which this call started
             if process.is_alive():
                 process.terminate()
         for process in processes:
             process.join(timeout=10)
+        if manager is not None:  # it closes its wake-up pipe as it ends: Python 3.11's exit hook then skips it,
+            manager.join(timeout=10)  # where it raced the close (EBADF and a traceback after "interrupted")
         raise
     pool.shutdown()
 

@@ -24,7 +24,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal
 
 ANTI_ALIAS_FRACTION = 0.8
 STEADY_CYCLES = 3
@@ -45,6 +44,8 @@ def resample(t: np.ndarray, x: np.ndarray, grid: np.ndarray) -> np.ndarray:
     fs_new = (grid.size - 1) / (grid[-1] - grid[0])
     cutoff = ANTI_ALIAS_FRACTION * 0.5 * fs_new
     if cutoff < 0.5 * fs_old:
+        from scipy import signal  # here: importing scipy.signal costs 0.4 s, which most commands never need
+
         sos = signal.butter(8, cutoff, fs=fs_old, output="sos")
         x = signal.sosfiltfilt(sos, x, axis=0)
     return resample_at(t, x, grid)
@@ -115,6 +116,8 @@ def steady_state(t: np.ndarray, groups, settle: float | None) -> tuple[float | N
 
 def sensor_filter(x: np.ndarray, fs: float, band: tuple[float, float]) -> np.ndarray:
     """Band-pass ``x`` (time along axis 0) to ``band`` = (low, high) Hz, zero phase."""
+    from scipy import signal
+
     low, high = band
     sos = signal.butter(4, [low, high], btype="bandpass", fs=fs, output="sos")
     return signal.sosfiltfilt(sos, x, axis=0)
@@ -122,6 +125,8 @@ def sensor_filter(x: np.ndarray, fs: float, band: tuple[float, float]) -> np.nda
 
 def estimate_lag(a: np.ndarray, b: np.ndarray, fs: float, max_lag: float) -> float:
     """Delay (s) of ``b`` behind ``a`` (positive: b happens later) on a uniform grid of rate ``fs``."""
+    from scipy import signal
+
     a = np.asarray(a, dtype=float) - np.mean(a)
     b = np.asarray(b, dtype=float) - np.mean(b)
     n = a.size

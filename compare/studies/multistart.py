@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import qmc
 
 SEED = 20261129
 SAME_MINIMUM = 1e-2  # in the fitted coordinates (ln p: 1 %), far above the solvers' tolerances, far below a basin
@@ -51,6 +50,8 @@ class MultiStart:
 
 def start_points(x0: np.ndarray, low: np.ndarray, high: np.ndarray, count: int) -> np.ndarray:
     """``x0`` and ``count - 1`` points of a Latin hypercube in the box [low, high] (seed :data:`SEED`)."""
+    from scipy.stats import qmc  # here: importing scipy.stats costs 0.2 s, which only a fit needs
+
     design = qmc.LatinHypercube(d=len(x0), rng=SEED).random(count - 1)
     return np.vstack([x0, low + design * (high - low)])
 

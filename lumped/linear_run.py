@@ -286,16 +286,17 @@ def linear_result(model, train, t, q, v, qdd, q0, info) -> TimeResult:
     """The named signals of a run (see the module docstring); ``q0`` its starting state, whose mesh forces are
     the static ones the load factor divides by."""
     mapped = train is not None and bool(model.physical_map())
-    signals, columns = coordinate_signals(model.coordinates, model.descriptions, model.name,
-                                          compared=not mapped), []
-    for j in range(model.n):
-        columns += [qdd[:, j], q[:, j], v[:, j]]
-    static = {}
+    signals = coordinate_signals(model.coordinates, model.descriptions, model.name, compared=not mapped)
+    columns, static = [], {}
     if mapped:
-        named, values, static = _train_signals(model, train, t, q, v, qdd, q0, {s.name for s in signals})
-        signals, columns = signals + named, columns + values
-    return TimeResult(model.name, model.name, np.asarray(t), signals, np.column_stack(columns), 0.0, info,
-                      static=static)
+        named, columns, static = _train_signals(model, train, t, q, v, qdd, q0, {s.name for s in signals})
+        signals = signals + named
+    values = np.empty((len(t), 3 * model.n + len(columns)))
+    for k, x in enumerate((qdd, q, v)):  # per coordinate its acceleration, displacement and velocity
+        values[:, k:3 * model.n:3] = x
+    for j, column in enumerate(columns, start=3 * model.n):
+        values[:, j] = column
+    return TimeResult(model.name, model.name, np.asarray(t), signals, values, 0.0, info, static=static)
 
 
 def _train_signals(model, train, t, q, v, qdd, q0, taken=frozenset()):

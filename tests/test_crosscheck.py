@@ -76,6 +76,14 @@ def test_reports_identical_across_runs(tmp_path, capsys):
     assert data["schema"] == "gearcheck.crosscheck" and data["schema_version"] == 2
     assert data["quantities"][0]["reference"]["rms"]["unit"] == "m/s^2"
     assert data["provenance"]["mujoco_version"] and data["provenance"]["train_sha256"]
+    # a report asked for its numbers only: the same report.json, no figure, and its pages say so
+    assert main(["crosscheck", "demo-3p", "--duration", DURATION, "--no-figures", "--out", str(tmp_path / "c")]) == 0
+    assert sorted(p.name for p in (tmp_path / "c").iterdir()) == [".gearcheck", "report.html", "report.json",
+                                                                  "report.md"]
+    assert _strip_volatile(tmp_path / "c" / "report.json") == _strip_volatile(tmp_path / "a" / "report.json")
+    for page in ("report.md", "report.html"):
+        text = (tmp_path / "c" / page).read_text()
+        assert "Not drawn: the report was asked for its numbers only" in text and ".png" not in text, page
 
 
 def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
@@ -83,7 +91,8 @@ def test_all_presets_against_their_shipped_baselines(tmp_path, capsys):
     (package data: this also fails when the installed package lacks them)."""
     # double-planet cannot settle from rest in the baselines' 0.05 s (its 145 Hz mode, damping ratio 0.28 %, rings
     # for 2.5 s): both of its runs start on their periodic steady states, and it is decided like the others
-    assert main(["crosscheck", "--all", "--baseline", "--out", str(tmp_path)]) == 0  # the baselines' duration
+    # the baselines' duration; no figures: the numbers are the same (test_reports_identical_across_runs)
+    assert main(["crosscheck", "--all", "--baseline", "--no-figures", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert {r["train"] for r in summary["trains"]} == set(preset_names())
     assert all(r["moved"] == 0 and r["failed"] == 0 for r in summary["trains"])

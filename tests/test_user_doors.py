@@ -195,7 +195,8 @@ def outcome(tmp_path, door: str, content: str) -> tuple[int, str, list[str]]:
     args = _door(tmp_path, door, CONTENTS[content][0]())
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        status = main(["crosscheck", TRAIN, *args, "--duration", "0.05", "--out", str(tmp_path / "report")])
+        status = main(["crosscheck", TRAIN, *args, "--duration", "0.05", "--no-figures", "--out",
+                       str(tmp_path / "report")])
     if status == INVALID:
         assert not (tmp_path / "report").exists()
         return status, err.getvalue().strip(), []

@@ -205,13 +205,14 @@ class CrosscheckResult:
                                                         f"a compared quantity of {self.spec.name}")
         return time_histories_figure(self, names)
 
-    def write(self, directory) -> dict:
-        """Write report.json, report.md, report.html and the figures as the folder ``directory``, whole or
-        not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the report's data."""
+    def write(self, directory, figures: bool = True) -> dict:
+        """Write report.json, report.md, report.html and the figures (none with ``figures=False``) as the folder
+        ``directory``, whole or not at all (:class:`~gearcheck.shared.outputs.OutputDirectory`); returns the
+        report's data."""
         from gearcheck.compare.presentation.report import write_report
 
         with OutputDirectory(directory, "directory") as place:
-            return write_report(self, place.path)
+            return write_report(self, place.path, figures)
 
 
 def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSettings], tolerances: Tolerances,

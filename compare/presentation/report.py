@@ -422,12 +422,17 @@ def _summary_lines(data) -> list[str]:
     ]
 
 
-def write_markdown(data, path: Path, figures: list[str]) -> None:
+NOT_DRAWN = "Not drawn: the report was asked for its numbers only (`--no-figures`, `figures=False`)."
+
+
+def write_markdown(data, path: Path, figures: list[str] | None) -> None:
+    """report.md; ``figures``: the names of the figures drawn beside it (None: none were asked for)."""
     verdict, counts, reasons = banner(data)
     lines = [f"# gearcheck cross-check: {data['train']['name']}", "", f"Verdict: **{verdict}** — {counts}", ""]
-    if reasons or "failing.png" in figures:
+    failing = "failing.png" in (figures or ())
+    if reasons or failing:
         lines += [f"{r}." for r in reasons]
-        lines += ["Failing quantities plotted: [failing.png](failing.png)."] if "failing.png" in figures else []
+        lines += ["Failing quantities plotted: [failing.png](failing.png)."] if failing else []
         lines.append("")
     lines += [f"- {line}" for line in _summary_lines(data)]
     lines += ["", _run_line(data), ""]
@@ -438,7 +443,7 @@ def write_markdown(data, path: Path, figures: list[str]) -> None:
         lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         lines += ["| " + " | ".join(r) + " |" for r in rows]
         lines.append("")
-    lines += ["## Figures", ""] + [f"![{f}]({f})" for f in figures] + [""]
+    lines += ["## Figures", ""] + ([f"![{f}]({f})" for f in figures] if figures is not None else [NOT_DRAWN]) + [""]
     lines += ["## References", ""] + [f"- [{r['key']}] {r['citation']}" for r in data["references"]] + [""]
     path.write_text("\n".join(lines), encoding="utf-8")
 
@@ -446,12 +451,13 @@ def write_markdown(data, path: Path, figures: list[str]) -> None:
 OPEN_ROWS = 12  # a table longer than this, with nothing failing or unresolved in it, starts folded in the HTML
 
 
-def write_html(data, path: Path, figure_paths: list[Path]) -> None:
+def write_html(data, path: Path, figure_paths: list[Path] | None) -> None:
+    """report.html, one page with ``figure_paths`` (the figures drawn) embedded (None: none were asked for)."""
     esc = html.escape
     title = f"gearcheck cross-check: {data['train']['name']}"
     parts = [f"<h1>{esc(title)}</h1>"]
     verdict, counts, reasons = banner(data)
-    names = [fig.name for fig in figure_paths]
+    names = [fig.name for fig in figure_paths or ()]
     parts.append(f"<div class=\"banner {verdict}\"><span class=\"verdict\">{verdict}</span>{esc(counts)}"
                  + "".join(f"<p>{esc(r)}.</p>" for r in reasons)
                  + ("<p><a href=\"#failing.png\">Failing quantities plotted</a>.</p>" if "failing.png" in names
@@ -473,7 +479,9 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
             parts.append(f"<tr{cls}>" + "".join(f"<td>{esc(c)}</td>" for c in r) + "</tr>")
         parts.append("</table></details>")
     parts.append("<h2>Figures</h2>")
-    for fig in figure_paths:
+    if figure_paths is None:
+        parts.append(f"<p>{esc(NOT_DRAWN.replace('`', ''))}</p>")
+    for fig in figure_paths or ():
         encoded = base64.b64encode(fig.read_bytes()).decode("ascii")
         parts.append(f"<figure id=\"{esc(fig.name)}\"><img alt=\"{esc(fig.name)}\" "
                      f"src=\"data:image/png;base64,{encoded}\"><figcaption>{esc(fig.name)}</figcaption></figure>")
@@ -482,22 +490,27 @@ def write_html(data, path: Path, figure_paths: list[Path]) -> None:
     path.write_text(page(title, "\n".join(parts)), encoding="utf-8")
 
 
-def write_report(result, directory) -> dict:
+def write_report(result, directory, figures: bool = True) -> dict:
     """Write report.json, report.md, report.html and the PNG figures into the folder ``directory`` (made if
-    missing); return the JSON dict.  :meth:`CrosscheckResult.write` writes them whole or not at all."""
-    from gearcheck.compare.presentation.plots import FIGURES  # matplotlib only when a report is written
-
+    missing); return the JSON dict.  :meth:`CrosscheckResult.write` writes them whole or not at all.
+    ``figures=False``: no figures (a CI job that reads the numbers; drawing them is a third of a cross-check's
+    time), which report.md and report.html say; report.json is the same either way."""
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     data = to_dict(result)
-    figures = []
-    for name, draw in FIGURES.items():
-        if draw(result, out / name) is not False:  # False: nothing to draw (no modes, nothing failing)
-            figures.append(name)
+    drawn = _draw(result, out) if figures else None
     (out / "report.json").write_text(json.dumps(data, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-    write_markdown(data, out / "report.md", figures)
-    write_html(data, out / "report.html", [out / f for f in figures])
+    write_markdown(data, out / "report.md", drawn)
+    write_html(data, out / "report.html", None if drawn is None else [out / f for f in drawn])
     return data
+
+
+def _draw(result, out: Path) -> list[str]:
+    """The report's figures drawn into ``out``: the names of those drawn."""
+    from gearcheck.compare.presentation.plots import FIGURES  # matplotlib only when a figure is drawn
+
+    # False: nothing to draw (no modes, nothing failing)
+    return [name for name, draw in FIGURES.items() if draw(result, out / name) is not False]
 
 
 # ------------------------------------------------------------------------------ JSON Schema of report.json

@@ -19,6 +19,7 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 
+from gearcheck.compare.studies import point_backends as backends
 from gearcheck.compare.studies import sweep as sw
 from gearcheck.shared.outputs import MARKER
 
@@ -132,3 +133,17 @@ def test_ctrl_c_on_two_worker_processes_ends_cleanly_and_the_sweep_resumes(tmp_p
     stdout, stderr = _finish(whole)
     assert whole.returncode == 0, stderr
     assert (out / "sweep.parquet").read_bytes() == (tmp_path / "whole" / "sweep.parquet").read_bytes()
+
+
+def test_an_interrupted_pool_has_closed_its_wake_up_pipe_when_it_returns():
+    """The pool's manager thread closes its wake-up pipe as it ends, and Python 3.11's exit hook writes to every
+    pipe not yet closed: an interrupted pool must have waited for that thread before the command goes on to exit,
+    or the two race (a traceback of EBADF after "gearcheck: interrupted", seen in CI)."""
+    from concurrent.futures import process
+
+    def finished(point, result):
+        raise KeyboardInterrupt  # Ctrl-C while the first result is handled
+
+    with pytest.raises(KeyboardInterrupt):
+        backends.run_pool(abs, [1, -2, 3, -4], 2, finished)
+    assert all(wakeup._closed for wakeup in process._threads_wakeups.values())

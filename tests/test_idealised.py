@@ -3,8 +3,6 @@ their published Table 2, the mode-type rules of their paper, both solvers, and b
 
 import math
 import re
-import subprocess
-import sys
 import warnings
 from pathlib import Path
 
@@ -12,6 +10,7 @@ import numpy as np
 import pytest
 
 from gearcheck import Train
+from gearcheck.cli import main
 from gearcheck.shared.errors import TrainNote
 from gearcheck.train.kinematics import kinematics
 from gearcheck.train.loader import load_text, preset_text
@@ -168,9 +167,10 @@ def test_a_toothed_train_at_rest_has_the_modes_of_its_operating_point():
                        rtol=1e-12)
 
 
-def run(tmp_path, *args):
-    return subprocess.run([sys.executable, "-m", "gearcheck", *map(str, args)], capture_output=True, text=True,
-                          cwd=tmp_path)
+def run(capsys, *args) -> tuple[int, str, str]:
+    """(exit status, stdout, stderr) of the command line run in this process."""
+    status = main([str(a) for a in args])
+    return status, *capsys.readouterr()
 
 
 BAD = {
@@ -202,14 +202,14 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", BAD, ids=list(BAD))
-def test_bad_idealised_input_is_one_line(tmp_path, case):
+def test_bad_idealised_input_is_one_line(tmp_path, capsys, case):
     edits, expected = BAD[case]
     path = tmp_path / "bad.toml"
     path.write_text(lin_parker(edits=edits), encoding="utf-8")
-    result = run(tmp_path, "modes", path)
-    assert result.returncode == 2 and result.stdout == ""
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {path}: {expected}"), result.stderr
+    status, out, err = run(capsys, "modes", path)
+    assert status == 2 and out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {path}: {expected}"), err
 
 
 @pytest.mark.parametrize("command, speed, field", [
@@ -218,14 +218,14 @@ def test_bad_idealised_input_is_one_line(tmp_path, case):
     ("run", "100", "stages[0].planet.teeth: missing: a time run needs the teeth of idealised stage stage1"),
     ("crosscheck", "100", "stages[0].planet.teeth: missing: a cross-check (its time runs) needs the teeth"),
 ])
-def test_time_runs_need_a_mesh_cycle(tmp_path, command, speed, field):
+def test_time_runs_need_a_mesh_cycle(tmp_path, capsys, command, speed, field):
     """At rest, or with an idealised stage, a time run and a cross-check are refused in one line naming the field,
     exit 2, nothing written."""
     args = [command, LIN_PARKER, "-q", "--out", tmp_path / "out"] + (["--speed", speed] if speed else [])
     if command == "run":
         args += ["--solver", "lumped"]
-    result = run(tmp_path, *args)
-    assert result.returncode == 2 and result.stdout == ""
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {LIN_PARKER}: {field}"), result.stderr
+    status, out, err = run(capsys, *args)
+    assert status == 2 and out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {LIN_PARKER}: {field}"), err
     assert not (tmp_path / "out").exists()

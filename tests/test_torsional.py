@@ -8,7 +8,6 @@ bearings stiffen (converging as 1/k), the twin's modes, the count of its modes; 
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 import warnings
 from pathlib import Path
@@ -174,12 +173,12 @@ def test_ignored_supports_are_noted():
         edited("demo-3p", [STAGE])
 
 
-def run(tmp_path, text):
+def run(tmp_path, capsys, text) -> tuple[Path, int, str, str]:
+    """(the file, exit status, stdout, stderr) of ``gearcheck modes`` on ``text``, in this process."""
     path = tmp_path / "bad.toml"
     path.write_text(text, encoding="utf-8")
-    result = subprocess.run([sys.executable, "-m", "gearcheck", "modes", str(path), "-q"], capture_output=True,
-                            text=True, cwd=tmp_path)
-    return path, result
+    status = main(["modes", str(path), "-q"])
+    return path, status, *capsys.readouterr()
 
 
 @pytest.mark.parametrize("text, expected", [
@@ -190,11 +189,11 @@ def run(tmp_path, text):
     (chained_text(2, 1e8).replace("planets = 3", "planets = 3\ntorsional = true", 1),
      "couplings[0].radial_stiffness: 1e+08 in a train with torsional members"),
 ], ids=["stage", "member", "radial coupling"])
-def test_bad_input_is_one_line(tmp_path, text, expected):
-    path, result = run(tmp_path, text)
-    assert result.returncode == 2 and result.stdout == ""
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {path}: {expected}"), result.stderr
+def test_bad_input_is_one_line(tmp_path, capsys, text, expected):
+    path, status, out, err = run(tmp_path, capsys, text)
+    assert status == 2 and out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {path}: {expected}"), err
 
 
 def test_an_rv_reducer_has_no_torsional_level():

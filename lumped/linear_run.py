@@ -29,6 +29,7 @@ from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.modal import central_coordinates
 from gearcheck.lumped.time_solver import rk4_step
 from gearcheck.shared import stepping
+from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.errors import DivergenceError, UnsupportedError
 from gearcheck.shared.modal import ModalResult, modal_result, multiplicities, speed_modal_result
 from gearcheck.shared.results import TimeResult, coordinate_signals, member_columns, train_signals
@@ -100,6 +101,7 @@ def default_step(model) -> float:
     return stepping.default_step(step_limits(model), [1.0 / p for p in periods])
 
 
+@one_blas_thread
 def simulate_linear(model, settings: RunSettings, train=None, progress=None, y0=None) -> TimeResult:
     """Fixed-step RK4 of the model from ``y0`` (q, q') or its own start; ``train`` (spec, kin, dofs of the train, or
     None) names its signals.  The step defaults to :func:`default_step`; a step beyond RK4's stability limit is

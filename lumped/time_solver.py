@@ -34,6 +34,7 @@ from gearcheck.lumped.frame_schedule import with_schedule
 from gearcheck.lumped.member_motion import member_motion
 from gearcheck.lumped.static import mean_load, static_solution
 from gearcheck.shared import divergence, stepping
+from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.contact_laws import deadzone
 from gearcheck.shared.errors import DivergenceError, SolverError
 from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together, first_crossing, pair_switch,
@@ -180,6 +181,7 @@ def mechanical_energy(model, q, v) -> np.ndarray:
     return 0.5 * np.einsum("ti,ij,tj->t", v, model.M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, K, q) - q @ F
 
 
+@one_blas_thread
 def simulate(model, settings: RunSettings, method: str = "rk4", rtol: float = 1e-8, atol: float = 1e-14, y0=None,
              progress=None, return_state: bool = False) -> TimeResult:
     """Integrate ``model`` as ``settings`` ask.

@@ -59,6 +59,7 @@ from gearcheck.compare.engine.metrics import waveform_metrics
 from gearcheck.compare.engine.mode_pairing import pair_modes
 from gearcheck.compare.engine.reduction import reduced_reference
 from gearcheck.compare.engine.tolerances import Tolerances
+from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.errors import SolverError, UnsupportedError, did_you_mean
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory
@@ -215,6 +216,7 @@ class CrosscheckResult:
             return write_report(self, place.path, figures)
 
 
+@one_blas_thread
 def compare(spec, reference, test, plan, settings: tuple[RunSettings, RunSettings], tolerances: Tolerances,
             sensor_band: tuple[float, float] | None = None, progress=None) -> CrosscheckResult:
     """Cross-check ``test`` against ``reference`` (two :class:`~gearcheck.shared.side.Side`) as ``plan`` reads

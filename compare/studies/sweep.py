@@ -68,7 +68,6 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import tomli_w
-from threadpoolctl import threadpool_limits
 
 from gearcheck.compare.studies import continuation as continued
 from gearcheck.compare.studies import point_backends as backends
@@ -84,6 +83,7 @@ from gearcheck.lumped.side import LumpedSide
 from gearcheck.train.files import MAX_DATA_BYTES, read_bytes
 from gearcheck.train.spec import TrainSpec, beside
 from gearcheck.mbd_models.side import MujocoSide
+from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory, check_place
@@ -511,14 +511,10 @@ def run_chain(chain: continued.Chain, each=None) -> list[tuple[str, bytes, float
     return done
 
 
+@one_blas_thread
 def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, float]:
     """Run ``point`` (from ``before``, its predecessor's table, where it goes on from one): (its table as Parquet
     bytes, wall time in s, CPU time of this process in s); see :func:`run_chain`."""
-    with threadpool_limits(limits=1):
-        return _run_point(point, before)
-
-
-def _run_point(point: Point, before: bytes | None) -> tuple[bytes, float, float]:
     started, cpu = time.perf_counter(), time.process_time()
     spec = load_train(load_text(point.text, point.source), point.speed_rpm)
     lumped = LumpedSide(spec)

@@ -12,6 +12,7 @@ from types import SimpleNamespace
 import pytest
 
 from gearcheck.api import compile_kernels, crosscheck
+from gearcheck.cli import main
 from gearcheck.train.loader import preset_names
 
 os.environ.setdefault("GEARCHECK_DEBUG", "1")  # a fault of gearcheck's own raises in a test, with its traceback
@@ -26,6 +27,20 @@ def preset(request):
 def demo_check():
     """demo-3p cross-checked over 0.05 s, one run for every test that reads it (a worker's tests share it)."""
     return crosscheck("demo-3p", duration=0.05)
+
+
+@pytest.fixture
+def refused(capsys):
+    """``refused(argv)``: the command line, run in this process, refuses ``argv`` as bad input: exit status 2,
+    nothing on stdout, one line on stderr (``gearcheck: error: ...``, no traceback), which it returns."""
+    def run(argv) -> str:
+        status = main([str(a) for a in argv])
+        out, err = capsys.readouterr()
+        assert status == 2 and out == "", (status, out, err)
+        lines = err.splitlines()
+        assert len(lines) == 1 and lines[0].startswith("gearcheck: error: ") and "Traceback" not in err, err
+        return lines[0]
+    return run
 
 
 CHROMIUM = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")

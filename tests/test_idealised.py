@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from gearcheck import Train
-from gearcheck.cli import main
 from gearcheck.shared.errors import TrainNote
 from gearcheck.train.kinematics import kinematics
 from gearcheck.train.loader import load_text, preset_text
@@ -167,12 +166,6 @@ def test_a_toothed_train_at_rest_has_the_modes_of_its_operating_point():
                        rtol=1e-12)
 
 
-def run(capsys, *args) -> tuple[int, str, str]:
-    """(exit status, stdout, stderr) of the command line run in this process."""
-    status = main([str(a) for a in args])
-    return status, *capsys.readouterr()
-
-
 BAD = {
     "module": ([(r"^pressure_angle_deg = 24.6$", "pressure_angle_deg = 24.6\nmodule_mm = 3.0")],
                "stages[0].module_mm: an idealised stage (no teeth) has no module"),
@@ -202,14 +195,12 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", BAD, ids=list(BAD))
-def test_bad_idealised_input_is_one_line(tmp_path, capsys, case):
+def test_bad_idealised_input_is_one_line(tmp_path, refused, case):
     edits, expected = BAD[case]
     path = tmp_path / "bad.toml"
     path.write_text(lin_parker(edits=edits), encoding="utf-8")
-    status, out, err = run(capsys, "modes", path)
-    assert status == 2 and out == ""
-    lines = err.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {path}: {expected}"), err
+    line = refused(["modes", path])
+    assert line.startswith(f"gearcheck: error: {path}: {expected}"), line
 
 
 @pytest.mark.parametrize("command, speed, field", [
@@ -218,14 +209,12 @@ def test_bad_idealised_input_is_one_line(tmp_path, capsys, case):
     ("run", "100", "stages[0].planet.teeth: missing: a time run needs the teeth of idealised stage stage1"),
     ("crosscheck", "100", "stages[0].planet.teeth: missing: a cross-check (its time runs) needs the teeth"),
 ])
-def test_time_runs_need_a_mesh_cycle(tmp_path, capsys, command, speed, field):
+def test_time_runs_need_a_mesh_cycle(tmp_path, refused, command, speed, field):
     """At rest, or with an idealised stage, a time run and a cross-check are refused in one line naming the field,
     exit 2, nothing written."""
     args = [command, LIN_PARKER, "-q", "--out", tmp_path / "out"] + (["--speed", speed] if speed else [])
     if command == "run":
         args += ["--solver", "lumped"]
-    status, out, err = run(capsys, *args)
-    assert status == 2 and out == ""
-    lines = err.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"gearcheck: error: {LIN_PARKER}: {field}"), err
+    line = refused(args)
+    assert line.startswith(f"gearcheck: error: {LIN_PARKER}: {field}"), line
     assert not (tmp_path / "out").exists()

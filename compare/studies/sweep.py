@@ -54,7 +54,6 @@ import dataclasses
 import functools
 import hashlib
 import importlib.metadata
-import io
 import itertools
 import json
 import math
@@ -66,7 +65,6 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.parquet as pq
 import tomli_w
 
 from gearcheck.compare.studies import continuation as continued
@@ -83,6 +81,7 @@ from gearcheck.lumped.side import LumpedSide
 from gearcheck.train.files import MAX_DATA_BYTES, read_bytes
 from gearcheck.train.spec import TrainSpec, beside
 from gearcheck.mbd_models.side import MujocoSide
+from gearcheck.shared import parquet_bytes
 from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.selection import chosen
@@ -555,9 +554,8 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
         states[solver] = continued.kept(run.state, run.rho, run.shapes)
     metadata = {KEY: point.key, continued.STATE: json.dumps(states, sort_keys=True),
                 continued.START: next((run.start for _, run in runs.values()), "")}
-    sink = io.BytesIO()
-    pq.write_table(rows.table().replace_schema_metadata(metadata), sink, compression="zstd")
-    return sink.getvalue(), time.perf_counter() - started, time.process_time() - cpu
+    data = parquet_bytes.to_bytes(rows.table().replace_schema_metadata(metadata))
+    return data, time.perf_counter() - started, time.process_time() - cpu
 
 
 def _checked(point: Point, lines: list[float], natural: np.ndarray, damping: np.ndarray) -> str:
@@ -826,7 +824,7 @@ def _readable(data: bytes, key: str) -> bool:
     """Whether ``data`` is a point's table, and the table of the point ``key`` (its inputs' hash, which every point
     table carries: a cache file renamed or copied over another is run again, never read as the other point)."""
     try:
-        schema = pq.read_table(io.BytesIO(data)).schema
+        schema = parquet_bytes.read_table(data).schema
         return schema.equals(POINT_SCHEMA) and (schema.metadata or {}).get(KEY.encode()) == key.encode()
     except Exception:  # a damaged cache file is run again
         return False
@@ -852,7 +850,7 @@ def assemble(plan: SweepPlan, tables: dict) -> pa.Table:
     """The sweep table: every point's rows, in point order, with the point's inputs as leading columns."""
     parts = []
     for p in plan.points:
-        t = pq.read_table(io.BytesIO(tables[p.key]))
+        t = parquet_bytes.read_table(tables[p.key])
         n = t.num_rows
         inputs = {"point": pa.array([p.index] * n, pa.int64()), "sample": pa.array([p.sample] * n, pa.int64()),
                   "seed": pa.array([p.seed] * n, pa.int64()),
@@ -890,12 +888,6 @@ def table_schema(plan: SweepPlan) -> pa.Schema:
             "gearcheck.units": json.dumps({k: {"unit": u, "description": d} for k, (u, d) in units.items()},
                                           sort_keys=True)}
     return unit_schema(pa.schema(head + list(POINT_SCHEMA) + [pa.field("key", pa.string())], metadata=meta), units)
-
-
-def parquet_bytes(table: pa.Table) -> bytes:
-    sink = io.BytesIO()
-    pq.write_table(table, sink, compression="zstd")
-    return sink.getvalue()
 
 
 # ----------------------------------------------------------------------------- the result
@@ -947,7 +939,7 @@ class SweepResult:
 
     def parquet(self) -> bytes:
         """The table as Parquet bytes: the same inputs give the same bytes."""
-        return parquet_bytes(self.table)
+        return parquet_bytes.to_bytes(self.table)
 
     def summary(self) -> dict:
         frame = self.to_pandas()

@@ -67,10 +67,10 @@ def _csv(text: str, label: str):
 
 
 def _parquet(data: bytes, label: str):
-    import pyarrow.parquet as pq
+    from gearcheck.shared import parquet_bytes  # pyarrow only when a profile is a Parquet file
 
     try:
-        table = pq.read_table(io.BytesIO(data))
+        table = parquet_bytes.read_table(data)
     except Exception as exc:  # pyarrow raises many kinds on a damaged file
         raise GearcheckError(f"{label}: cannot be read as Parquet: {one_line(exc)}") from None
     if table.num_columns != 2:

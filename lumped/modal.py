@@ -5,11 +5,15 @@
 * :func:`modes_at_speed`: the gyroscopic eigenproblem (M s^2 + Omega G s + K_mean + K_Omega) x = 0 of the
   train turning at a speed (Cooley & Parker 2012): complex s, frequency splitting of the degenerate
   modes, divergence and flutter where the centripetal softening wins;
-* :func:`settling_time`: how long the damped free vibration of a start lasts.
+* :func:`settling_time`: how long the damped free vibration of a start lasts;
+* :func:`line_resonances`: the modes each mesh-harmonic line can drive (mesh-phasing selection rules).
 """
 
 from __future__ import annotations
 
+import numpy as np
+
+from gearcheck.lumped.static import static_solution
 from gearcheck.train.spec import AXIAL, ROTATION
 from gearcheck.shared import modal as shared
 from gearcheck.shared.modal import ModalResult, modal_result
@@ -48,3 +52,42 @@ def settling_time(model, fraction: float) -> float:
     ``fraction`` (its slowest-decaying mode): how long a run from the static state needs before its
     start has died away."""
     return shared.settling_time(model.M, model.C + model.G, model.K_mean + model.K_frame, fraction)
+
+
+DRIVEN = 1e-6  # a line drives a mode if it drives it more than this, relative to the mode it drives most
+CYCLE_SAMPLES = 4096  # a mesh cycle's stiffness samples for its Fourier coefficients
+
+
+def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For each line (mesh frequency in Hz, harmonic k) of ``lines``, (natural frequencies in Hz, damping
+    ratios) of the modes of the damped, rotating model at mean mesh stiffness that the line drives.
+
+    A line is forced by the meshes of its frequency: to first order, mesh m's force k_m(t) (a_m.q - e_m(t))
+    puts into it a_m (c_mk d_m - k_m E_mk) e^(-2 pi i k phi_m), c_mk the k-th Fourier coefficient of its
+    stiffness over a mesh cycle, d_m its static elastic deflection (static force over mean stiffness k_m), E_mk
+    that of its static transmission error's harmonic k, phi_m its mesh phase (Parker & Lin 2004).  The planets'
+    phases cancel the sum on whole families of modes (rotational modes only where k z_s is a multiple of the
+    number N of equally spaced planets, translational ones where k z_s = +-1 mod N, Parker 2000).  A mode counts
+    where the line drives it (:func:`gearcheck.shared.modal.driven_modes`) more than :data:`DRIVEN` of the mode
+    it drives most: over the speed ranges of the hub drive, the helical planetary, the RV reducer and demo-3p,
+    the cancelled ones sit at round-off (1.3e-10 and below), the driven ones at 4e-4 and above.  A gear's
+    eccentricity forces its rotation frequency, off the lines.  Where a mesh's force is not linear in its
+    deflection (tip relief) or a torque ripple may fall on a line, every mode counts for every line."""
+    exc = model.excitation
+    M, D, K = model.M, model.C + model.G, model.K_mean + model.K_frame
+    if exc.relieved.size or exc.ripple:
+        natural, damping = shared.damped_modes(M, D, K)
+        return [(natural, damping)] * len(lines)
+    deflection = static_solution(model).mesh_force / exc.mean_stiffness
+    xi = np.arange(CYCLE_SAMPLES) / CYCLE_SAMPLES
+    shapes = [stiffness(xi) for stiffness in exc.models]
+    forces = np.zeros((M.shape[0], len(lines)), dtype=complex)
+    for i, (frequency, k) in enumerate(lines):
+        for m in np.flatnonzero(np.isclose(exc.frequency, frequency, rtol=1e-9, atol=0.0)):
+            c = np.mean(shapes[m] * np.exp(-2j * np.pi * k * xi))
+            error = sum(0.5 * amplitude * np.exp(1j * phase)
+                        for h, amplitude, phase in model.spec.meshes[m].ste if h == k)
+            weight = c * deflection[m] - exc.mean_stiffness[m] * error
+            forces[:, i] += model.mesh_rows[m] * weight * np.exp(-2j * np.pi * k * exc.phase[m])
+    natural, damping, cosines = shared.driven_modes(M, D, K, forces)
+    return [(natural[driven], damping[driven]) for driven in (cosines > DRIVEN).T]

@@ -20,12 +20,12 @@ from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import EXTRA_DOMINATED, linear_modes, linear_modes_at_speed, set_aside, simulate_linear
 from gearcheck.lumped.linear_run import default_step as linear_default_step, periodic_start, step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
-from gearcheck.lumped.modal import modes, modes_at_speed, settling_time
+from gearcheck.lumped.modal import line_resonances, modes, modes_at_speed, settling_time
 from gearcheck.lumped.periodic_steady_state import periodic_steady_state
 from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
 from gearcheck.shared import stepping
-from gearcheck.shared.modal import ModalResult, damped_modes, slowest_decaying_mode
+from gearcheck.shared.modal import ModalResult, slowest_decaying_mode
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
@@ -90,10 +90,11 @@ class LumpedSide(Side):
         m = self.model
         return slowest_decaying_mode(m.M, m.C + m.G, m.K_mean + m.K_frame)
 
-    def resonances(self) -> tuple[np.ndarray, np.ndarray]:
-        """(natural frequencies in Hz, damping ratios) of the damped, rotating model at mean mesh stiffness."""
-        m = self.model
-        return damped_modes(m.M, m.C + m.G, m.K_mean + m.K_frame)
+    def resonances(self, lines) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(natural frequencies in Hz, damping ratios) of the modes of the damped, rotating model at mean mesh
+        stiffness that each line (mesh frequency in Hz, harmonic) drives
+        (:func:`~gearcheck.lumped.modal.line_resonances`)."""
+        return line_resonances(self.model, lines)
 
     def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
         steady = periodic_steady_state(self.model, dt=settings.dt)

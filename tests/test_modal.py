@@ -7,7 +7,8 @@ import pytest
 
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.loader import load_train
-from gearcheck.lumped.modal import modes
+from gearcheck.lumped.modal import line_resonances, modes, modes_at_speed
+from gearcheck.shared.modal import driven_modes
 from gearcheck.train.variants import edited, wide_stage
 
 RIGID = "1.0e16"  # N/m or N·m/rad: supports this stiff perturb a 1e8..1e9 N/m mesh mode by O(1e-8)
@@ -69,6 +70,50 @@ def test_mode_multiplicities_for_equally_spaced_planets(n_planets):
     assert types.count("rotational") == 6
     assert types.count("translational") == 12
     assert types.count("planet") == 3 * (n_planets - 3)
+
+
+def test_a_force_drives_the_modes_it_is_not_orthogonal_to_whatever_their_basis():
+    """Two unit masses on springs 1 and 4 N/m, lightly damped: a force on the first drives its mode alone; one on
+    both drives both equally (a unit oscillator's velocity residue at its pole s is f s / (2 s + c), about f / 2
+    whatever its stiffness); springs 1 and 1 (a degenerate pair, in whatever basis the eigensolver picks): the
+    force on the first drives the pair."""
+    M, D = np.eye(2), 0.01 * np.eye(2)
+    f, zeta, drive = driven_modes(M, D, np.diag([1.0, 4.0]), np.array([[1.0, 1.0], [0.0, 1.0]]))
+    assert np.allclose(f, [1 / (2 * np.pi), 2 / (2 * np.pi)], rtol=1e-4) and np.allclose(zeta, [0.005, 0.0025])
+    assert drive[0, 0] == 1.0 and drive[1, 0] < 1e-12
+    assert np.allclose(drive[:, 1], 1.0)
+    _, _, drive = driven_modes(M, D, np.eye(2), np.array([[1.0], [0.0]]))
+    assert np.allclose(drive[:, 0], 1.0)
+
+
+@pytest.mark.parametrize("n_planets, teeth", [(3, (22, 20, 62)), (4, (30, 24, 78)), (5, (21, 24, 69)),
+                                              (6, (30, 24, 78))])
+def test_a_mesh_harmonic_drives_the_family_of_modes_its_planets_phasing_selects(n_planets, teeth):
+    """Parker (2000): with N equally spaced planets, the mesh harmonic k of a stage whose sun has z_s teeth drives
+    only the rotational modes where k z_s is a multiple of N, only the translational modes where k z_s = +-1
+    (mod N), only the planet modes otherwise.  Of each translational pair, split by the turning carrier's
+    gyroscopic terms, +1 and -1 drive one whirl each.  :func:`line_resonances` finds the same, from the mesh
+    forces' phases alone, on the rotating, damped model."""
+    spec = wide_stage(n_planets, teeth)
+    model = build_model(spec)
+    undamped = modes_at_speed(model, spec.operating.input_speed)
+    frequencies, types = np.asarray(undamped.frequencies), list(undamped.types)
+    mesh_frequency = model.excitation.frequency[0]
+    whirls = {}
+    for k in range(1, 2 * n_planets + 1):
+        natural, _ = line_resonances(model, [(mesh_frequency, k)])[0]
+        nearest = [int(np.argmin(np.abs(frequencies - f))) for f in natural]
+        assert np.allclose(frequencies[nearest], natural, rtol=2e-3)  # the damped modes are the undamped ones
+        residue = k * teeth[0] % n_planets
+        family = "rotational" if residue == 0 else "translational" if residue in (1, n_planets - 1) else "planet"
+        assert {types[i] for i in nearest} == {family}, k
+        if family == "translational":
+            whirls.setdefault(residue, set()).update(nearest)
+        else:
+            assert len(nearest) == types.count(family), k
+    if whirls:
+        assert len(whirls) == 2 and not whirls[1] & whirls[n_planets - 1]
+        assert len(whirls[1] | whirls[n_planets - 1]) == types.count("translational")
 
 
 def test_planet_mode_frequencies_independent_of_planet_count():

@@ -7,10 +7,10 @@ final state of the point at the neighbouring speed where the sweep continues (:m
 continuation`: its steady window starts once that start's mismatch has died away; ``start`` says how each point
 started), else from the static state with the steady window found by the cross-check's rule
 (:func:`gearcheck.compare.engine.align.steady_state` over the plan's mesh-force groups; without a steady state the
-second half, flagged ``steady = "none"``); on the checked points (``checked``: every ``CHECK_EVERY``-th speed and
-every point with a line in a mode's half-power band, or all) it runs each solver again from the same state at its
-check step (2 h, or h / 2).  It reduces the window to a tidy table, one row per (solver, quantity, metric, mesh,
-order), from the gated signals alone (the runs build no others):
+second half, flagged ``steady = "none"``); on the checked points (``checked``: every ``CHECK_EVERY``-th speed,
+every point with a line in the half-power band of a mode it drives or with a mesh that unloads, or all) it runs each
+solver again from the same state at its check step (2 h, or h / 2).  It reduces the window to a tidy table, one
+row per (solver, quantity, metric, mesh, order), from the gated signals alone (the runs build no others):
 
 * ``mean``, ``rms``, ``peak_to_peak`` of every quantity the cross-check gates, over the steady window;
 * ``harmonic``: amplitude and phase of each of them at the mesh harmonics k f_mesh, k = 1..``harmonics``, of
@@ -101,7 +101,8 @@ MAX_POINTS = 100_000  # each point carries its edited train file (some 10 kB): 1
 MAX_REFINE = 64
 MAX_HARMONICS = 20
 CHECKS = ("subset", "all", "none")  # which points get the integration check
-CHECK_EVERY = 8  # the subset: every CHECK_EVERY-th point, and every point with a line in a mode's half-power band
+CHECK_EVERY = 8  # the subset: every CHECK_EVERY-th point, every point with a line near a mode it drives, ...
+UNLOADED = 0.1  # ... and every point where a mesh with backlash or tip relief unloads below this of its mean force
 
 KEY = "gearcheck.point"  # a point table's metadata: the point's key (Point.key), checked when read from the cache
 POINT_SCHEMA = pa.schema([
@@ -140,7 +141,8 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
     "start": ("", "cold (from the static state), continued (from the previous speed's final state), or from the "
                   "static state because the continuation did not settle or the solvers' continuations parted"),
     "checked": ("", "why the point's integration error was estimated: all, every Nth (every Nth speed), "
-                    "resonance (a line in the half-power band of a mode), or no"),
+                    "resonance (a line in the half-power band of a mode it drives), contact (a mesh with backlash "
+                    "or tip relief unloads below a tenth of its mean force), or no"),
     "error": ("", "why a solver failed at this point (metric failed)"),
     "key": ("", "SHA-256 of the point's inputs: its cache file's name"),
 }
@@ -526,7 +528,6 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
             rows.add(solver="lumped", quantity=f"mode{k}", kind=kind, unit="Hz", metric="natural_frequency",
                      order=k, frequency_hz=float(f))
     lines = [(label, k, k * f) for label, f in mesh_groups(spec, model.kin) for k in range(1, point.harmonics + 1)]
-    checked = _checked(point, [f for _, _, f in lines], *lumped.resonances())
     runs, failed = {}, {}
     skip = point.after and continued.started(before) == continued.PARTED_START
     for solver in point.solvers:
@@ -538,6 +539,8 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
         except SolverError as exc:
             failed[solver] = str(exc)
     runs = _aligned(runs, point, plan, lines, failed)
+    checked = _checked(point, lines, lumped.resonances([(f / k, k) for _, k, f in lines]),
+                       any(_unloads(run, model.excitation) for _, run in runs.values()))
     states = {}
     for solver in point.solvers:
         if solver in failed:
@@ -558,18 +561,36 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
     return data, time.perf_counter() - started, time.process_time() - cpu
 
 
-def _checked(point: Point, lines: list[float], natural: np.ndarray, damping: np.ndarray) -> str:
+def _checked(point: Point, lines: list, resonances: list, unloads: bool) -> str:
     """Why ``point`` runs its integration check ("no": it does not): the sweep's ``check`` setting, and in the
-    subset, its place among the speeds (every :data:`CHECK_EVERY`-th) or a line in the half-power band of a mode
-    of the damped model (|f - f_n| <= zeta_n f_n, ``natural`` and ``damping``), where the response is amplified and
-    most sensitive to the step."""
+    subset, its place among the speeds (every :data:`CHECK_EVERY`-th), a line in the half-power band of a mode
+    of the damped model that it drives (|f - f_n| <= zeta_n f_n; ``resonances``, one (f_n, zeta_n) per line),
+    where the response is amplified and most sensitive to the step, or a mesh that ``unloads``
+    (:func:`_unloads`), where the response is not the linear one whose modes say where it is sensitive.  A mode
+    the line's mesh phasing leaves at rest is not amplified at its natural frequency, and does not make the point
+    checked."""
     if point.check != "subset":
         return "all" if point.check == "all" else "no"
     if point.place % CHECK_EVERY == 0:
         return f"every {CHECK_EVERY}th"
-    if any(np.any(np.abs(f - natural) <= damping * natural) for f in lines):
-        return "resonance"
-    return "no"
+    for (_, _, f), (natural, damping) in zip(lines, resonances):
+        if np.any(np.abs(f - natural) <= damping * natural):
+            return "resonance"
+    return "contact" if unloads else "no"
+
+
+def _unloads(run: "_SteadyRun", excitation) -> bool:
+    """Whether a mesh with backlash or tip relief falls below :data:`UNLOADED` of its mean force in the steady
+    window of ``run``: its contact parts or nearly does, and the response is no longer linear in it."""
+    result = run.result
+    window = result.t >= run.steady[0]
+    for j, mesh in enumerate(excitation.mesh_ids):
+        name = f"{mesh}.force"
+        if (excitation.backlash[j] > 0 or j in excitation.relieved) and name in result.names():
+            force = result[name][window]
+            if force.size and np.min(force) < UNLOADED * np.mean(force):
+                return True
+    return False
 
 
 @dataclass

@@ -110,10 +110,14 @@ def generalized_modes(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndar
 def quadratic_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Eigenpairs of (M s^2 + D s + K) x = 0 through the first-order form y = (x, s x): (s, x), x over the
     coordinates.  D holds damping and gyroscopic terms, K every stiffness term (rotating frame included)."""
+    s, y = np.linalg.eig(_first_order(M, D, K))
+    return s, y[:M.shape[0]]
+
+
+def _first_order(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """The matrix of y' = J y, y = (q, q'), of M q'' + D q' + K q = 0."""
     n = M.shape[0]
-    J = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, D)]])
-    s, y = np.linalg.eig(J)
-    return s, y[:n]
+    return np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, D)]])
 
 
 def settling_time(M: np.ndarray, D: np.ndarray, K: np.ndarray, fraction: float) -> float:
@@ -139,9 +143,44 @@ def damped_modes(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[np.ndarra
     M q'' + D q' + K q = 0, s = -zeta w +- i w sqrt(1 - zeta^2) (one of each pair; an overdamped mode's two real
     roots each), lowest first."""
     s, _ = quadratic_eigenvalues(M, D, K)
-    s = s[(np.abs(s) ** 2 > RIGID_TOLERANCE * np.max(np.abs(s)) ** 2) & (s.imag >= 0)]
-    order = np.argsort(np.abs(s))
-    return np.abs(s[order]) / (2 * math.pi), -s[order].real / np.abs(s[order])
+    s = s[_elastic_order(s)]
+    return np.abs(s) / (2 * math.pi), -s.real / np.abs(s)
+
+
+def driven_modes(M: np.ndarray, D: np.ndarray, K: np.ndarray, forces: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`damped_modes` of M q'' + D q' + K q = f e^(i w t), with how much each force column f drives each
+    mode: (frequencies, damping ratios, drive of shape (modes, forces)).  The mode's part of the response at any
+    one frequency is its right eigenvector x_r times eta_r = y_r^H (0, M^-1 f) / (y_r^H x_r) over a resonance
+    factor, y_r the left eigenvector of the first-order form; ``drive`` is the square root of that part's kinetic
+    energy, over the largest among the modes: 1 for the mode the force drives most, 0 for one it is orthogonal
+    to, whatever the frequency (a planetary's mesh-phasing selection rules, Parker 2000: 0 to round-off).  Modes
+    of one eigenvalue (a degenerate pair of a train at rest) are taken together, in their own basis, so the
+    eigensolver's arbitrary basis for them does not hide a driven one."""
+    n = M.shape[0]
+    s, left, right = sla.eig(_first_order(M, D, K), left=True, right=True)
+    kept = _elastic_order(s)
+    B = np.concatenate([np.zeros(forces.shape, dtype=complex), np.linalg.solve(M, forces)])
+    energy = np.zeros((kept.size, forces.shape[1]))
+    start = 0
+    while start < kept.size:  # a run of equal eigenvalues, solved together
+        stop = start + 1
+        while stop < kept.size and abs(s[kept[stop]] - s[kept[start]]) <= 1e-8 * abs(s[kept[start]]):
+            stop += 1
+        Y, X = left[:, kept[start:stop]], right[:, kept[start:stop]]
+        velocity = (X @ np.linalg.solve(Y.conj().T @ X, Y.conj().T @ B))[n:]
+        energy[start:stop] = np.real(np.einsum("ij,ik,kj->j", velocity.conj(), M, velocity))
+        start = stop
+    top = np.max(energy, axis=0)
+    drive = np.sqrt(np.clip(energy, 0.0, None) / np.where(top > 0, top, 1.0))
+    return np.abs(s[kept]) / (2 * math.pi), -s[kept].real / np.abs(s[kept]), drive
+
+
+def _elastic_order(s: np.ndarray) -> np.ndarray:
+    """Indices of the elastic eigenvalues among ``s`` (rigid ones, |s| below ``RIGID_TOLERANCE`` of the largest in
+    the square, left out; one of each complex pair), lowest |s| first."""
+    kept = np.flatnonzero((np.abs(s) ** 2 > RIGID_TOLERANCE * np.max(np.abs(s)) ** 2) & (s.imag >= 0))
+    return kept[np.argsort(np.abs(s[kept]), kind="stable")]
 
 
 def frequency_groups(frequencies: np.ndarray) -> list[list[int]]:

@@ -89,5 +89,5 @@ def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
                         for h, amplitude, phase in model.spec.meshes[m].ste if h == k)
             weight = c * deflection[m] - exc.mean_stiffness[m] * error
             forces[:, i] += model.mesh_rows[m] * weight * np.exp(-2j * np.pi * k * exc.phase[m])
-    natural, damping, cosines = shared.driven_modes(M, D, K, forces)
-    return [(natural[driven], damping[driven]) for driven in (cosines > DRIVEN).T]
+    natural, damping, drive = shared.driven_modes(M, D, K, forces)
+    return [(natural[driven], damping[driven]) for driven in (drive > DRIVEN).T]

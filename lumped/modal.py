@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gearcheck.lumped.harmonic import phased_force
 from gearcheck.lumped.static import static_solution
 from gearcheck.train.spec import AXIAL, ROTATION
 from gearcheck.shared import modal as shared
@@ -83,11 +84,12 @@ def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
     shapes = [stiffness(xi) for stiffness in exc.models]
     forces = np.zeros((M.shape[0], len(lines)), dtype=complex)
     for i, (frequency, k) in enumerate(lines):
+        amplitudes = np.zeros(len(exc.models), dtype=complex)
         for m in np.flatnonzero(np.isclose(exc.frequency, frequency, rtol=1e-9, atol=0.0)):
             c = np.mean(shapes[m] * np.exp(-2j * np.pi * k * xi))
             error = sum(0.5 * amplitude * np.exp(1j * phase)
                         for h, amplitude, phase in model.spec.meshes[m].ste if h == k)
-            weight = c * deflection[m] - exc.mean_stiffness[m] * error
-            forces[:, i] += model.mesh_rows[m] * weight * np.exp(-2j * np.pi * k * exc.phase[m])
+            amplitudes[m] = c * deflection[m] - exc.mean_stiffness[m] * error
+        forces[:, i] = phased_force(model, k, amplitudes)
     natural, damping, drive = shared.driven_modes(M, D, K, forces)
     return [(natural[driven], damping[driven]) for driven in (drive > DRIVEN).T]

@@ -222,6 +222,7 @@ def test_the_sweep_command_writes_table_plots_and_summary(tmp_path, capsys):
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert "demo-3p: 3 points (3 run, 0 from the cache" in printed and "largest harmonic stage1 x" in printed
+    assert "integration check on 1 of 3 points (1 every 8th; the checked column)" in printed
     names = sorted(p.name for p in out.iterdir())
     assert "sweep.parquet" in names and "sweep.json" in names and "order_stage1.ring.ay.carrier.png" in names
     before = {p.name: p.read_bytes() for p in out.iterdir() if p.suffix in (".parquet", ".png")}

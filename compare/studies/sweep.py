@@ -962,6 +962,12 @@ class SweepResult:
         """The table as Parquet bytes: the same inputs give the same bytes."""
         return parquet_bytes.to_bytes(self.table)
 
+    def checked_points(self) -> dict[str, int]:
+        """How many points ran the integration check, by the reason their ``checked`` column gives, most first."""
+        points = self.to_pandas().dropna(subset=["checked"]).drop_duplicates("point")
+        counts = points.loc[points["checked"] != "no", "checked"].value_counts(sort=False)
+        return dict(sorted(((str(k), int(v)) for k, v in counts.items()), key=lambda kv: (-kv[1], kv[0])))
+
     def summary(self) -> dict:
         frame = self.to_pandas()
         peaks = []

@@ -791,6 +791,10 @@ def cmd_sweep(args) -> int:
             f"({peak['frequency_hz']:.5g} Hz, {peak['solver']})")
     for quantity, peaks in by_quantity.items():
         print(f"  {quantity}: largest harmonic " + "; ".join(peaks))
+    checked = result.checked_points()
+    if checked:
+        print(f"  integration check on {sum(checked.values())} of {n} points ("
+              + ", ".join(f"{count} {reason}" for reason, count in checked.items()) + "; the checked column)")
     if summary["no_steady_state"]:
         print(f"  {summary['no_steady_state']} of {n * len(result.settings['solvers'])} runs reached no steady state "
               "(steady = none: their second half is reduced, left out of the peaks and plots); a longer --duration "

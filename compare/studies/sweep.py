@@ -964,7 +964,7 @@ class SweepResult:
 
     def checked_points(self) -> dict[str, int]:
         """How many points ran the integration check, by the reason their ``checked`` column gives, most first."""
-        points = self.to_pandas().dropna(subset=["checked"]).drop_duplicates("point")
+        points = self.table.select(["point", "checked"]).to_pandas().dropna(subset=["checked"]).drop_duplicates("point")
         counts = points.loc[points["checked"] != "no", "checked"].value_counts(sort=False)
         return dict(sorted(((str(k), int(v)) for k, v in counts.items()), key=lambda kv: (-kv[1], kv[0])))
 

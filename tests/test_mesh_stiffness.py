@@ -17,11 +17,13 @@ import time
 
 import numpy as np
 import pytest
+from scipy.interpolate import CubicSpline
 
 import gearcheck
 from gearcheck.train import iso6336, tooth_stiffness
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.loader import load_text, preset_text
+from gearcheck.train.compiled_excitation import spline_parts
 from gearcheck.train.mesh_stiffness import MODELS, EnergyMethodStiffness, energy_stiffness_curve
 from gearcheck.lumped.modal import modes
 from gearcheck.train.schema import Context
@@ -145,6 +147,29 @@ def test_periodic_and_vectorised(meshes):
     sampled = np.max(model(np.linspace(0.0, 1.0, 20001)))
     assert sampled <= model.maximum < sampled * (1.0 + 1e-6)  # the tabulated maximum, not a sample
     assert model.mean == pytest.approx(np.mean(model(np.linspace(0.0, 1.0, 400001)[:-1])), rel=1e-5)
+
+
+@pytest.mark.parametrize("parts", [1, 2])
+def test_the_compiled_splines_are_scipys_to_the_bit(parts):
+    """The energy method's splines evaluated compiled (:func:`spline_parts`) give scipy's ``CubicSpline`` values to
+    the bit: the same interval, found on uneven breaks too, and the same sum; at the breaks, beyond both ends (where
+    both extrapolate), on either side of the split and at NaN."""
+    rng = np.random.default_rng(parts)
+    ends = ((0.0, 0.4), (0.4, 1.0)) if parts == 2 else ((0.0, 1.0),)
+    splines = []
+    for lo, hi in ends:
+        x = np.sort(np.concatenate([[lo, hi], rng.uniform(lo, hi, 59)]))
+        splines.append(CubicSpline(x, rng.normal(size=x.size)))
+    split = 0.4 if parts == 2 else math.inf
+    both = (splines * 2)[:2]
+    breaks = np.concatenate([s.x for s in both])
+    x = np.concatenate([rng.uniform(-0.5, 1.5, 20000), breaks, np.nextafter(breaks, -1.0), np.nextafter(breaks, 2.0),
+                        [np.nan]])
+    expected = np.where(x < split, both[0](x), both[1](x))
+    got = np.empty_like(x)
+    spline_parts(x, split, np.stack([s.x for s in both]), np.stack([s.c for s in both]), got)
+    np.testing.assert_array_equal(got, expected)
+    assert np.isnan(got[-1]) and np.count_nonzero(got[:-1] != 0.0) == x.size - 1
 
 
 @pytest.mark.parametrize("kind", ["sun", "ring"])

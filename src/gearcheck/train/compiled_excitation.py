@@ -1,9 +1,16 @@
-"""The static transmission error's sums compiled (numba): one pass over the samples per term, no temporaries.
+"""The excitation's sums and splines compiled (numba): one pass over the samples, no temporaries.
 
-:meth:`gearcheck.train.excitation.Excitation.transmission_error` samples e(t) and de/dt at every stage time of a
-chunk of steps, for both solvers; in numpy each harmonic or eccentricity term made some ten arrays of the chunk's
-size.  :func:`add_terms` does the same arithmetic in the same order (so the same bits: numpy's float64 cosine and
-sine are the C library's, as numba's are), a sample at a time.
+Both solvers sample the excitation at every stage time of a chunk of steps, and each sample is worth the bits it
+had in numpy and scipy:
+
+* :meth:`gearcheck.train.excitation.Excitation.transmission_error`: in numpy each harmonic or eccentricity term
+  made some ten arrays of the chunk's size.  :func:`add_terms` does the same arithmetic in the same order (so the
+  same bits: numpy's float64 cosine and sine are the C library's, as numba's are), a sample at a time.
+* :class:`gearcheck.train.mesh_stiffness.EnergyMethodStiffness`, two cubic splines over the parts of a mesh cycle:
+  scipy found each sample's interval by a binary search, and the two parts' masks and gathers cost as much again.
+  :func:`spline_parts` finds the interval on the splines' even grid by one division, corrected against the
+  breakpoints so that it is the interval scipy's search finds, and sums the cubic as scipy's ``PPoly`` does (so
+  the same bits; a test compares them).
 """
 
 from __future__ import annotations
@@ -47,7 +54,38 @@ def add_terms(angle, scale, frequency, phase, harmonics, eccentric, e, de):
             de[j, i] += amp * omega * scale[j] * (-s * dx + c * dy)
 
 
+@njit(cache=True)
+def spline_parts(x, split, breaks, coefficients, out):
+    """out[j]: at x[j] (a fraction of a mesh cycle), the first of two piecewise cubics below ``split``, the second at
+    and above it.  Part p has ``breaks[p]`` (evenly spaced, ascending) and ``coefficients[p]`` (4, breaks - 1), as
+    scipy's ``PPoly`` holds them; it is evaluated as ``PPoly`` evaluates it, extrapolating: the interval i with
+    breaks[i] <= x < breaks[i + 1] (the first below the first break, the last from the last interior break on),
+    then sum_k c[3 - k, i] s^k, s = x - breaks[i], summed from k = 0 up with s^k by repeated products.  NaN gives
+    NaN."""
+    n = breaks.shape[1]
+    scale = (n - 1) / (breaks[0, n - 1] - breaks[0, 0]), (n - 1) / (breaks[1, n - 1] - breaks[1, 0])
+    for j in range(x.size):  # breaks[p, i], not a view of row p: a view per sample costs as much as the sum
+        value = x[j]
+        if value != value:
+            out[j] = value
+            continue
+        p = 0 if value < split else 1
+        i = 0
+        if value > breaks[p, 0]:
+            guess = (value - breaks[p, 0]) * scale[p]
+            i = int(guess) if guess < n - 2 else n - 2
+        while i > 0 and value < breaks[p, i]:
+            i -= 1
+        while i < n - 2 and value >= breaks[p, i + 1]:
+            i += 1
+        s = value - breaks[p, i]
+        out[j] = ((coefficients[p, 3, i] + coefficients[p, 2, i] * s) + coefficients[p, 1, i] * (s * s)) + \
+            coefficients[p, 0, i] * (s * s * s)
+
+
 def compile_now() -> None:
-    """Compile :func:`add_terms` (or load it from numba's cache) for the arrays the excitation passes it."""
+    """Compile :func:`add_terms` and :func:`spline_parts` (or load them from numba's cache) for the arrays the
+    excitation passes them."""
     e = np.zeros((1, 1))
     add_terms(np.zeros(1), np.ones(1), np.zeros(1), np.zeros(1), np.zeros((1, 4)), np.zeros((0, 6)), e, e.copy())
+    spline_parts(np.zeros(1), 0.5, np.array([[0.0, 1.0], [0.0, 1.0]]), np.zeros((2, 4, 1)), np.zeros(1))

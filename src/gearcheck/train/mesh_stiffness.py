@@ -135,16 +135,19 @@ class EnergyMethodStiffness(MeshStiffness):
         self._parts = _energy_splines(pair, self.grid_points, params["youngs_modulus"], params["poisson_ratio"],
                                       params["slices"], params["tooth_load_per_width"])
         self.mean = float(sum(part.integrate(*part.x[[0, -1]]) for part in self._parts))
+        # the splines as the compiled evaluation takes them: two parts (the one part twice for a whole eps), split at
+        # eps - floor(eps), where the rest's spline holds, so that k jumps there exactly
+        both = (self._parts * 2)[:2]
+        self._split = self.multi_fraction if len(self._parts) == 2 else math.inf
+        self._breaks = np.stack([part.x for part in both])
+        self._coefficients = np.stack([part.c for part in both])
 
     def __call__(self, xi):
-        # at eps - floor(eps), the end of the multi-pair part and the start of the rest, the rest's spline holds,
-        # so k jumps there exactly
+        from gearcheck.train.compiled_excitation import spline_parts  # numba on first use, not when a file is read
+
         x = cycle_fraction(xi)
-        if len(self._parts) == 1:
-            return self._parts[0](x)
-        multi = x < self.multi_fraction
-        k = np.empty_like(x)
-        k[multi], k[~multi] = self._parts[0](x[multi]), self._parts[1](x[~multi])  # each part where it holds
+        k = np.empty(x.shape)
+        spline_parts(np.ravel(x), self._split, self._breaks, self._coefficients, k.reshape(-1))
         return k
 
     @property

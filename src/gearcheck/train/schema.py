@@ -714,7 +714,8 @@ OPERATING = Table(
 COUPLING = Table(
     {
         "name": Text("coupling name", REQUIRED, pattern=r"[A-Za-z0-9_\-]+"),
-        "kind": Text("what it is (ring: two stages' rings joined into one, by a stiff coupling)", "spline", ("spline", "shaft", "ring")),
+        "kind": Text("what it is (ring: two stages' rings joined into one, by a stiff coupling)", "spline",
+                     ("spline", "shaft", "ring")),
         "from": Text("first member (`stage1.carrier`)", REQUIRED),
         "to": Text("second member (`stage2.sun`)", REQUIRED),
         "torsional_stiffness": Positive("torsional stiffness", "N·m/rad", REQUIRED, bound("stiffness")),

@@ -19,6 +19,7 @@ from gearcheck.shared.modal import damped_modes
 from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
 from gearcheck.train.loader import load_text, load_train
+from gearcheck.train.variants import edited_text
 
 
 @pytest.mark.parametrize("kind, tolerance", [(LumpedSide, 1e-10), (MujocoSide, 1e-8)])
@@ -169,6 +170,28 @@ def test_a_point_where_a_mesh_with_backlash_unloads_is_checked():
         window = run.t >= 0.075  # the second half, the sweep's window where no steady state is found
         lowest = min(np.min(run[f"{m.id}.force"][window]) / np.mean(run[f"{m.id}.force"][window]) for m in spec.meshes)
         assert (lowest < 0.0) == parts and (lowest < sw.UNLOADED) == parts, (rpm, lowest)
+
+
+def test_a_point_where_a_cycloid_discs_pins_unload_is_checked(tmp_path):
+    """The RV reducer under an output load that reverses (a 40 Hz ripple of 1.5 times the mean): at 1200 rpm its
+    lines lie off the bands of the modes, and its meshes have neither backlash nor tip relief, but a disc's largest
+    pin force falls below a tenth of its mean (its pins touch in compression only, and all let go as the load
+    passes through zero): the point is checked ("contact")."""
+    text = edited_text("rv-reducer", [(r"^\[\[stages\]\]", "[[operating.ripple]]\nmember = \"output\"\n"
+                                       "frequency_hz = 40.0\namplitude = 1.5\n\n[[stages]]")])
+    path = tmp_path / "rv-reversing.toml"
+    path.write_text(text)
+    frame = sw.sweep(str(path), speeds=[1190.0, 1200.0], solvers=("lumped",), duration=0.1, workers=1).to_pandas()
+    points = frame[frame["metric"] == "rms"].drop_duplicates("point").sort_values("point")
+    assert list(points["checked"]) == ["every 8th", "contact"]
+    spec = load_train(str(path), 1200.0)
+    excitation = LumpedSide(spec).model.excitation
+    assert not np.any(excitation.backlash > 0) and not excitation.relieved.size
+    run = gearcheck.simulate(spec, "lumped", duration=0.1)
+    window = run.t >= 0.05  # its second half, after the start's decay
+    for disc in ("rv.disc1", "rv.disc2"):
+        force = run[f"{disc}.pin_force_max"][window]
+        assert np.min(force) < sw.UNLOADED * np.mean(force) and np.min(run[f"{disc}.pins_loaded"][window]) == 0
 
 
 def test_a_translation_along_the_worlds_axes_is_unresolved_where_its_carrier_sidebands_are():

@@ -86,7 +86,7 @@ from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.errors import GearcheckError, SolverError
 from gearcheck.shared.selection import chosen
 from gearcheck.shared.outputs import OutputDirectory, check_place
-from gearcheck.shared.results import TimeResult, train_signals, unit_schema
+from gearcheck.shared.results import TimeResult, disc_names, train_signals, unit_schema
 from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
 from gearcheck.shared.stepping import richardson_factor
@@ -102,7 +102,7 @@ MAX_REFINE = 64
 MAX_HARMONICS = 20
 CHECKS = ("subset", "all", "none")  # which points get the integration check
 CHECK_EVERY = 8  # the subset: every CHECK_EVERY-th point, every point with a line near a mode it drives, ...
-UNLOADED = 0.1  # ... and every point where a mesh with backlash or tip relief unloads below this of its mean force
+UNLOADED = 0.1  # ... and every point where a contact that can part (a mesh's, a disc's pins) unloads below this
 
 KEY = "gearcheck.point"  # a point table's metadata: the point's key (Point.key), checked when read from the cache
 POINT_SCHEMA = pa.schema([
@@ -540,7 +540,7 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
             failed[solver] = str(exc)
     runs = _aligned(runs, point, plan, lines, failed)
     checked = _checked(point, lines, lumped.resonances([(f / k, k) for _, k, f in lines]),
-                       any(_unloads(run, model.excitation) for _, run in runs.values()))
+                       any(_unloads(run, _parting(spec, model.excitation)) for _, run in runs.values()))
     states = {}
     for solver in point.solvers:
         if solver in failed:
@@ -565,8 +565,9 @@ def _checked(point: Point, lines: list, resonances: list, unloads: bool) -> str:
     """Why ``point`` runs its integration check ("no": it does not): the sweep's ``check`` setting, and in the
     subset, its place among the speeds (every :data:`CHECK_EVERY`-th), a line in the half-power band of a mode
     of the damped model that it drives (|f - f_n| <= zeta_n f_n; ``resonances``, one (f_n, zeta_n) per line),
-    where the response is amplified and most sensitive to the step, or a mesh that ``unloads``
-    (:func:`_unloads`), where the response is not the linear one whose modes say where it is sensitive.  A mode
+    where the response is amplified and most sensitive to the step, or a contact that ``unloads`` (a mesh's or a
+    disc's pins, :func:`_unloads`), where the response is not the linear one whose modes say where it is
+    sensitive.  A mode
     the line's mesh phasing leaves at rest is not amplified at its natural frequency, and does not make the point
     checked."""
     if point.check != "subset":
@@ -579,14 +580,21 @@ def _checked(point: Point, lines: list, resonances: list, unloads: bool) -> str:
     return "contact" if unloads else "no"
 
 
-def _unloads(run: "_SteadyRun", excitation) -> bool:
-    """Whether a mesh with backlash or tip relief falls below :data:`UNLOADED` of its mean force in the steady
-    window of ``run``: its contact parts or nearly does, and the response is no longer linear in it."""
+def _parting(spec, excitation) -> list[str]:
+    """The force signals of the contacts that can part: each mesh with backlash or tip relief, and each cycloid
+    disc's largest pin force (its pins touch in compression only, with a clearance or without)."""
+    meshes = [f"{mesh}.force" for j, mesh in enumerate(excitation.mesh_ids)
+              if excitation.backlash[j] > 0 or j in excitation.relieved]
+    return meshes + [f"{disc}.pin_force_max" for disc in disc_names(spec)]
+
+
+def _unloads(run: "_SteadyRun", forces: list[str]) -> bool:
+    """Whether one of the contacts' ``forces`` (:func:`_parting`) falls below :data:`UNLOADED` of its mean in the
+    steady window of ``run``: the contact parts or nearly does, and the response is no longer linear in it."""
     result = run.result
     window = result.t >= run.steady[0]
-    for j, mesh in enumerate(excitation.mesh_ids):
-        name = f"{mesh}.force"
-        if (excitation.backlash[j] > 0 or j in excitation.relieved) and name in result.names():
+    for name in forces:
+        if name in result.names():
             force = result[name][window]
             if force.size and np.min(force) < UNLOADED * np.mean(force):
                 return True

@@ -248,8 +248,8 @@ def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int |
     integration_check : {"subset", "all", "none"} or bool
         Which points run each solver a second time, at twice its step, for the integration error estimates:
         "subset" (default) every 8th speed, every point with a line in the half-power band of a mode it
-        drives and every point where a mesh with backlash or tip relief unloads (the table's ``checked`` column
-        says which and why), "all" (True), or "none" (False).
+        drives and every point where a mesh with backlash or tip relief or a cycloid disc's pins unload (the
+        table's ``checked`` column says which and why), "all" (True), or "none" (False).
     refine : int
         Each solver's default step divided by this (1 to 64): for lines whose integration error estimate is
         too large to read them.

@@ -1051,7 +1051,8 @@ COMMANDS = {  # name: the function that runs it, its help line, its arguments (a
         arg("--integration-check", choices=("subset", "all", "none"), default="subset",
             help="which points run each solver a second time at twice the step, for each line's integration error: "
                  "every 8th speed, every point with a line in the half-power band of a mode it drives and every "
-                 "point where a mesh with backlash unloads (subset, the default), all, or none"),
+                 "point where a contact that can part unloads: a mesh with backlash or tip relief, a cycloid "
+                 "disc's pins (subset, the default), all, or none"),
         arg("--no-integration-check", dest="integration_check", action="store_const", const="none",
             help="the same as --integration-check none (every line then counts)"),
         arg("--no-continuation", dest="continuation", action="store_false",

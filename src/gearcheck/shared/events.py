@@ -26,6 +26,8 @@ ensure_cache_folder(Path(__file__).parent)  # before the cached kernels below ar
 MAX_EVENTS = 8  # contact events located within one (sub-)step; more are resolved to the step
 MIN_FRACTION = 1e-9  # an event this close to a step's ends is taken as there
 SIMULTANEOUS = 1e-6  # functions this close to zero (in fractions of the step, at their rate) cross together
+APART = 0.25  # a function whose ends are both further than this times |R0| + |R1| from zero, on one side, does
+# not cross: the cubic's slope terms theta (1 - theta)^2 R0 and -theta^2 (1 - theta) R1 are at most 4/27 of them
 
 
 @njit(inline="always")
@@ -48,6 +50,8 @@ def first_crossing(g0, r0, g1, r1, span) -> tuple[float, int]:
     first, which = 2.0, -1
     for i in range(g0.size):
         G0, R0, G1, R1 = g0[i], r0[i] * span, g1[i], r1[i] * span
+        if G0 * G1 > 0.0 and min(abs(G0), abs(G1)) > APART * (abs(R0) + abs(R1)):
+            continue  # the cubic stays on G0's side: its slope terms are at most 4/27 of |R0| + |R1| on [0, 1]
         end = 1.0
         if not G0 * G1 < 0.0:
             a3, a2 = 2 * G0 + R0 - 2 * G1 + R1, -3 * G0 - 2 * R0 + 3 * G1 - R1

@@ -452,24 +452,32 @@ def _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stag
 
 
 @numba.njit(cache=True, inline="always", _nrt=False)
-def _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, s, span, flags, g, rate):
+def _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, s, span, flags, g, rate, motion,
+               measure):
     """The contact switching functions of the twin's state into g and their rates into ``rate``: each mesh
     tendon's backlash edges (L - e - b, L - e + b) or tooth pairs (L - e - e_j; -1 for a padded pair), L the
     tendon's length with its coefficients turned to the state's carrier angles, and each pin's compression (its
     coefficients and kinematics at the state); the drive of row ``r`` at sample ``s`` (0 or 2) of a step of length
-    ``span``.  A mesh's rate includes what its coefficients' turning adds (:func:`_turning_rates`)."""
+    ``span``.  A mesh's rate includes what its coefficients' turning adds (:func:`_turning_rates`).  The tendons'
+    L and rate go into ``motion`` (2, tendons) when ``measure``; without it they are read from there, measured at
+    this same state (the end of the step before: a step's start needs what its predecessor's end measured)."""
     qpos, qvel, wrap_prm = data.qpos, data.qvel, model.wrap_prm
     tendons, wraps, qadr, dofs, starts, relieved, half, _ = switches
-    _refresh(qpos, wrap_prm, turning.coefficients, work.coef)
-    _turning_rates(qpos, qvel, turning, work.coef, work.turning_rate)
+    if measure:
+        _refresh(qpos, wrap_prm, turning.coefficients, work.coef)
+        _turning_rates(qpos, qvel, turning, work.coef, work.turning_rate)
+        for i in range(tendons.size):
+            length = 0.0
+            speed = work.turning_rate[tendons[i]]
+            for w in range(starts[i], starts[i + 1]):
+                length += wrap_prm[wraps[w]] * qpos[qadr[w]]
+                speed += wrap_prm[wraps[w]] * qvel[dofs[w]]
+            motion[0, i] = length
+            motion[1, i] = speed
     n = 0
     for i in range(tendons.size):
         t = tendons[i]
-        length = 0.0
-        speed = work.turning_rate[t]
-        for w in range(starts[i], starts[i + 1]):
-            length += wrap_prm[wraps[w]] * qpos[qadr[w]]
-            speed += wrap_prm[wraps[w]] * qvel[dofs[w]]
+        length, speed = motion[0, i], motion[1, i]
         if flags.transmission_error:
             length -= drive.e[r, s, t]
             speed -= drive.de[r, s, t]
@@ -513,18 +521,22 @@ def _step(c, pointers, model, data, turning, contacts, work, reader, moving, sta
     """One (sub-)step of length h with the drive of row ``r`` (:func:`_rk4`), its contact events located where
     ``switches`` has any (:mod:`gearcheck.shared.events`: the step taken again to the first crossing of a switching
     function, :func:`_switching`, and on from there; counted into ``events.located[0]``).  Returns the next row."""
-    g0, r0, g1, r1, part, located = events
+    g0, r0, g1, r1, part, located, motion, carried = events
     if g0.size:
-        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 0, h, flags, g0, r0)
+        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 0, h, flags, g0, r0, motion,
+                   not carried[0])
+        carried[0] = False
     j = _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, r, h, flags, outputs,
              sample, j)
     if not g0.size:
         return j
     done, span = 0.0, h
     for _ in range(MAX_EVENTS):
-        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 2, h, flags, g1, r1)
+        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 2, h, flags, g1, r1, motion,
+                   True)
         theta, crossed = first_crossing(g0, r0, g1, r1, span)
         if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
+            carried[0] = True  # the step's end, where the next step starts, measured
             break
         at = done + theta * (1.0 - done)  # the crossing, a fraction of the whole step
         _restart(stages, data)
@@ -533,7 +545,7 @@ def _step(c, pointers, model, data, turning, contacts, work, reader, moving, sta
              flags, outputs, False, j)
         located[0] += 1
         _switching(c, pointers, model, data, turning, work, moving, switches, part, 0, 2, (at - done) * h, flags,
-                   g0, r0)
+                   g0, r0, motion, True)
         crossed_together(g0, r0, (at - done) * h, crossed)
         done, span = at, (1.0 - at) * h
         _part_of(drive, r, done, 1.0, part)
@@ -544,7 +556,9 @@ def _step(c, pointers, model, data, turning, contacts, work, reader, moving, sta
 
 class Events(NamedTuple):
     """Work space of the event location: switching functions and rates at a step's two ends, the drive of a part
-    of a step (a :class:`Drive` of one row), and the count of events located."""
+    of a step (a :class:`Drive` of one row), the count of events located, the mesh tendons' lengths and rates
+    last measured (2, tendons) and whether they are those of the present state (``carried[0]``: a step's end
+    measured them, and the next step starts there)."""
 
     g0: np.ndarray
     r0: np.ndarray
@@ -552,6 +566,14 @@ class Events(NamedTuple):
     r1: np.ndarray
     part: Drive
     located: np.ndarray
+    motion: np.ndarray
+    carried: np.ndarray
+
+    @classmethod
+    def of(cls, switches: MeshSwitches, part: Drive) -> "Events":
+        count = switches.count
+        return cls(np.zeros(count), np.zeros(count), np.zeros(count), np.zeros(count), part,
+                   np.zeros(1, dtype=np.int64), np.zeros((2, switches.tendons.size)), np.zeros(1, dtype=np.bool_))
 
 
 @numba.njit(nogil=True, cache=True, _nrt=False)
@@ -563,6 +585,7 @@ def run_steps(c, pointers, model, data, turning, contacts, work, reader, moving,
     contact's group (:data:`gearcheck.mbd_models.elements.base.GROUPS`), ``drive`` one row per step, ``split`` the
     split steps' sub-steps, ``switches`` and ``events`` the contact events' location (:func:`_step`)."""
     first, count, lengths = split.first, split.count, split.lengths
+    events.carried[0] = False  # the state may have been set since the last call
     for step in range(start, stop):
         i = step - start
         sample = step % every == 0

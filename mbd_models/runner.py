@@ -403,9 +403,7 @@ class _CompiledStepper(_Stepper):
                                         np.zeros((0, 0)) if self.pins is None else self.pins)
         self.flags = compiled.Flags(self.drive.has_te, self.contacts is not None, self.stiffness is not None,
                                     self.energy is not None, self.pins is not None)
-        count = self.switches.count
-        self.events = compiled.Events(np.zeros(count), np.zeros(count), np.zeros(count), np.zeros(count),
-                                      self._arrays(self.drive.steps(np.zeros(1), h), 1), np.zeros(1, dtype=np.int64))
+        self.events = compiled.Events.of(self.switches, self._arrays(self.drive.steps(np.zeros(1), h), 1))
 
     def _arrays(self, values, rows: int) -> compiled.Drive:
         """(k, u, e, de, pairs) of :meth:`_Drive.steps` as contiguous arrays, the absent ones empty along their last

@@ -44,7 +44,9 @@ def first_crossing(g0, r0, g1, r1, span) -> tuple[float, int]:
     interpolant of its values g and rates r at the step's ends (length ``span``): where g changes sign, and where
     it does not but the cubic dips across zero and back (a contact made and broken within the step: the first
     crossing lies before the cubic's turning point); the root by the Illinois method, taken at the end of its last
-    bracket past the crossing.  Returns (the fraction, the function; 2 and -1: none).  A step ended there starts
+    bracket past the crossing.  A function whose ends lie on one side, both further from zero than :data:`APART`
+    times |R0| + |R1|, cannot cross and is passed over at once (a function away from its kink).  Returns (the
+    fraction, the function; 2 and -1: none).  A step ended there starts
     within round-off of the kink, on either side: the caller takes that function as crossed for the rest of the
     step."""
     first, which = 2.0, -1

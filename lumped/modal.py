@@ -6,7 +6,8 @@
   train turning at a speed (Cooley & Parker 2012): complex s, frequency splitting of the degenerate
   modes, divergence and flutter where the centripetal softening wins;
 * :func:`settling_time`: how long the damped free vibration of a start lasts;
-* :func:`line_resonances`: the modes each mesh-harmonic line can drive (mesh-phasing selection rules).
+* :func:`line_drives`, :func:`line_resonances`: the modes each mesh-harmonic line can drive (mesh-phasing
+  selection rules).
 """
 
 from __future__ import annotations
@@ -61,7 +62,16 @@ CYCLE_SAMPLES = 4096  # a mesh cycle's stiffness samples for its Fourier coeffic
 
 def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
     """For each line (mesh frequency in Hz, harmonic k) of ``lines``, (natural frequencies in Hz, damping
-    ratios) of the modes of the damped, rotating model at mean mesh stiffness that the line drives.
+    ratios) of the modes of the damped, rotating model at mean mesh stiffness that the line drives
+    (:func:`line_drives`)."""
+    natural, damping, driven = line_drives(model, lines)
+    return [(natural[line], damping[line]) for line in driven.T]
+
+
+def line_drives(model, lines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(natural frequencies in Hz, damping ratios) of the elastic modes of the damped, rotating model at mean mesh
+    stiffness (:func:`gearcheck.shared.modal.damped_modes`), and whether each line (mesh frequency in Hz at the
+    model's own speed, harmonic k) of ``lines`` drives each mode (modes, lines).
 
     A line is forced by the meshes of its frequency: to first order, mesh m's force k_m(t) (a_m.q - e_m(t))
     puts into it a_m (c_mk d_m - k_m E_mk) e^(-2 pi i k phi_m), c_mk the k-th Fourier coefficient of its
@@ -78,7 +88,7 @@ def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
     M, D, K = model.M, model.C + model.G, model.K_mean + model.K_frame
     if exc.relieved.size or exc.ripple:
         natural, damping = shared.damped_modes(M, D, K)
-        return [(natural, damping)] * len(lines)
+        return natural, damping, np.ones((natural.size, len(lines)), dtype=bool)
     deflection = static_solution(model).mesh_force / exc.mean_stiffness
     xi = np.arange(CYCLE_SAMPLES) / CYCLE_SAMPLES
     shapes = [stiffness(xi) for stiffness in exc.models]
@@ -92,4 +102,4 @@ def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
             amplitudes[m] = c * deflection[m] - exc.mean_stiffness[m] * error
         forces[:, i] = phased_force(model, k, amplitudes)
     natural, damping, drive = shared.driven_modes(M, D, K, forces)
-    return [(natural[driven], damping[driven]) for driven in (drive > DRIVEN).T]
+    return natural, damping, drive > DRIVEN

@@ -20,7 +20,7 @@ from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import EXTRA_DOMINATED, linear_modes, linear_modes_at_speed, set_aside, simulate_linear
 from gearcheck.lumped.linear_run import default_step as linear_default_step, periodic_start, step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
-from gearcheck.lumped.modal import line_resonances, modes, modes_at_speed, settling_time
+from gearcheck.lumped.modal import line_drives, line_resonances, modes, modes_at_speed, settling_time
 from gearcheck.lumped.periodic_steady_state import periodic_steady_state
 from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
@@ -95,6 +95,11 @@ class LumpedSide(Side):
         stiffness that each line (mesh frequency in Hz, harmonic) drives
         (:func:`~gearcheck.lumped.modal.line_resonances`)."""
         return line_resonances(self.model, lines)
+
+    def drives_at_speed(self, input_speed: float, lines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`~gearcheck.lumped.modal.line_drives` of the model turning at ``input_speed`` (rad/s), the lines at
+        the train's own mesh frequencies (its excitation and static loads stay its own)."""
+        return line_drives(self.model.at_speed(input_speed), lines)
 
     def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
         steady = periodic_steady_state(self.model, dt=settings.dt)

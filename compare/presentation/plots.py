@@ -358,8 +358,9 @@ MODE_COLORS = {"rotational": "tab:blue", "translational": "tab:green", "planet":
 
 def campbell_figure(result, solvers=None) -> Figure:
     """A :class:`~gearcheck.compare.studies.campbell.CampbellResult` drawn: lumped curves coloured by mode type
-    (at the lowest speed), MuJoCo markers, mesh lines, their crossings with the curves (those the planets' phasing
-    keeps from the mode hollow: Parker 2000), instability zones shaded; ``solvers``: those drawn (default: all)."""
+    (at the lowest speed), MuJoCo markers, mesh lines, their crossings with the curves (hollow where the line's
+    phased mesh forces do not reach the mode: Parker 2000), instability zones shaded; ``solvers``: those drawn
+    (default: all)."""
     fig, ax = _figure(figsize=(9, 6))
     speeds = result.speeds_rpm
     shown = list(result.results) if solvers is None else list(solvers)
@@ -390,7 +391,7 @@ def campbell_figure(result, solvers=None) -> Figure:
                                                              if all(c["excited"] is None for c in reached) else ""))
     if kept:
         ax.plot([c["speed_rpm"] for c in kept], [c["frequency_hz"] for c in kept], "o", ms=5, mfc="none",
-                color="gray", label="crossing the planets' phasing keeps from the mode")
+                color="gray", label="crossing whose line does not reach the mode")
     for zone in result.zones:
         ax.axvspan(zone["from_rpm"], zone["to_rpm"], color="red", alpha=0.15,
                    label=f"unstable ({zone['solver']})" if zone is result.zones[0] else None)

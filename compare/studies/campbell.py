@@ -7,11 +7,14 @@ crossings of the natural-frequency curves (the speeds where a mesh harmonic may 
 speeds at which a mode grows (divergence or flutter) are shaded as instability zones.  The curves
 are the modes ordered by frequency at each speed, so two modes that cross swap curves there.
 
-A crossing is a resonance only if the harmonic reaches the mode.  With N equally spaced planets in one simple
-planetary stage, the mesh phases select the modes (Parker 2000): harmonic l excites rotational modes only when
-l z_s / N is an integer, translational modes only when l z_s +- 1 is a multiple of N, planet modes otherwise
-(the forced-response test of the rule is ``tests/test_phasing.py``).  Each crossing says ``excited`` True or
-False by that rule, None where it does not apply (several stages, unequal spacing, double planets).
+A crossing is a resonance only if the harmonic reaches the mode.  Each crossing says ``excited`` True or False
+from the lumped model turning at the crossing's speed: whether the line's phased mesh forces drive the mode that
+crosses it (the mode of the damped model nearest the crossing's frequency; :func:`gearcheck.lumped.modal.
+line_drives`), for any train.  With N equally spaced planets in one simple planetary stage this is Parker's (2000)
+rule: harmonic l excites rotational modes only when l z_s / N is an integer, translational modes only when
+l z_s +- 1 is a multiple of N, planet modes otherwise (``tests/test_modes_at_speed.py`` checks the crossings
+against it; the forced-response test of the rule is ``tests/test_phasing.py``).  Without the lumped model's
+drives (a user's matrices, a train at rest), the rule decides where it applies, and ``excited`` is None elsewhere.
 """
 
 from __future__ import annotations
@@ -73,16 +76,20 @@ def _modes(r: ModalResult) -> list[dict]:
             for f, g, st, t in zip(r.frequencies, r.growth, r.stability, r.types)]
 
 
-def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics: int = 3) -> CampbellResult:
+def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics: int = 3,
+             drives_at=None) -> CampbellResult:
     """The Campbell diagram of ``spec`` at ``speeds_rpm`` (ascending, >= 0); ``modes_at(solver, speed_rad_s)``
-    gives one solver's :class:`ModalResult` at a speed; ``harmonics`` mesh harmonics are drawn."""
+    gives one solver's :class:`ModalResult` at a speed; ``harmonics`` mesh harmonics are drawn;
+    ``drives_at(speed_rad_s, lines)`` (optional: the lumped model's
+    :meth:`~gearcheck.lumped.side.LumpedSide.drives_at_speed`) the modes' natural frequencies and which each line
+    (mesh frequency at the train's speed, harmonic) drives, which decide each crossing's ``excited``."""
     speeds = np.asarray(speeds_rpm, dtype=float)
     results = {s: [modes_at(s, rpm_to_rad_s(v)) for v in speeds] for s in solvers}
     lines = _mesh_lines(spec, harmonics)
     out = CampbellResult(spec.name, speeds, results, lines)
     reference = solvers[0]
     f = out.frequencies(reference)
-    phasing = phasing_rule(spec)
+    excited = _excitation(spec, drives_at)
     for line in lines:
         excitation = line["hz_per_rpm"] * speeds
         for mode in range(f.shape[1]):
@@ -94,13 +101,28 @@ def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics
                     out.crossings.append({"speed_rpm": float(s), "frequency_hz": float(line["hz_per_rpm"] * s),
                                           "mode": mode + 1, "type": kind, "meshes": line["meshes"],
                                           "harmonic": line["harmonic"],
-                                          "excited": None if phasing is None else excites(line["harmonic"], kind,
-                                                                                          *phasing)})
+                                          "excited": excited(line, kind, float(s))})
     for solver, rs in results.items():
         unstable = np.array([not r.stable for r in rs])
         for start, stop in _runs(unstable):
             out.zones.append({"solver": solver, "from_rpm": float(speeds[start]), "to_rpm": float(speeds[stop])})
     return out
+
+
+def _excitation(spec, drives_at):
+    """excited(line, mode type, speed in rpm) of a crossing at the line's frequency there: whether the line drives
+    the mode of the lumped model at that speed nearest that frequency (``drives_at``, given for a turning train),
+    else Parker's rule where it applies (:func:`phasing_rule`), else None."""
+    if drives_at is None or not spec.operating.input_speed:
+        phasing = phasing_rule(spec)
+        return lambda line, kind, rpm: None if phasing is None else excites(line["harmonic"], kind, *phasing)
+    own = kinematics(spec).mesh_frequency
+
+    def excited(line, kind, rpm):
+        natural, _, driven = drives_at(rpm_to_rad_s(rpm), [(own[line["meshes"][0]], line["harmonic"])])
+        return bool(driven[np.argmin(np.abs(natural - line["hz_per_rpm"] * rpm)), 0])
+
+    return excited
 
 
 def phasing_rule(spec) -> tuple[int, int] | None:

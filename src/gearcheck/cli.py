@@ -370,7 +370,8 @@ def cmd_campbell(args) -> int:
     kept = sum(c["excited"] is False for c in result.crossings)
     print(f"{result.train}: {len(result.speeds_rpm)} speeds from {result.speeds_rpm[0]:g} to "
           f"{result.speeds_rpm[-1]:g} rpm, {len(result.crossings)} crossings of mesh harmonics with modes"
-          + (f", {kept} of them kept from their modes by the planets' phasing (Parker 2000)" if kept else ""))
+          + (f", {kept} of them out of their line's reach (the planets' phasing, Parker 2000, or a mode the line's "
+             f"meshes do not move): drawn hollow" if kept else ""))
     if result.agreement is not None:
         print(f"  lumped and MuJoCo frequencies agree to {result.agreement:.2e} (relative, worst over all speeds)")
     for zone in result.zones:

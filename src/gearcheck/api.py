@@ -151,7 +151,8 @@ def campbell(train, speeds, solver: str = "both", harmonics: int = 3) -> Campbel
     Returns
     -------
     CampbellResult
-        ``frequencies(solver)`` (speeds x modes, Hz), ``crossings`` of mesh harmonics with modes,
+        ``frequencies(solver)`` (speeds x modes, Hz), ``crossings`` of mesh harmonics with modes (each
+        ``excited`` when the line's phased mesh forces reach the mode in the lumped model at that speed),
         instability ``zones``, ``agreement`` of the two solvers; ``to_dict()``; ``plot()``.
     """
     return Train(train).campbell(speeds, solver, harmonics)

@@ -68,6 +68,13 @@ def line_resonances(model, lines) -> list[tuple[np.ndarray, np.ndarray]]:
     return [(natural[line], damping[line]) for line in driven.T]
 
 
+def drives_are_linear(model) -> bool:
+    """Whether :func:`line_drives` finds the modes each line drives from its first-order forces: every mesh's force
+    linear in its deflection (no tip relief) and no torque ripple that may fall on a line; else it counts every
+    mode."""
+    return not (model.excitation.relieved.size or model.excitation.ripple)
+
+
 def line_drives(model, lines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(natural frequencies in Hz, damping ratios) of the elastic modes of the damped, rotating model at mean mesh
     stiffness (:func:`gearcheck.shared.modal.damped_modes`), and whether each line (mesh frequency in Hz at the
@@ -86,7 +93,7 @@ def line_drives(model, lines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     deflection (tip relief) or a torque ripple may fall on a line, every mode counts for every line."""
     exc = model.excitation
     M, D, K = model.M, model.C + model.G, model.K_mean + model.K_frame
-    if exc.relieved.size or exc.ripple:
+    if not drives_are_linear(model):
         natural, damping = shared.damped_modes(M, D, K)
         return natural, damping, np.ones((natural.size, len(lines)), dtype=bool)
     deflection = static_solution(model).mesh_force / exc.mean_stiffness

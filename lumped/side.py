@@ -20,7 +20,8 @@ from gearcheck.lumped.linear_model import LinearModel
 from gearcheck.lumped.linear_run import EXTRA_DOMINATED, linear_modes, linear_modes_at_speed, set_aside, simulate_linear
 from gearcheck.lumped.linear_run import default_step as linear_default_step, periodic_start, step_limits, unmapped
 from gearcheck.train.mesh_stiffness import MODELS
-from gearcheck.lumped.modal import line_drives, line_resonances, modes, modes_at_speed, settling_time
+from gearcheck.lumped.modal import (drives_are_linear, line_drives, line_resonances, modes, modes_at_speed,
+                                    settling_time)
 from gearcheck.lumped.periodic_steady_state import periodic_steady_state
 from gearcheck.lumped.published import four_dof_model, linear_model
 from gearcheck.lumped.time_solver import default_step, simulate, stable_step, step_limits as model_step_limits
@@ -100,6 +101,12 @@ class LumpedSide(Side):
         """:func:`~gearcheck.lumped.modal.line_drives` of the model turning at ``input_speed`` (rad/s), the lines at
         the train's own mesh frequencies (its excitation and static loads stay its own)."""
         return line_drives(self.model.at_speed(input_speed), lines)
+
+    @property
+    def drives_known(self) -> bool:
+        """Whether :meth:`drives_at_speed` tells the modes each line drives, not every mode
+        (:func:`~gearcheck.lumped.modal.drives_are_linear`)."""
+        return drives_are_linear(self.model)
 
     def run_periodic(self, settings: RunSettings, check_step, progress=None) -> tuple[TimeResult, TimeResult, str]:
         steady = periodic_steady_state(self.model, dt=settings.dt)

@@ -164,3 +164,17 @@ def test_campbell_decides_each_crossing_of_two_stages_from_the_forces_that_reach
     pair = sorted((c for c in result.crossings if c["meshes"][0].startswith("I.") and c["harmonic"] == 1
                    and c["type"] == "translational" and c["frequency_hz"] < 240.0), key=lambda c: c["speed_rpm"])
     assert [c["excited"] for c in pair] == [True, False]
+
+
+def test_campbell_leaves_undecided_what_the_lumped_drives_cannot_tell():
+    """The RV reducer's pin pass is a line of no gear mesh, which the phased mesh forces say nothing of: its crossings
+    are None, while its planetary stage's are decided.  The double-planet reducer's torque ripple would make the
+    drives count every mode, and no closed-form rule covers its double planets: every crossing is None."""
+    rv = gearcheck.campbell("rv-reducer", np.linspace(0.0, 6000.0, 7), solver="lumped")
+    pins = [c["excited"] for c in rv.crossings if c["meshes"] == ["rv.pins"]]
+    gears = [c["excited"] for c in rv.crossings if c["meshes"] != ["rv.pins"]]
+    assert pins and all(e is None for e in pins)
+    assert True in gears and False in gears and None not in gears
+    assert not Train("double-planet").side("lumped").drives_known
+    double = gearcheck.campbell("double-planet", np.linspace(0.0, 3000.0, 4), solver="lumped")
+    assert double.crossings and all(c["excited"] is None for c in double.crossings)

@@ -14,7 +14,8 @@ line_drives`), for any train.  With N equally spaced planets in one simple plane
 rule: harmonic l excites rotational modes only when l z_s / N is an integer, translational modes only when
 l z_s +- 1 is a multiple of N, planet modes otherwise (``tests/test_modes_at_speed.py`` checks the crossings
 against it; the forced-response test of the rule is ``tests/test_phasing.py``).  Without the lumped model's
-drives (a user's matrices, a train at rest), the rule decides where it applies, and ``excited`` is None elsewhere.
+drives (a train at rest; tip relief or a torque ripple, where they would count every mode), the rule decides
+where it applies, and ``excited`` is None elsewhere.
 """
 
 from __future__ import annotations
@@ -111,14 +112,18 @@ def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics
 
 def _excitation(spec, drives_at):
     """excited(line, mode type, speed in rpm) of a crossing at the line's frequency there: whether the line drives
-    the mode of the lumped model at that speed nearest that frequency (``drives_at``, given for a turning train),
-    else Parker's rule where it applies (:func:`phasing_rule`), else None."""
+    the mode of the lumped model at that speed nearest that frequency (``drives_at``, given for a turning train;
+    None for a line of no gear mesh, a cycloid stage's pin pass), else Parker's rule where it applies
+    (:func:`phasing_rule`), else None."""
     if drives_at is None or not spec.operating.input_speed:
         phasing = phasing_rule(spec)
         return lambda line, kind, rpm: None if phasing is None else excites(line["harmonic"], kind, *phasing)
     own = kinematics(spec).mesh_frequency
+    gears = {mesh.id for mesh in spec.meshes}  # a cycloid stage's pin pass is a line of no gear mesh: None
 
     def excited(line, kind, rpm):
+        if line["meshes"][0] not in gears:
+            return None
         natural, _, driven = drives_at(rpm_to_rad_s(rpm), [(own[line["meshes"][0]], line["harmonic"])])
         return bool(driven[np.argmin(np.abs(natural - line["hz_per_rpm"] * rpm)), 0])
 

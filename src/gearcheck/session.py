@@ -108,7 +108,7 @@ class Train:
         if len(speeds) < 2 or any(b <= a for a, b in zip(speeds, speeds[1:])):
             raise GearcheckError(f"speeds: give at least two speeds in ascending order, got {list(speeds)}")
         return campbell(self.spec, speeds, lambda s, w: sides[s].modes_at_speed(w), solvers, harmonics,
-                        self.lumped.drives_at_speed)
+                        self.lumped.drives_at_speed if self.lumped.drives_known else None)
 
     def mac(self, model=None, against: str = "lumped") -> ModePairing:
         """The two solvers' mode shapes paired by the modal assurance criterion (Allemang & Brown 1982); with

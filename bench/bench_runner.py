@@ -10,7 +10,9 @@
    (rollout) <= 1.1 (the runner does more than a bare step: the drive at every stage, contact events located,
    the mesh forces read at every sample).  Also without samples, as a sweep point's settling stretch runs: the
    runner sampling only its run's ends (its steps then go without MuJoCo's sensors) against ``rollout`` with
-   the sensors disabled.
+   the sensors disabled.  The table holds each column's best of the repeats; the ratios to ``rollout`` are the
+   median of each repeat's own ratio (its runs back to back), which a machine whose speed drifts between repeats
+   moves less than a ratio of two bests taken at different times.
 2. Several twins at once (``simulate_mujoco_many``, threads): wall time per step per twin.
 3. With ``--convergence``: normalised RMS differences between MuJoCo and the lumped RK4 run of
    demo-3p as the step shrinks.
@@ -115,14 +117,17 @@ def cost_table(n_steps: int, twins: int, repeats: int = 5):
                           rollout_step_cost(mb, n_steps, dt, sensors=False),
                           runner_step_cost(mb, n_steps, dt, "compiled", sampled=False)))
         bare, bare_c, before, after, many, quiet_c, quiet = np.min(costs, axis=0)
+        paired = np.median([(c[3] / c[1], c[6] / c[5]) for c in costs], axis=0)  # each repeat's own ratios
         label = n_stages if isinstance(n_stages, str) else f"{n_stages} stage" + ("s" if n_stages > 1 else "")
-        rows.append((label, bare, bare_c, before, after, many, quiet_c, quiet))
+        rows.append((label, bare, bare_c, before, after, many, quiet_c, quiet, *paired))
         print(f"{label:<10} {mb.model.nbody - 1:>6} {mb.model.ntendon:>7} {dt:>10.4g} {bare * 1e6:>9.2f} "
               f"{bare_c * 1e6:>9.2f} {before * 1e6:>11.2f} {after * 1e6:>11.2f} {before / bare:>8.3f} "
               f"{after / bare:>8.3f} {many * 1e6:>8.2f} {many / bare:>8.3f}")
-    print("runner/bare C (compiled, sampled at every step): " + ", ".join(f"{r[0]} {r[4] / r[2]:.3f}" for r in rows))
-    print("without samples (a sweep's settling stretch), runner / bare C without sensors: " + ", ".join(
-        f"{r[0]} {r[7] * 1e6:.2f} / {r[6] * 1e6:.2f} us = {r[7] / r[6]:.3f}" for r in rows))
+    print("runner/bare C (compiled, sampled at every step; median of the repeats' own ratios): " + ", ".join(
+        f"{r[0]} {r[8]:.3f}" for r in rows))
+    print("without samples (a sweep's settling stretch), runner / bare C without sensors (best of each, then the "
+          "median of the repeats' own ratios): " + ", ".join(
+              f"{r[0]} {r[7] * 1e6:.2f} / {r[6] * 1e6:.2f} us, {r[9]:.3f}" for r in rows))
     return rows
 
 

@@ -9,6 +9,9 @@ Every figure below is measured in this one run, side by side:
    stiffness jumps, contacts, outputs, divergence checks) on every preset, against a minimal numba RK4 of
    M q'' = F(t) - C q' - K(t) q, K(t) q = K_0 q + A^T (k(t) * A q), over the same steps with the same stiffness
    history (the yardstick; its kernel alone is timed, the history precomputed).  Target: ratio <= 3.
+   The loop against its own kernel, in one process (cProfile): the RK4 loop of ``simulate`` (the drive sampled
+   per chunk, steps split at stiffness jumps, divergence checks) over the compiled steps alone
+   (``rk4_steps``).  Target: <= 1.2.
 3. scipy.integrate.solve_ivp RK45 (``simulate(method="RK45")``) at equal accuracy on hub-drive and demo-3p: the
    error is the largest mesh-force difference from a reference run (RK4 at a sixteenth of the default step,
    drive at each stage's own time) over the samples, over the peak mesh force; RK45 takes the loosest rtol of a
@@ -26,7 +29,9 @@ Run:  python bench/bench_lumped.py [--quick]
 from __future__ import annotations
 
 import argparse
+import cProfile
 import os
+import pstats
 import subprocess
 import sys
 import tempfile
@@ -140,6 +145,29 @@ def cost_table(title: str, label: str, cases, repeats: int = 1):
               f"{per_step:>8.2f} {yard:>9.2f} {per_step / yard:>6.2f} {per_step * info.steps / first:>7.2f}")
         rows.append((name, per_step, yard))
     return rows
+
+
+def loop_and_kernel(model, duration: float, repeats: int = 3) -> tuple[float, float]:
+    """(seconds of the RK4 loop of :func:`simulate`, of which in its compiled kernel) on ``model`` over
+    ``duration``, from cProfile in one process, the run with the fastest loop of ``repeats``: a machine whose speed
+    drifts moves both alike.  The kernel is one Python call a chunk, so the profile costs it nothing."""
+    best = (np.inf, np.inf)
+    for _ in range(repeats):
+        profile = cProfile.Profile()
+        profile.runcall(simulate, model, RunSettings(duration))
+        stats = pstats.Stats(profile).stats  # (file, line, function) -> (calls, primitive calls, own, cumulative, ...)
+        loop = next(v[3] for k, v in stats.items() if k[2] == "_rk4" and k[0].endswith("time_solver.py"))
+        kernel = next(v[3] for k, v in stats.items() if k[2] == "rk4_steps")
+        best = min(best, (loop, kernel))
+    return best
+
+
+def loop_table(duration: float):
+    print(f"\nthe lumped loop against its kernel ({duration:g} s, cProfile in one process; target <= 1.2)")
+    print(f"{'preset':<22} {'loop [s]':>9} {'kernel [s]':>10} {'ratio':>6}")
+    for name in PRESETS:
+        loop, kernel = loop_and_kernel(build_model(load_train(name)), duration)
+        print(f"{name:<22} {loop:>9.3f} {kernel:>10.3f} {loop / kernel:>6.2f}")
 
 
 # ---------------------------------------------------------------------------------------------- equal accuracy
@@ -260,6 +288,7 @@ def main():
         compile_table()
     cost_table("every preset (0.02 s; yardstick: minimal numba RK4 of the same M, C, K(t), F(t), same steps)",
                "preset", [(name, load_train(name), 0.02 * scale) for name in PRESETS], repeats=5)
+    loop_table(0.5 * scale)
     accuracy_table(args.quick)
     steady_state_table()
     demo = load_train("demo-3p")

@@ -539,8 +539,9 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
         except SolverError as exc:
             failed[solver] = str(exc)
     runs = _aligned(runs, point, plan, lines, failed)
+    parting = _parting(spec, model.excitation)
     checked = _checked(point, lines, lumped.resonances([(f / k, k) for _, k, f in lines]),
-                       any(_unloads(run, _parting(spec, model.excitation)) for _, run in runs.values()))
+                       any(_unloads(run, parting) for _, run in runs.values()))
     states = {}
     for solver in point.solvers:
         if solver in failed:

@@ -288,6 +288,38 @@ def test_contact_force_on_many_approach_position_pairs_matches_the_sum():
     np.testing.assert_allclose(stiffness, np.sum(np.where(reach >= 0, k[rows], 0.0), axis=-1), rtol=1e-12)
 
 
+def trapezoids(xi, eps_a, eps_b):
+    """The lines' shares of the face summed, as contact_line_length's docstring defines them, in numpy: a row of
+    lines per sample."""
+    u = np.mod(xi, 1.0)[..., None] + np.arange(math.floor(eps_a + eps_b) + 1)
+    if eps_b == 0.0:
+        return (u < eps_a).sum(axis=-1).astype(float)
+    return ((np.clip(u, 0.0, eps_b) - np.clip(u - eps_a, 0.0, eps_b)) / eps_b).sum(axis=-1)
+
+
+@pytest.mark.parametrize("eps_a, eps_b", [(1.55, 0.0), (1.4, 0.7), (2.3, 2.9), (0.6, 0.4), (1.8, 4.9), (1.2, 8.3)])
+def test_the_compiled_contact_lines_are_the_formula_in_numpy(eps_a, eps_b):
+    """The compiled sum over the lines (both solvers call it at every stage time) is numpy's evaluation of the
+    trapezoids to the bit below 8 lines, where numpy adds one by one too (every edge: the corners, whole cycles, both
+    signs, huge positions, the infinities and NaN), and within a few rounding errors of numpy's pairwise sum above."""
+    rng = np.random.default_rng(int(10 * eps_a + eps_b))
+    kinks = np.mod([0.0, eps_a, eps_b, eps_a + eps_b], 1.0)
+    edges = (kinks + np.arange(-3, 4)[:, None]).ravel()
+    xi = np.concatenate([rng.uniform(-1e3, 1e3, 20000), rng.uniform(-2, 2, 20000), edges,
+                         np.nextafter(edges, np.inf), np.nextafter(edges, -np.inf),
+                         [0.0, -0.0, 5e-324, -5e-324, 1 - 2**-53, 2.0**60, -2.0**60, 1e20, -3e19, np.inf, -np.inf,
+                          np.nan]])
+    beta = helix(eps_b)
+    with np.errstate(invalid="ignore"):
+        expected = WIDTH / math.cos(beta) * trapezoids(xi, eps_a, eps_b)
+    length = contact_line_length(xi.reshape(-1, 2), eps_a, eps_b, WIDTH, beta)
+    assert length.shape == (xi.size // 2, 2)
+    if math.floor(eps_a + eps_b) + 1 < 8:
+        assert np.array_equal(length.ravel(), expected, equal_nan=True)
+    else:
+        np.testing.assert_allclose(length.ravel(), expected, rtol=8 * np.finfo(float).eps, atol=0.0)
+
+
 @pytest.mark.parametrize("call, message", [
     (lambda: contact_line_length(0.0, 0.4, 0.5, WIDTH, helix(0.5)), "below 1"),
     (lambda: contact_line_length(0.0, 1.5, -0.1, WIDTH, 0.1), "negative"),

@@ -45,14 +45,14 @@ def contact_line_length(xi, eps_a: float, eps_b: float, face_width: float, base_
     over eps_b with u = xi + j, is a trapezoid in u (the box [0, eps_a) smeared over eps_b).  A
     line over face width w is w / cos(beta_b) long.  eps_b = 0: the spur rectangular wave.
     """
+    from gearcheck.train.compiled_excitation import contact_line_shares  # numba on first use, not at import
+
     _check_ratios(eps_a, eps_b)
     _check_line(eps_b, face_width, base_helix_angle)
-    u = np.mod(np.asarray(xi, dtype=float), 1.0)[..., None] + np.arange(math.floor(eps_a + eps_b) + 1)
-    if eps_b > 0.0:
-        share = (np.clip(u, 0.0, eps_b) - np.clip(u - eps_a, 0.0, eps_b)) / eps_b
-    else:
-        share = (u < eps_a).astype(float)
-    return face_width / math.cos(base_helix_angle) * share.sum(axis=-1)
+    xi = np.asarray(xi, dtype=float)
+    shares = np.empty(xi.shape)
+    contact_line_shares(np.ravel(xi), float(eps_a), float(eps_b), math.floor(eps_a + eps_b) + 1, shares.reshape(-1))
+    return face_width / math.cos(base_helix_angle) * shares
 
 
 def mean_contact_line_length(eps_a: float, face_width: float, base_helix_angle: float) -> float:

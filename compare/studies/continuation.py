@@ -38,15 +38,14 @@ point's final state (kept, losslessly, in that point's cache file) to the same b
 from __future__ import annotations
 
 import dataclasses
-import io
 import json
 import math
 from dataclasses import dataclass
 
 import numpy as np
-import pyarrow.parquet as pq
 
 from gearcheck.compare.engine.align import STEADY_THRESHOLD, STEADY_WINDOW_CYCLES
+from gearcheck.shared import parquet_bytes
 from gearcheck.shared.results import TimeResult
 from gearcheck.shared.run_state import RunState
 from gearcheck.shared.settings import RunSettings
@@ -121,7 +120,7 @@ def started(before: bytes | None) -> str | None:
 
 def _metadata(before: bytes | None) -> dict:
     """The schema metadata of the point table ``before`` (empty where there is none)."""
-    return {} if before is None else pq.read_schema(io.BytesIO(before)).metadata or {}
+    return {} if before is None else parquet_bytes.metadata(before)
 
 
 BINS = 64  # phases of a mesh cycle at which a waveform is averaged

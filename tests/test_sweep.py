@@ -123,6 +123,18 @@ def test_reproducible_and_resumable_from_the_cache(tmp_path):
         assert sw.sweep("demo-3p", speeds=SPEEDS, executor=executor, **FAST).parquet() == first.parquet()
 
 
+def test_a_point_cached_by_other_code_is_computed_again(tmp_path, monkeypatch):
+    """The key holds the code (the package's Python files and the numeric libraries' versions), not only the
+    release: after an edit of the solvers in a checkout, or a library's upgrade, the cache gives no old bytes."""
+    first = sw.sweep("demo-3p", speeds=SPEEDS, workers=1, cache=tmp_path, **FAST)
+    assert len(sw.code_digest()) == 64
+    monkeypatch.setattr(sw, "code_digest", lambda: "0" * 64)
+    other = sw.sweep("demo-3p", speeds=SPEEDS, workers=1, cache=tmp_path, **FAST)
+    assert (other.computed, other.cached) == (3, 0)
+    assert set(other.to_pandas()["key"]).isdisjoint(first.to_pandas()["key"])
+    assert len(list(tmp_path.glob("*.parquet"))) == 6
+
+
 def test_an_interrupted_sweep_keeps_its_finished_points(tmp_path):
     def stop_at(share):
         def stop(fraction):

@@ -144,13 +144,39 @@ COLUMNS = {  # every column of the sweep table: (unit, meaning)
                     "resonance (a line in the half-power band of a mode it drives), contact (a mesh with backlash "
                     "or tip relief unloads below a tenth of its mean force), or no"),
     "error": ("", "why a solver failed at this point (metric failed)"),
-    "key": ("", "SHA-256 of the point's inputs: its cache file's name"),
+    "key": ("", "SHA-256 of the point's inputs and of the code that ran it: its cache file's name"),
 }
 
 
 @functools.lru_cache(maxsize=1)
 def version() -> str:
     return importlib.metadata.version("gearcheck")
+
+
+NUMERIC_LIBRARIES = ("numpy", "scipy", "mujoco", "numba", "pyarrow")  # whose arithmetic a point's bytes carry
+
+
+@functools.lru_cache(maxsize=1)
+def code_digest() -> str:
+    """SHA-256 of the code that computes a point, part of its key: every Python file of the installed gearcheck
+    (its name in the package and its bytes: an editable install maps subpackages to their own folders) and the
+    versions of :data:`NUMERIC_LIBRARIES`.  A point cached by other code -- a checkout one commit on, a library
+    upgraded -- is computed again, where a key holding the release alone would give its old bytes."""
+    import gearcheck
+    from gearcheck import compare, lumped, mbd_models
+
+    files = {}  # name -> path, the name as an install lays it out (gearcheck/lumped/time_solver.py)
+    for package in (gearcheck, lumped, mbd_models, compare):
+        for root in map(Path, package.__path__):
+            for path in root.rglob("*.py"):
+                files[f"{package.__name__.replace('.', '/')}/{path.relative_to(root).as_posix()}"] = path
+    digest = hashlib.sha256()
+    for name, path in sorted(files.items()):
+        data = path.read_bytes()
+        digest.update(f"{name}\0{len(data)}\0".encode() + data)
+    for library in NUMERIC_LIBRARIES:
+        digest.update(f"{library} {importlib.metadata.version(library)}\0".encode())
+    return digest.hexdigest()
 
 
 # ----------------------------------------------------------------------------- fields of the train file
@@ -259,9 +285,9 @@ class Point:
     @property
     def key(self) -> str:
         """SHA-256 of the point's canonical inputs: the edited train file's text and the files it reads, not
-        where it lies, and the key of the point it goes on from, not its index (the same run in two sweeps shares
-        it)."""
-        data = {"format": FORMAT, "gearcheck": version(), "train": self.text,
+        where it lies, the key of the point it goes on from, not its index (the same run in two sweeps shares
+        it), and the code that runs it (:func:`code_digest`)."""
+        data = {"format": FORMAT, "gearcheck": version(), "code": code_digest(), "train": self.text,
                 "speed_rpm": self.speed_rpm, "solvers": list(self.solvers), "duration_s": self.duration,
                 "harmonics": self.harmonics, "files": self.extra, "integration_check": self.check,
                 "refine": self.refine, "after": self.after, "after_rpm": self.after_rpm, "place": self.place,

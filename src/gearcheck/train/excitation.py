@@ -197,7 +197,7 @@ class Excitation:
         """Static transmission error e(t) and its rate per mesh, in m and m/s; shape (..., n_mesh)."""
         t = np.asarray(t, dtype=float)
         e = np.zeros(t.shape + (len(self.mesh_ids),))
-        de = np.zeros_like(e)
+        de = np.zeros(e.shape)  # not zeros_like, which writes its zeros: zeros maps zero pages until they are written
         if not self.has_transmission_error:
             return e, de
         from gearcheck.train.compiled_excitation import add_terms  # numba on first use, not when a file is read

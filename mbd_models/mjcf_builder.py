@@ -197,7 +197,7 @@ def document(spec: TrainSpec, header: list[str]) -> Template:
     lines = ["<!--"] + [f"  {h}" for h in header] + ["-->", f'<mujoco model="{spec.name}">',
              '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
              f'  <option timestep="{slot(TIMESTEP)}" integrator="RK4" gravity="0 0 0">',
-             '    <flag contact="disable"/>', "  </option>",
+             '    <flag contact="disable" constraint="disable"/>', "  </option>",
              '  <visual><map znear="0.001"/><headlight ambient="0.4 0.4 0.4" diffuse="0.6 0.6 0.6"/></visual>']
     lines += (_assets(spec) if VISUALS else []) + _worldbody(spec, VISUALS)
     tendons = _hook(spec, "driven_tendons", spec) + _hook(spec, "tendons", spec)  # the driven ones first

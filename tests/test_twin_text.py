@@ -34,6 +34,31 @@ def test_the_file_compiles_to_the_twin(name):
     assert model.opt.timestep == again.opt.timestep
 
 
+@pytest.mark.parametrize("name", ["demo-3p", "rv-reducer"])
+def test_the_twin_runs_without_mujocos_constraint_stage_to_the_same_bits(name):
+    """The twin has no constraint (every force a joint's or a tendon's spring and damper, a control or an applied
+    force), so its document disables the constraint stage: a step with the stage on gives the same state to the
+    bit.  A constraint that a part brought would be refused, not ignored."""
+    mb = twin.compile_train(gearcheck.load(name))
+    model = mb.model
+    assert model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    states = []
+    for flags in (model.opt.disableflags, model.opt.disableflags & ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)):
+        model.opt.disableflags = flags
+        data = mujoco.MjData(model)
+        data.qvel[:] = np.linspace(-1.0, 1.0, model.nv)  # moving, so that every force acts
+        data.ctrl[:] = 1.0
+        for _ in range(20):
+            mujoco.mj_step(model, data)
+        states.append(np.concatenate([data.qpos, data.qvel, data.qacc]))
+    assert np.array_equal(states[0], states[1])
+    limited = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint name="j" type="hinge" range="-1 1"/><geom size="0.1"/></body></worldbody>'
+        '<equality><joint joint1="j"/></equality></mujoco>')
+    with pytest.raises(RuntimeError, match="1 equality, 1 limited joint: its constraint stage is disabled"):
+        twin.check_unconstrained(limited, "a train")
+
+
 def test_late_numbers_are_slots_filled_by_name():
     text = Template("\n".join(fixed("m", [("a", LATE), ("b", LATE)], LATE, LATE, (-0.5, 0.5))
                               + fixed("p", [("a", 1.0)], 2.0, 0.0, LATE)))

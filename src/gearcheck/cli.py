@@ -783,8 +783,9 @@ def cmd_sweep(args) -> int:
         summary = result.summary()
     n = len(result.plan.points)
     per_point = f", {sum(result.point_wall_s) / result.computed:.3g} s per point run" if result.computed else ""
+    where = "in this process" if result.backend == "in-process" else f"on {result.backend}"
     print(f"{result.train}: {n} points ({result.computed} run, {result.cached} from the cache"
-          f"{'' if cache is None else f' {cache}'}) in {result.wall_s:.3g} s on {result.backend}{per_point}")
+          f"{'' if cache is None else f' {cache}'}) in {result.wall_s:.3g} s {where}{per_point}")
     by_quantity: dict[str, list[str]] = {}
     for peak in summary["peaks"]:
         by_quantity.setdefault(peak["quantity"], []).append(

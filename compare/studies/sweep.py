@@ -54,6 +54,7 @@ import dataclasses
 import functools
 import hashlib
 import importlib.metadata
+import importlib.util
 import itertools
 import json
 import math
@@ -162,14 +163,11 @@ def code_digest() -> str:
     (its name in the package and its bytes: an editable install maps subpackages to their own folders) and the
     versions of :data:`NUMERIC_LIBRARIES`.  A point cached by other code -- a checkout one commit on, a library
     upgraded -- is computed again, where a key holding the release alone would give its old bytes."""
-    import gearcheck
-    from gearcheck import compare, lumped, mbd_models
-
     files = {}  # name -> path, the name as an install lays it out (gearcheck/lumped/time_solver.py)
-    for package in (gearcheck, lumped, mbd_models, compare):
-        for root in map(Path, package.__path__):
+    for package in ("gearcheck", "gearcheck.lumped", "gearcheck.mbd_models", "gearcheck.compare"):
+        for root in map(Path, importlib.util.find_spec(package).submodule_search_locations):  # found, not imported
             for path in root.rglob("*.py"):
-                files[f"{package.__name__.replace('.', '/')}/{path.relative_to(root).as_posix()}"] = path
+                files[f"{package.replace('.', '/')}/{path.relative_to(root).as_posix()}"] = path
     digest = hashlib.sha256()
     for name, path in sorted(files.items()):
         data = path.read_bytes()

@@ -89,8 +89,10 @@ def line_drives(model, lines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     where the line drives it (:func:`gearcheck.shared.modal.driven_modes`) more than :data:`DRIVEN` of the mode
     it drives most: over the speed ranges of the hub drive, the helical planetary, the RV reducer and demo-3p,
     the cancelled ones sit at round-off (1.3e-10 and below), the driven ones at 4e-4 and above.  A gear's
-    eccentricity forces its rotation frequency, off the lines.  Where a mesh's force is not linear in its
-    deflection (tip relief) or a torque ripple may fall on a line, every mode counts for every line."""
+    eccentricity forces its rotation frequency, off the lines.  A line at no mesh's frequency is refused
+    (ValueError): no mesh forces it, and "it drives no mode" would be a wrong answer.  Where a mesh's force is not
+    linear in its deflection (tip relief) or a torque ripple may fall on a line, every mode counts for every
+    line."""
     exc = model.excitation
     M, D, K = model.M, model.C + model.G, model.K_mean + model.K_frame
     if not drives_are_linear(model):
@@ -102,7 +104,11 @@ def line_drives(model, lines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     forces = np.zeros((M.shape[0], len(lines)), dtype=complex)
     for i, (frequency, k) in enumerate(lines):
         amplitudes = np.zeros(len(exc.models), dtype=complex)
-        for m in np.flatnonzero(np.isclose(exc.frequency, frequency, rtol=1e-9, atol=0.0)):
+        meshes = np.flatnonzero(np.isclose(exc.frequency, frequency, rtol=1e-9, atol=0.0))
+        if not meshes.size:  # no force to drive anything: not "drives nothing"
+            raise ValueError(f"line at {frequency!r} Hz (harmonic {k}) is no mesh frequency of {model.spec.name} at "
+                             f"its speed ({', '.join(f'{f:.6g}' for f in np.unique(exc.frequency))} Hz)")
+        for m in meshes:
             c = np.mean(shapes[m] * np.exp(-2j * np.pi * k * xi))
             error = sum(0.5 * amplitude * np.exp(1j * phase)
                         for h, amplitude, phase in model.spec.meshes[m].ste if h == k)

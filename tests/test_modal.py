@@ -7,7 +7,7 @@ import pytest
 
 from gearcheck.lumped.assembly import build_model
 from gearcheck.train.loader import load_train
-from gearcheck.lumped.modal import line_resonances, modes, modes_at_speed
+from gearcheck.lumped.modal import line_drives, line_resonances, modes, modes_at_speed
 from gearcheck.shared.modal import driven_modes
 from gearcheck.train.variants import edited, wide_stage
 
@@ -129,3 +129,13 @@ def test_dof_count_and_labels():
     result = modes(build_model(load_train("demo-4p")))
     assert len(result) == 3 * (3 + 4)
     assert result.dof_labels[:3] == ["stage1.sun.x", "stage1.sun.y", "stage1.sun.theta"]
+
+
+def test_a_line_at_no_mesh_frequency_is_refused_not_read_as_driving_nothing():
+    """line_drives answers for lines of the train's mesh frequencies; a frequency no mesh has would find every mode
+    undriven, an answer for a question it cannot decide."""
+    model = build_model(load_train("demo-3p"))
+    f_mesh = float(model.excitation.frequency[0])
+    assert line_drives(model, [(f_mesh, 1)])[2].any()
+    with pytest.raises(ValueError, match=r"line at 123\.4 Hz \(harmonic 1\) is no mesh frequency of demo-3p"):
+        line_drives(model, [(f_mesh, 1), (123.4, 1)])

@@ -112,9 +112,9 @@ def campbell(spec, speeds_rpm, modes_at, solvers=("lumped", "mujoco"), harmonics
 
 def _excitation(spec, drives_at):
     """excited(line, mode type, speed in rpm) of a crossing at the line's frequency there: whether the line drives
-    the mode of the lumped model at that speed nearest that frequency (``drives_at``, given for a turning train;
-    None for a line of no gear mesh, a cycloid stage's pin pass), else Parker's rule where it applies
-    (:func:`phasing_rule`), else None."""
+    the mode of the lumped model at that speed nearest that frequency (:func:`nearest_mode_driven`; ``drives_at``,
+    given for a turning train; None for a line of no gear mesh, a cycloid stage's pin pass), else Parker's rule
+    where it applies (:func:`phasing_rule`), else None."""
     if drives_at is None or not spec.operating.input_speed:
         phasing = phasing_rule(spec)
         return lambda line, kind, rpm: None if phasing is None else excites(line["harmonic"], kind, *phasing)
@@ -125,9 +125,21 @@ def _excitation(spec, drives_at):
         if line["meshes"][0] not in gears:
             return None
         natural, _, driven = drives_at(rpm_to_rad_s(rpm), [(own[line["meshes"][0]], line["harmonic"])])
-        return bool(driven[np.argmin(np.abs(natural - line["hz_per_rpm"] * rpm)), 0])
+        return nearest_mode_driven(natural, driven[:, 0], line["hz_per_rpm"] * rpm)
 
     return excited
+
+
+def nearest_mode_driven(natural, driven, frequency: float) -> bool | None:
+    """Whether the mode nearest ``frequency`` (Hz) among the modes ``natural`` (Hz) is ``driven``; None where the
+    nearest is not clearly it (the next mode at most twice as far: a pair that has barely split, a crossing
+    interpolated between two close modes) and the two are not driven alike."""
+    distance = np.abs(np.asarray(natural, dtype=float) - frequency)
+    order = np.argsort(distance, kind="stable")
+    first = bool(driven[order[0]])
+    if order.size > 1 and distance[order[1]] <= 2.0 * distance[order[0]] and bool(driven[order[1]]) != first:
+        return None
+    return first
 
 
 def phasing_rule(spec) -> tuple[int, int] | None:

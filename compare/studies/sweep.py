@@ -165,7 +165,10 @@ def code_digest() -> str:
     upgraded -- is computed again, where a key holding the release alone would give its old bytes."""
     files = {}  # name -> path, the name as an install lays it out (gearcheck/lumped/time_solver.py)
     for package in ("gearcheck", "gearcheck.lumped", "gearcheck.mbd_models", "gearcheck.compare"):
-        for root in map(Path, importlib.util.find_spec(package).submodule_search_locations):  # found, not imported
+        found = importlib.util.find_spec(package)  # found, not imported: compare does not import the front door
+        if found is None or found.submodule_search_locations is None:
+            raise RuntimeError(f"{package} is not an installed package")
+        for root in map(Path, found.submodule_search_locations):
             for path in root.rglob("*.py"):
                 files[f"{package.replace('.', '/')}/{path.relative_to(root).as_posix()}"] = path
     digest = hashlib.sha256()

@@ -113,11 +113,11 @@ class LumpedModel:
 
     @property
     def K_b(self) -> np.ndarray:
-        return _sum_outer(self.rows, "stiffness", self.n)
+        return sum_outer(self.rows, "stiffness", self.n)
 
     @property
     def C_b(self) -> np.ndarray:
-        return _sum_outer(self.rows, "damping", self.n)
+        return sum_outer(self.rows, "damping", self.n)
 
     def K_mesh(self, k: np.ndarray) -> np.ndarray:
         return self.mesh_rows.T @ (k[:, None] * self.mesh_rows)
@@ -140,12 +140,16 @@ class LumpedModel:
                        rotating_frame_terms=False, turning=turning)
 
 
-def _sum_outer(rows, attr, n):
+def sum_outer(rows, attr: str, n: int) -> np.ndarray:
+    """sum_r value_r a_r a_r^T over the rows whose ``attr`` (stiffness or damping) is non-zero, added in the rows'
+    order as one outer product at a time would be (numpy reduces the stacked terms row by row: the same bits,
+    without a Python step per row)."""
+    kept = [r for r in rows if getattr(r, attr)]
     out = np.zeros((n, n))
-    for r in rows:
-        value = getattr(r, attr)
-        if value:
-            out += value * np.outer(r.a, r.a)
+    if kept:
+        a = np.array([r.a for r in kept])
+        terms = np.array([getattr(r, attr) for r in kept])[:, None, None] * (a[:, :, None] * a[:, None, :])
+        np.add.reduce(terms, axis=0, out=out)
     return out
 
 

@@ -21,7 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from gearcheck.lumped.assembly import LumpedModel, contact_sets, frozen_at
+from gearcheck.lumped.assembly import LumpedModel, contact_sets, frozen_at, sum_outer
 from gearcheck.lumped.fourier_response import ParametricProblem, grid_angles
 from gearcheck.lumped.static import mean_load
 from gearcheck.shared.errors import SolverError
@@ -134,7 +134,6 @@ def _turning_part(model: LumpedModel, omega: float, contacts: dict):
             contacts.setdefault(key, contact_sets(frozen))
             names = {name for e in frozen.turning for name in e.rows}
             rows = [r for r in frozen.rows if r.name in names]
-            cache[key] = tuple(sum((getattr(r, attr) * np.outer(r.a, r.a) for r in rows), np.zeros((model.n,) * 2))
-                               for attr in ("stiffness", "damping"))
+            cache[key] = tuple(sum_outer(rows, attr, model.n) for attr in ("stiffness", "damping"))
         return cache[key]
     return part

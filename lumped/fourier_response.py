@@ -26,6 +26,7 @@ from scipy import sparse
 from scipy.linalg import lu_factor, lu_solve
 from scipy.sparse.linalg import splu
 
+from gearcheck.shared.blas import one_blas_thread
 from gearcheck.shared.errors import SolverError
 
 
@@ -236,6 +237,7 @@ def hill_force(problem: ParametricProblem, orders) -> np.ndarray:
     return out.ravel()
 
 
+@one_blas_thread
 def fourier_series_response(problem: ParametricProblem, harmonics) -> HarmonicResponse:
     """The Fourier series method (Yang, Chen & Wang 2018, Eqs. 5-6) with damping, for ``harmonics``: orders
     (H for one frequency, (H1, H2) for two: every h != 0 with |h_k| <= H_k) or explicit (m, d) rows h."""
@@ -248,6 +250,7 @@ def fourier_series_response(problem: ParametricProblem, harmonics) -> HarmonicRe
     return HarmonicResponse("Fourier series", _fs_truncation(problem, h), h, w, q, np.reshape(Q, (len(h), problem.n)))
 
 
+@one_blas_thread
 def harmonic_balance_response(problem: ParametricProblem, orders) -> HarmonicResponse:
     """Harmonic balance (Hill's method; Bolotin 1964, Nayfeh & Mook 1979) on the lattice |h_k| <= H_k,
     ``orders`` = H, (H1, H2) or a union of such boxes (:func:`harmonic_lattice`)."""

@@ -30,6 +30,7 @@ from gearcheck.lumped.fourier_response import (
     lattice_response,
     refined_solve,
 )
+from gearcheck.shared.blas import one_blas_thread
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,7 @@ def parameter_derivative(problem: ParametricProblem, dM=None, dC=None, dK_of=Non
                    C_of=dC_of, F_of=dF_of)
 
 
+@one_blas_thread
 def fourier_series_sensitivity(problem: ParametricProblem, derivative: ParametricProblem, harmonics,
                                truncated: bool = False) -> ResponseSensitivity:
     """d/d xi of :func:`fourier_series_response`; ``truncated``: Yang, Chen & Wang's Eq. (15), dA_h dropped."""
@@ -71,6 +73,7 @@ def fourier_series_sensitivity(problem: ParametricProblem, derivative: Parametri
                                                  amplitudes=np.reshape(dQ, response.amplitudes.shape)))
 
 
+@one_blas_thread
 def harmonic_balance_sensitivity(problem: ParametricProblem, derivative: ParametricProblem,
                                  orders) -> ResponseSensitivity:
     """d/d xi of :func:`harmonic_balance_response` on the lattice |h_k| <= H_k."""

@@ -25,6 +25,7 @@ of t = 0 with the contact set of the static solution (like a turning coupling), 
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 from typing import NamedTuple
 
@@ -204,15 +205,12 @@ class CycloidRows(Turning):
     def pin_rows(self, t: float) -> list[tuple[str, np.ndarray]]:
         """Every pin contact's row at one time, named (disc j, pin i)."""
         on_disc, on_wheel = self.pin_coefficients(t)
-        out = []
+        a = np.zeros(on_disc.shape[:2] + (self.n,))
         for j, disc in enumerate(self.disc):
-            for i in range(on_disc.shape[-2]):
-                a = np.zeros(self.n)
-                a[disc] += on_disc[j, i]
-                if self.wheel is not None:
-                    a[self.wheel] += on_wheel[j, i]
-                out.append((f"{self.stage}.disc{j + 1}.pin{i + 1}", a))
-        return out
+            a[j][:, disc] += on_disc[j]
+            if self.wheel is not None:
+                a[j][:, self.wheel] += on_wheel[j]
+        return list(zip(_pin_names(self.stage, *a.shape[:2]), a.reshape(-1, self.n)))
 
     def switching(self, t: float, q, v) -> tuple[np.ndarray, np.ndarray]:
         """Every pin's compression (disc by disc, pin by pin), the contact made where it turns positive, and its
@@ -300,6 +298,12 @@ class CycloidRows(Turning):
                 return active
             active = touching
         raise SolverError(f"{self.stage}: the static pin contact set did not settle")  # pragma: no cover
+
+
+@functools.lru_cache(maxsize=64)
+def _pin_names(stage: str, discs: int, pins: int) -> tuple[str, ...]:
+    """The pin rows' names, disc by disc (built once: a harmonic method places the rows at every sample)."""
+    return tuple(f"{stage}.disc{j + 1}.pin{i + 1}" for j in range(discs) for i in range(pins))
 
 
 # ------------------------------------------------------------------------- the compiled steps' form

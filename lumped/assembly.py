@@ -140,16 +140,18 @@ class LumpedModel:
                        rotating_frame_terms=False, turning=turning)
 
 
-def sum_outer(rows, attr: str, n: int) -> np.ndarray:
+def sum_outer(rows, attr: str, n: int, chunk_bytes: int = 1 << 23) -> np.ndarray:
     """sum_r value_r a_r a_r^T over the rows whose ``attr`` (stiffness or damping) is non-zero, added in the rows'
-    order as one outer product at a time would be (numpy reduces the stacked terms row by row: the same bits,
-    without a Python step per row)."""
+    order as one outer product at a time would be: numpy reduces the stacked terms row by row (the same bits,
+    without a Python step per row), at most ``chunk_bytes`` of them at a time after the sum so far."""
     kept = [r for r in rows if getattr(r, attr)]
     out = np.zeros((n, n))
-    if kept:
-        a = np.array([r.a for r in kept])
-        terms = np.array([getattr(r, attr) for r in kept])[:, None, None] * (a[:, :, None] * a[:, None, :])
-        np.add.reduce(terms, axis=0, out=out)
+    step = max(1, chunk_bytes // (8 * n * n))
+    for start in range(0, len(kept), step):
+        part = kept[start:start + step]
+        a = np.array([r.a for r in part])
+        terms = np.array([getattr(r, attr) for r in part])[:, None, None] * (a[:, :, None] * a[:, None, :])
+        out = np.add.reduce(np.concatenate([out[None], terms]), axis=0)
     return out
 
 

@@ -14,7 +14,7 @@ from numba import njit
 from numba.core.caching import NullCache
 
 import gearcheck
-from gearcheck.lumped.assembly import build_model
+from gearcheck.lumped.assembly import build_model, sum_outer
 from gearcheck.lumped.compiled_steps import rk4_steps
 from gearcheck.lumped.elements import ELEMENTS as LUMPED
 from gearcheck.lumped.elements import base as lumped_base
@@ -235,3 +235,21 @@ def test_a_part_whose_forces_move_with_time_runs_in_the_compiled_steps(monkeypat
     scale = np.max(np.abs(python[name]))
     assert np.max(np.abs(compiled[name] - python[name])) < 1e-9 * scale
     assert np.max(np.abs(compiled[name] - plain[name])) > 1e-3 * scale
+
+
+@pytest.mark.parametrize("chunk_bytes", [1 << 23, 8 * 12 * 12 * 7, 1])
+def test_the_rows_matrices_are_their_outer_products_added_in_order(chunk_bytes):
+    """K_b = sum_r k_r a_r a_r^T, stacked and reduced in chunks, is the sum taken one outer product at a time, to the
+    bit (the zeros' signs too): the generated files written from it do not move when the chunks do.  Rows of no
+    stiffness are left out, and their infinite coefficients with them."""
+    rng = np.random.default_rng(7)
+    rows = [Row(f"r{i}", "bearing", rng.standard_normal(12) * 10.0 ** rng.integers(-4, 4),
+                float(rng.choice([0.0, 1e8 * rng.standard_normal()])), 0.0) for i in range(300)]
+    rows.append(Row("loose", "contact", np.full(12, np.inf), 0.0, 0.0))
+    one_at_a_time = np.zeros((12, 12))
+    for r in rows:
+        if r.stiffness:
+            one_at_a_time += r.stiffness * np.outer(r.a, r.a)
+    summed = sum_outer(rows, "stiffness", 12, chunk_bytes)
+    assert np.array_equal(summed, one_at_a_time) and np.array_equal(np.signbit(summed), np.signbit(one_at_a_time))
+    assert not sum_outer(rows, "damping", 12, chunk_bytes).any()

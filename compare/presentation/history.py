@@ -16,10 +16,10 @@ Schema ``gearcheck.history`` version 1 (in the table ``meta``)::
             PRIMARY KEY (commit_id, train, item, metric))
 
 A run's metrics (``item`` / ``metric``): per quantity (``item`` its name) ``nrmse`` (gated against
-``tolerance`` when the quantity is), ``lumped.rms``, ``lumped.peak_to_peak``, ``mujoco.rms``,
-``mujoco.peak_to_peak`` (in the quantity's unit), ``integration_error.lumped`` and
-``integration_error.mujoco`` (with the quantity's tolerance, which their sum must stay below); per
-mode (``item`` "mode N") ``rel_error`` (gated), ``lumped.frequency`` and ``mujoco.frequency`` (Hz);
+``tolerance`` when the quantity is), ``reference.rms``, ``reference.peak_to_peak``, ``test.rms``,
+``test.peak_to_peak`` (in the quantity's unit), ``integration_error.reference`` and
+``integration_error.test`` (with the quantity's tolerance, which their sum must stay below); per
+mode (``item`` "mode N") ``rel_error`` (gated), ``reference.frequency`` and ``test.frequency`` (Hz);
 ``item`` "wall_time" and "cpu_time" (this process's, its threads included; reports up to gearcheck 0.2.0 have wall
 time only): one metric per timed step (s).
 

@@ -108,7 +108,8 @@ def _share_the_cores(workers: int) -> None:
     The workers already keep every core busy, and a BLAS thread that finds its core taken spins: with both cores
     busy, a 60-coordinate eigenproblem took 0.7-1.0 s on OpenBLAS's two threads and 0.02 s on one. The processes a
     test starts inherit the share."""
-    share = max(1, len(os.sched_getaffinity(0)) // workers)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1  # not on macOS
+    share = max(1, cores // workers)
     for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[name] = str(share)
     threadpool_limits(limits=share)

@@ -1,11 +1,13 @@
-"""Mesh harmonics of a signal that jumps: the plain windowed sum against the jump-corrected projection.
+"""Mesh harmonics of a signal that jumps: the plain windowed sum against the corrected projection.
 
 demo-3p's rectangular mesh stiffness switches twice a mesh cycle, so the mesh forces and the bodies' accelerations
 jump there.  The lumped solver runs the train at 1500 rpm for 0.5 s at 2, 1, 1/2, 1/4 and 1/8 times its default
 step h; the steady half of each run is projected on the first three mesh harmonics, once by the plain Hann-windowed
-sum and once with the jumps at the stiffness switches corrected (:func:`gearcheck.compare.engine.harmonics`).
-The plain lines converge at first order in the step (the jumps alias onto them: the step divides the mesh period),
-the corrected ones sit on their limit from the default step on.  Writes line_aliasing.png and line_aliasing.json.
+sum and once with each signal's jumps and changes of slope corrected where Newton's law puts them, as the sweep and
+the cross-check read their lines (:func:`gearcheck.compare.engine.harmonics` at the plan's
+:meth:`~gearcheck.compare.engine.plan.TrainPlan.singularities`).  The plain lines converge at first order in the
+step (the jumps alias onto them: the step divides the mesh period), the corrected ones sit on their limit from the
+default step on.  Writes line_aliasing.png and line_aliasing.json.
 
 Run:  OPENBLAS_NUM_THREADS=1 python examples/sweep_line_aliasing.py --out docs/sweep
 """
@@ -20,7 +22,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import gearcheck
-from gearcheck.compare.engine import harmonics  # what this example shows at work
+from gearcheck.compare.engine import TrainPlan, harmonics  # what this example shows at work
 
 TRAIN, SPEED, DURATION = "demo-3p", 1500.0, 0.5
 QUANTITIES = ("stage1.planet1.sun.force", "stage1.sun.alpha")
@@ -34,12 +36,12 @@ def lines(train, factor: float, frequencies: np.ndarray) -> dict:
     run = train.simulate("lumped", DURATION, dt=factor * default)
     window = run.t >= 0.5 * DURATION
     t = run.t[window]
-    switches = train.lumped.model.excitation.switch_times(t[0], t[-1])
+    switches, kinks = TrainPlan.of(train.spec, train.lumped, DURATION).singularities(QUANTITIES, t[0], t[-1])
     out = {}
-    for q in QUANTITIES:
+    for j, q in enumerate(QUANTITIES):
         x = run[q][window]
         out[q] = (np.abs(harmonics(t, x, frequencies, np.inf)[:, 0]),
-                  np.abs(harmonics(t, x, frequencies, np.inf, switches)[:, 0]))
+                  np.abs(harmonics(t, x, frequencies, np.inf, switches[j], kinks[j])[:, 0]))
     return out
 
 
@@ -51,7 +53,7 @@ def figure(steps_per_cycle, data, units) -> Figure:
             ax.plot(steps_per_cycle, [d[q][0][k] for d in data], "--o", color=colour, ms=4, mfc="none",
                     label=f"{k + 1}× mesh, plain sum")
             ax.plot(steps_per_cycle, [d[q][1][k] for d in data], "-o", color=colour, ms=4,
-                    label=f"{k + 1}× mesh, jumps corrected")
+                    label=f"{k + 1}× mesh, corrected")
         ax.axvline(steps_per_cycle[1], color="0.6", lw=0.8)
         ax.text(steps_per_cycle[1], 0.98, " default step", transform=ax.get_xaxis_transform(), va="top", fontsize=8,
                 color="0.4")

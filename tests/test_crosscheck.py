@@ -207,15 +207,17 @@ def test_sensor_band_filters_both_solvers_alike(demo_check):
 
 
 def test_spectral_lines_of_a_switching_stiffness_are_read_from_each_runs_own_samples():
-    """demo-3p's rectangular stiffness makes the carrier's angular acceleration jump at every switch.  Read from
-    each run's own samples with the jumps projected exactly (as the sweep reads its lines), its mesh harmonics agree
-    between the solvers within a quarter of the quantity's tolerance (0.24 measured); read from the anti-aliased
-    common grid they came out 7 to 12 tolerances apart, three lines flagged fail on a passing quantity."""
+    """demo-3p's rectangular stiffness makes the carrier's angular acceleration kink at every switch (and the twin's
+    jump a little: :func:`gearcheck.shared.results.signal_jumps`).  Read from each run's own samples with its jumps
+    and kinks projected exactly (as the sweep reads its lines), its mesh harmonics agree between the solvers within
+    a fifth of the quantity's tolerance (0.17 measured; 0.24 with a jump read at every switch and no kink); read
+    from the anti-aliased common grid they came out 7 to 12 tolerances apart, three lines flagged fail on a passing
+    quantity."""
     result = crosscheck("demo-3p", duration=0.1)
     carrier = result["stage1.carrier.alpha"]
     assert carrier.status == "pass"
     assert max(abs(line["rel_error"]) for line in carrier.spectrum if line["rel_error"] is not None) \
-        < 0.3 * carrier.tolerance
+        < 0.25 * carrier.tolerance
 
 
 def test_a_lightly_damped_first_train_is_decided_from_its_periodic_steady_states():

@@ -81,3 +81,24 @@ def test_a_smooth_signal_is_left_as_the_plain_projection_gives_it():
     # the spurious "jumps" of a smooth signal are its cubic remainder, (w h)^3 ~ 1e-4 of it, each one projected
     # over one step: the lines move by a few millionths of their size
     assert np.max(np.abs(corrected - plain)) < 1e-5
+
+
+def test_each_column_is_corrected_at_its_own_switches():
+    """Switches given column by column: each column's lines are those of a call on that column alone with its own
+    switches (to round-off: a product over several columns sums in another order); a column whose switches are
+    not given keeps its jumps in the plain sum (the pulse train's lines at the step of 133 samples a period err by
+    the aliased jumps), and one array serves every column."""
+    t, x, switches, fs = signal(133)
+    columns = np.stack([x, 2.0 * x, np.cos(2 * np.pi * F * t)], axis=1)
+    own = [switches, switches, np.empty(0)]
+    lines = [F, 2 * F, 3 * F]
+    together = harmonics(t, columns, lines, fs, own)
+    for j in range(3):
+        alone = harmonics(t, columns[:, j], lines, fs, own[j])[:, 0]
+        assert together[:, j] == pytest.approx(alone, rel=1e-13, abs=1e-15)
+    assert np.max(np.abs(together[:, 0] - pulse_lines(np.arange(1, 4)))) < 1e-3
+    assert np.max(np.abs(harmonics(t, x, lines, fs)[:, 0] - pulse_lines(np.arange(1, 4)))) > 1e-2
+    shared = harmonics(t, columns[:, :2], lines, fs, switches)
+    assert shared.ravel() == pytest.approx(together[:, :2].ravel(), rel=1e-13)
+    with pytest.raises(ValueError, match="2 arrays of switches for 3 columns"):
+        harmonics(t, columns, lines, fs, own[:2])

@@ -21,6 +21,7 @@ from gearcheck.compare.studies import point_backends
 from gearcheck.compare.studies import sweep as sw
 from gearcheck.compare.studies.distributions import Distribution, draw_samples
 from gearcheck.compare.engine.line_projection import harmonics
+from gearcheck.compare.engine.plan import TrainPlan
 from gearcheck.compare.studies.sweep_lines import counted
 from gearcheck.compare.presentation.sweep_plots import crossings
 from gearcheck.train.kinematics import kinematics
@@ -79,11 +80,11 @@ def test_each_line_carries_its_integration_error_and_the_stiffness_switches_do_n
     fine = side.run(RunSettings(duration, dt=lines["dt_s"].iloc[0] / 8))
     window = fine.t >= lines["steady_start_s"].iloc[0]
     t = fine.t[window]
-    switches = side.model.excitation.switch_times(t[0], t[-1])
+    plan = TrainPlan.of(side.spec, side, duration)
     worst, plain_worst = 0.0, 0.0
     for quantity, rows in lines.groupby("quantity"):
         f = rows["frequency_hz"].to_numpy()
-        reference = harmonics(t, fine[quantity][window], f, np.inf, switches)[:, 0]
+        reference = harmonics(t, fine[quantity][window], f, np.inf, *plan.singularities([quantity], t[0], t[-1]))[:, 0]
         plain = harmonics(t[::8], fine[quantity][window][::8], f, np.inf)[:, 0]  # the sum at the step h, uncorrected
         got = rows["amplitude"].to_numpy() * np.exp(1j * rows["phase_rad"].to_numpy())
         counts = counted(rows).to_numpy()

@@ -607,8 +607,10 @@ def _quantities(a, names, series, window, fs, plan, tolerances, errors, own) -> 
 def _own_lines(names, lines: dict, plan, own: dict) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """name -> both sides' amplitudes at its lines' frequencies (``lines``: name -> (label, Hz)), from each run's
     own uniform samples over its steady window (``own``: name -> the two runs and the window's start), the jumps of
-    a switching mesh stiffness projected exactly (:func:`~gearcheck.compare.engine.line_projection.harmonics`, as
-    the sweep reads its lines): a jump sampled at a step aliases onto every line, which the anti-aliased common
+    a switching mesh stiffness and the kinks they cause projected exactly, each signal's own
+    (:meth:`~gearcheck.compare.engine.plan.TrainPlan.singularities`,
+    :func:`~gearcheck.compare.engine.line_projection.harmonics`, as the sweep reads its lines): a jump sampled at a
+    step aliases onto every line, which the anti-aliased common
     grid would smear instead.  The quantities that share their runs and lines are projected together.  A name not
     in it (a signal a sensor chain filters, a recording, no switches) takes the common grid's series."""
     if plan.switch_times is None:
@@ -625,7 +627,7 @@ def _own_lines(names, lines: dict, plan, own: dict) -> dict[str, tuple[np.ndarra
             window = run.t >= start
             t = run.t[window]
             x = np.column_stack([run[n][window] for n in group])
-            amplitudes.append(np.abs(harmonics(t, x, freqs, _rate(t), plan.switch_times(t[0], t[-1]))))
+            amplitudes.append(np.abs(harmonics(t, x, freqs, _rate(t), *plan.singularities(group, t[0], t[-1]))))
         out.update({n: (amplitudes[0][:, j], amplitudes[1][:, j]) for j, n in enumerate(group)})
     return out
 

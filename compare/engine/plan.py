@@ -21,6 +21,7 @@ Each plan is built from the reference side, the one whose runs it reads (:meth:`
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -29,7 +30,7 @@ import numpy as np
 
 from gearcheck.compare.engine.align import STEADY_CYCLES, STEADY_THRESHOLD, STEADY_WINDOW_CYCLES
 from gearcheck.compare.engine.metrics import spectral_lines
-from gearcheck.shared.results import train_signals
+from gearcheck.shared.results import signal_jumps, train_signals
 from gearcheck.shared.stepping import transient_step
 from gearcheck.train.excitation import Excitation
 from gearcheck.train.kinematics import kinematics
@@ -77,6 +78,32 @@ class TrainPlan:
             if forces:
                 groups.append((forces, 1.0 / f_mesh))
         return groups
+
+    @functools.cached_property
+    def _jumps(self) -> dict:
+        return signal_jumps(self.spec)
+
+    def singularities(self, names, t0: float, t1: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """For each of ``names``, the instants in (t0, t1) at which it may jump, and those at which only its slope may
+        (:func:`~gearcheck.shared.results.signal_jumps`; every switch for a signal it does not know): the
+        ``switches`` and ``kinks`` of :func:`~gearcheck.compare.engine.line_projection.harmonics`.  Read with its own
+        switches alone, a signal's jumps stay apart: at hub-drive's step, 20 of the 724 switches of all its meshes in
+        0.15 s at 1100 rpm lie within three samples of another, where they can only be measured together, and a
+        signal that does not jump at one of them would take the other's jump."""
+        found: dict = {}
+
+        def at(meshes, corners: bool) -> np.ndarray:
+            if (meshes, corners) not in found:
+                found[meshes, corners] = self.switch_times(t0, t1, meshes, corners)
+            return found[meshes, corners]
+
+        switches, kinks = [], []
+        for name in names:
+            where = self._jumps.get(name)
+            switches.append(at(None, True) if where is None else at(where.meshes, where.corners))
+            kinks.append(at(None, True) if where is None else np.empty(0) if where.kinks is None else
+                         at(where.kinks, True))
+        return switches, kinks
 
     def needed_duration(self) -> float | None:
         """The shortest run whose steady state the decay of the free vibration guarantees."""

@@ -260,7 +260,8 @@ def read_modes(path: str | Path, spec, solver: str | None = None) -> tuple[Modal
     mass = _mass(data["mass"], source, len(coordinates))[np.ix_(rows, rows)] if "mass" in extras else None
     types, fractions = rigid_or_elastic(frequencies), None
     if labels == known:
-        fractions = energy_fractions(model.M if mass is None else mass, shapes, *central_coordinates(spec, model.dofs.labels()))
+        fractions = energy_fractions(model.M if mass is None else mass, shapes,
+                                     *central_coordinates(spec, model.dofs.labels()))
         types = mode_types(fractions, frequencies)
     modal = ModalResult(spec.name, frequencies, shapes, types, multiplicities(frequencies), labels, solver, fractions)
     return modal, labels, mass

@@ -63,8 +63,8 @@ def _quantity_case(suite, data, q) -> None:
         errors = q["integration_error"]
         bounds = " + ".join(_number(e and e["value"]) for e in (errors["reference"], errors["test"]))
         ET.SubElement(case, "error", type="Unresolved",
-                      message=f"integration error estimates {bounds} reach the tolerance {_number(tol)}: the comparison "
-                              f"cannot decide (NRMSE {_number(nrmse)})")
+                      message=f"integration error estimates {bounds} reach the tolerance {_number(tol)}: the "
+                              f"comparison cannot decide (NRMSE {_number(nrmse)})")
 
 
 def _mode_case(suite, data, m) -> None:

@@ -146,7 +146,7 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
             mesh = meshes.get(name.rsplit(".", 1)[0])
             # a mesh's force and deflection jump where its stiffness does: those jumps taken exactly (the other
             # signals' jumps, at every mesh's switches, lie too close together at these samples to be measured)
-            switches = () if mesh is None else excitation.switch_times(result.t[0], result.t[-1], mesh)
+            switches = () if mesh is None else excitation.switch_times(result.t[0], result.t[-1], [mesh])
             times, sizes = jumps(result.t, x[:, None], switches)
             tracks[(solver, name)] = order_track(
                 result.t, x - step_series(result.t, times, sizes)[:, 0], angle, [o for *_, o in orders],

@@ -21,16 +21,17 @@ row per (solver, quantity, metric, mesh, order), from the gated signals alone (t
   from its carrier sidebands (T f_carrier < 2: the response is periodic in the carrier's frame, and turned into
   the world's its lines move to k f_mesh +/- f_carrier; measured on hub-drive at 1080 rpm, I.sun.ay.world's first
   stage I line read 5.0 and 6.5 m/s^2 over 0.19 s and 0.07 s windows and 0.013 m/s^2 over 1.2 s).  The lines
-  are projected with the jumps of a switching mesh stiffness taken out
-  (:func:`gearcheck.compare.engine.line_projection.harmonics`): a plain sum aliases them onto the lines, by the same
+  are projected with the jumps of a switching mesh stiffness and the kinks they cause taken out, each signal's
+  where Newton's law puts them (:func:`gearcheck.compare.engine.line_projection.harmonics` at
+  :meth:`~gearcheck.compare.engine.plan.TrainPlan.singularities`): a plain sum aliases them onto the lines, by the same
   amount in both solvers, which then agree on a wrong number -- the cross-check of two solvers cannot see an error
   they share. ``integration_error`` estimates the error of a statistic or line by its change on doubling the step
   (|X_h - X_2h|, or 2 |X_h - X_h/2|; for a line the change of its complex amplitude), which bounds it for any order p
-  >= 1 in the asymptotic range: the solvers are fourth order, but what is read from their samples is not (a peak-to-
-  peak between samples, a line with the jumps projected out), and against runs at h / 8 on demo-3p the lines' errors
-  were 0.3 to 0.8 of their change, where Richardson's fourth-order rule (a fifteenth of it) would have put them 4 to
-  12 times too low; a line whose estimate exceeds a tenth of it (:mod:`gearcheck.compare.studies.sweep_lines`) is
-  left out of the peaks and drawn faint in the plots;
+  >= 1 in the asymptotic range: the solvers are fourth order, but what is read from their samples need not be (a
+  peak-to-peak between samples, a line with its jumps and kinks projected out from extrapolated samples), and
+  against runs at h / 8 on demo-3p the lines' errors are 0.008 to 1.5 of their change, median 0.08 (Richardson's
+  fourth-order rule says a fifteenth) but 0.37 at the 90th percentile; a line whose estimate exceeds a tenth of it
+  (:mod:`gearcheck.compare.studies.sweep_lines`) is left out of the peaks and drawn faint in the plots;
 * ``natural_frequency``: the reference lumped model's gyroscopic natural frequencies at the point's speed
   (Cooley & Parker 2012), one row per elastic mode, so order plots overlay them (``solver`` "lumped").
 
@@ -580,8 +581,7 @@ def run_point(point: Point, before: bytes | None = None) -> tuple[bytes, float, 
         except SolverError as exc:
             rows.add(solver=solver, quantity="", metric="failed", error=str(exc))
             continue
-        reduce_run(run.result, plan, lines, rows, solver, run.steady, check, model.excitation.switch_times,
-                   {"start": run.start, "checked": checked})
+        reduce_run(run.result, plan, lines, rows, solver, run.steady, check, {"start": run.start, "checked": checked})
         states[solver] = continued.kept(run.state, run.rho, run.shapes)
     metadata = {KEY: point.key, continued.STATE: json.dumps(states, sort_keys=True),
                 continued.START: next((run.start for _, run in runs.values()), "")}
@@ -742,16 +742,16 @@ def _check_run(side, point: Point, run: _SteadyRun):
 
 
 def reduce_run(result, plan, lines, rows: _Rows, solver: str, steady: tuple[float, str], check=None,
-               switch_times=None, columns=None) -> None:
+               columns=None) -> None:
     """The steady window of ``result`` reduced to statistics and mesh harmonics (rows of ``rows``), each with its
-    integration error estimate from ``check``, the same run at 2 h or h / 2 (None: no estimate).  ``switch_times(t0,
-    t1)``: the instants where the mesh stiffness jumps, which the harmonics are corrected for
-    (:func:`gearcheck.compare.engine.line_projection.harmonics`).  ``steady``: (start, how) of the window;
-    ``columns``: more columns of every row."""
+    integration error estimate from ``check``, the same run at 2 h or h / 2 (None: no estimate).  The harmonics are
+    corrected for each quantity's jumps and changes of slope where Newton's law puts them (``plan.singularities``,
+    :func:`gearcheck.compare.engine.line_projection.harmonics`).  ``steady``: (start, how) of the window; ``columns``:
+    more columns of every row."""
     start, how = steady
     names = result.names(compared=True)
     freqs = np.array([f for _, _, f in lines])
-    stats, full, fs, span = _window(result, names, start, freqs, switch_times)
+    stats, full, fs, span = _window(result, names, start, freqs, plan.singularities)
     resolved = [bool(f < 0.45 * fs and f * span >= 2.0 and all(abs(f - g) * span >= 2.0 for g in freqs if g != f))
                 for f in freqs]
     dt = float(result.info.get("dt_s", np.nan))
@@ -760,7 +760,7 @@ def reduce_run(result, plan, lines, rows: _Rows, solver: str, steady: tuple[floa
         line_error = np.full(full.shape, np.nan)
     else:  # the estimate of compare.engine.integration_error, per statistic and line
         factor = richardson_factor(check.info["dt_s"] / dt, order=1)  # a bound: see the module docstring
-        check_stats, check_full, _, _ = _window(check, names, start, freqs, switch_times)
+        check_stats, check_full, _, _ = _window(check, names, start, freqs, plan.singularities)
         stat_error = {m: factor * np.abs(stats[m] - check_stats[m]) for m in STATISTICS}
         line_error = factor * np.abs(full - check_full)
     common = {"solver": solver, "steady": how, "steady_start_s": float(start), "dt_s": dt, **(columns or {})}
@@ -788,18 +788,19 @@ def _sideband_spacing(plan, signal) -> float:
     return f_carrier if f_carrier > 0 else math.inf
 
 
-def _window(result, names, start: float, freqs: np.ndarray, switch_times=None):
+def _window(result, names, start: float, freqs: np.ndarray, singularities=None):
     """(statistics {metric: per quantity}, complex harmonics at ``freqs`` (lines x quantities), sampling rate,
-    window span) of ``result``'s quantities ``names`` over t >= ``start``, corrected for the jumps at
-    ``switch_times(t0, t1)``."""
+    window span) of ``result``'s quantities ``names`` over t >= ``start``, corrected for the jumps and changes of
+    slope at ``singularities(names, t0, t1)`` (each quantity's own, :meth:`~gearcheck.compare.engine.plan.
+    TrainPlan.singularities`)."""
     t = result.t
     window = t >= start
     tw = t[window]
     x = result.values[window][:, [result._index[n] for n in names]]
     fs = (t.size - 1) / (t[-1] - t[0])
     stats = {"mean": x.mean(axis=0), "rms": np.sqrt(np.mean(x**2, axis=0)), "peak_to_peak": np.ptp(x, axis=0)}
-    switches = switch_times(tw[0], tw[-1]) if switch_times is not None and tw.size > 1 else ()
-    return stats, harmonics(tw, x, freqs, fs, switches), fs, (tw[-1] - tw[0] if tw.size > 1 else 0.0)
+    singular = singularities(names, tw[0], tw[-1]) if singularities is not None and tw.size > 1 else ((), ())
+    return stats, harmonics(tw, x, freqs, fs, *singular), fs, (tw[-1] - tw[0] if tw.size > 1 else 0.0)
 
 
 def _number(value) -> float | None:

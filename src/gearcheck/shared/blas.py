@@ -9,7 +9,8 @@ nothing: hub-drive's lumped run took 0.28 s on one thread and 0.51 s (0.91 s of 
 cross-check the same wall time and a tenth less CPU.  The harmonic methods' solves run on one thread too: SuperLU
 factors a Hill matrix by many small BLAS calls, each of which a second thread only slows (a 40-coordinate chain on
 a 13 x 13 lattice, 6760 unknowns: 0.5-0.8 s on one thread, 6.5-15 s on OpenBLAS's two while other processes
-kept both cores busy, and 0.4-0.6 s on either on an idle machine).  Large dense problems (the modes of a big user model) keep every thread.
+kept both cores busy, and 0.4-0.6 s on either on an idle machine).  Large dense problems (the modes of a big user
+model) keep every thread.
 """
 
 from __future__ import annotations

@@ -271,6 +271,85 @@ def train_signals(spec) -> list[Signal]:
     return signals
 
 
+OWN_MESH_KINDS = frozenset({"mesh_force", "dynamic_factor", "mesh_stiffness", "mesh_moment", "face_load_factor"})
+ACCELERATION_KINDS = frozenset({"acceleration", "angular_acceleration"})
+SMOOTH_KINDS = frozenset({"dte", "displacement", "angle", "tilt", "pin_count"})
+
+
+class Jumps(NamedTuple):
+    """Where a signal jumps: at the stiffness switches of ``meshes`` (indices into ``spec.meshes``) and, if
+    ``corners``, at an operating history's corners; and where its slope may jump while it stays continuous: at the
+    switches of ``kinks`` and at the corners (None: nowhere, a smooth signal)."""
+
+    meshes: tuple[int, ...]
+    corners: bool
+    kinks: tuple[int, ...] | None
+
+
+def signal_jumps(spec) -> dict[str, Jumps]:
+    """Where each signal of :func:`train_signals` jumps and where it kinks, from Newton's law and the parts that join
+    the members.  A member's acceleration jumps where a force on it does: at its meshes' switches, and at those of
+    the members it is rigidly tied to (a torsional planet rides its carrier's pin), not through an elastic part;
+    and at an operating history's corners, where the frames' angular acceleration Omega' = lambda' Omega does.  A
+    mesh force k(t) delta + c delta' jumps where its own k does (delta and delta' are continuous), and so do its Kv,
+    stiffness, tilting moment and face load factor.  A damper's force c (v_a - v_b) has a slope that jumps where
+    the acceleration of a member it joins does: so a mesh's or a bearing's force, or a pin's, kinks where its
+    members' accelerations jump, and a member's acceleration where those of the members joined to it do (its
+    parts' forces); a velocity kinks where its member's acceleration jumps.  A deflection, a position and a tilt
+    angle are smooth (their rates are continuous).  Another kind of signal may jump and kink at every switch.
+
+    One jump Newton's law does not give is kept too: a carrier's angular acceleration at its planets' switches.
+    MuJoCo's twin carries each planet in its carrier's frame and sets its mesh force along a tendon of the nominal
+    geometry, while its mass matrix follows the planet's displaced place, so the carrier takes a torque of the
+    force's jump times a lever of the order of the planet's displacement (on demo-3p 14 um, 4.5e-4 of the sun's
+    lever; the lumped model's carrier does not jump).  Small as it is, on the carrier's small lines it aliases."""
+    groups = {mid: {mid} for mid in spec.members}
+    for mid, member in spec.members.items():
+        carrier = f"{member.stage}.carrier"
+        if member.torsional and member.orbits and carrier in groups:
+            group = groups[mid] | groups[carrier]
+            for m in group:
+                groups[m] = group
+    meshes_of: dict[str, set[int]] = {mid: set() for mid in spec.members}
+    for j, mesh in enumerate(spec.meshes):
+        for m in groups[mesh.central] | groups[mesh.planet]:
+            meshes_of[m].add(j)
+    joined: dict[str, set[str]] = {mid: {mid} for mid in spec.members}
+    for part in spec.parts:
+        members = [m for m in part.joined() if m in joined]
+        for m in members:
+            joined[m].update(members)
+
+    def jumping(members) -> tuple[int, ...]:  # the meshes at whose switches an acceleration of ``members`` jumps
+        return tuple(sorted(set().union(*(meshes_of[m] for m in members))))
+
+    own = {f"{mesh.id}.": j for j, mesh in enumerate(spec.meshes)}
+    carriers = {f"{mid}.bearing_": (mid, f"{m.stage}.carrier") for mid, m in spec.members.items() if m.orbits}
+    everything = tuple(range(len(spec.meshes)))
+    out = {}
+    for s in train_signals(spec):
+        member = next((m for m in spec.members if s.name.startswith(f"{m}.")), None)
+        mesh = next((j for prefix, j in own.items() if s.name.startswith(prefix)), None)
+        bearing = next((pair for prefix, pair in carriers.items() if s.name.startswith(prefix)), None)
+        if s.kind in SMOOTH_KINDS:
+            out[s.name] = Jumps((), False, None)
+        elif s.kind in OWN_MESH_KINDS and mesh is not None:
+            out[s.name] = Jumps((mesh,), False, jumping(spec.meshes[mesh].joined()))
+        elif s.kind in ACCELERATION_KINDS and member is not None:
+            carried = [m for m, other in spec.members.items() if other.orbits and f"{other.stage}.carrier" == member]
+            turning = jumping(carried) if s.kind == "angular_acceleration" else ()
+            out[s.name] = Jumps(tuple(sorted(set(jumping([member]) + turning))), True, jumping(joined[member]))
+        elif s.kind == "bearing_force" and bearing is not None:
+            out[s.name] = Jumps((), False, jumping(bearing))
+        elif s.kind == "pin_force" and member is not None:
+            out[s.name] = Jumps((), False, jumping(joined[member]))
+        elif s.kind in ("velocity", "angular_velocity") and member is not None:
+            out[s.name] = Jumps((), False, jumping([member]))
+        else:
+            out[s.name] = Jumps(everything, True, everything)
+    return out
+
+
 def acceleration_signals(spec) -> list[Signal]:
     """Every member's accelerations, the first signals of a train run: the central members' gated."""
     return [s for mid, member in spec.members.items() for s in member_accelerations(mid, member)]

@@ -128,12 +128,13 @@ class Excitation:
             k[..., r, :pairs.size], e[..., r, :pairs.size] = pairs(xi[..., r])
         return k, e
 
-    def switch_times(self, t0: float, t1: float, mesh: int | None = None) -> np.ndarray:
-        """Sorted times in (t0, t1) at which some mesh's stiffness (or that of the mesh of index ``mesh`` alone)
-        jumps (its model's ``breaks``) or, under a history, the speed's or a torque's slope does (their points)."""
+    def switch_times(self, t0: float, t1: float, meshes=None, corners: bool = True) -> np.ndarray:
+        """Sorted times in (t0, t1) at which some mesh's stiffness (or that of the meshes of indices ``meshes`` alone)
+        jumps (its model's ``breaks``) or, under a history and with ``corners``, the speed's or a torque's slope
+        does (their points)."""
         times = []
         a0, a1 = (float(x) for x in self.nominal_time(np.array([t0, t1])))
-        chosen = range(len(self.models)) if mesh is None else [mesh]
+        chosen = list(range(len(self.models)) if meshes is None else meshes)
         for f, phase, model in (zip(self.frequency[chosen], self.phase[chosen], [self.models[j] for j in chosen])):
             for b in model.breaks:
                 if f > 0:  # xi = f Lambda(t) - phase = n + b
@@ -141,7 +142,7 @@ class Excitation:
                     at = (n + b + phase) / f
                     at = at[(at > a0) & (at < a1)]
                     times.append(at if self.clock is None else self.clock.times_at(at, t0, t1))
-        if self.clock is not None:
+        if self.clock is not None and corners:
             times += [self.clock.corners, self.history.corners]
         t = np.concatenate(times) if times else np.empty(0)
         return np.unique(t[(t > t0) & (t < t1)])

@@ -39,6 +39,10 @@ class Part:
         set), named."""
         return []
 
+    def joined(self) -> tuple[str, ...]:
+        """The members whose motion its forces depend on and act on (member ids)."""
+        return ()
+
     def describe(self, spec, kin, touching: set[str]) -> dict:
         """What ``gearcheck show`` prints of the part, in its stage (``stage``) under its kind: derived from
         ``spec``, its kinematics ``kin`` and the names of the contacts ``touching`` at rest in the reference
@@ -54,6 +58,9 @@ class SupportPart(Part):
     member: str
     support: object  # gearcheck.train.spec.Support
     axial: bool
+
+    def joined(self) -> tuple[str, ...]:
+        return (self.member,)
 
     def turning_frequencies(self, spec, speeds: dict) -> list[float]:
         """A seat misaligned in the housing (``Support.rest_tilt``) turns in its member's carrier frame at -Omega."""
@@ -71,6 +78,9 @@ class BearingPart(Part):
     bearing: object  # gearcheck.train.spec.Support
     axial: bool
 
+    def joined(self) -> tuple[str, ...]:
+        return self.member, self.carrier
+
 
 @dataclass(frozen=True)
 class SplinePart(Part):
@@ -80,6 +90,9 @@ class SplinePart(Part):
     planet: str
     crank: str
     spline: object  # gearcheck.train.spec.Support
+
+    def joined(self) -> tuple[str, ...]:
+        return self.planet, self.crank
 
 
 @dataclass(frozen=True)
@@ -92,6 +105,10 @@ class DrivePart(Part):
     output: str
     stiffness: float | None  # the input shaft's; None: the input is driven by torque
     damping: float
+
+    def joined(self) -> tuple[str, ...]:
+        """The input member on its shaft (the output's torque is prescribed)."""
+        return (self.member,)
 
 
 def train_parts(spec) -> tuple:

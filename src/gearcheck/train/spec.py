@@ -201,6 +201,9 @@ class MeshSpec(Part):
         stage, planet, central = self.id.split(".")
         return f"{stage}_{planet}_{central}_mesh"
 
+    def joined(self) -> tuple[str, ...]:
+        return self.central, self.planet
+
 
 @dataclass(frozen=True)
 class Coupling(Part):
@@ -215,6 +218,9 @@ class Coupling(Part):
     torsional_damping: float
     radial_stiffness: float
     radial_damping: float
+
+    def joined(self) -> tuple[str, ...]:
+        return self.a, self.b
 
     def speed_rows(self, spec, index: dict) -> list:
         """Rigid in torsion: both members turn together."""
@@ -287,6 +293,10 @@ class CycloidStage(Part):
     contact_stiffness: float | None  # N/m per pin contact; None: Palmgren's law at the rated load
     contact_damping: float
     clearance: float  # m
+
+    def joined(self) -> tuple[str, ...]:
+        """The cranks' eccentrics on the discs' needle bearings, the discs on the pins."""
+        return self.cranks + self.discs + ((self.pin_wheel,) if self.pin_wheel else ())
 
     def speed_rows(self, spec, index: dict) -> list:
         """An RV reducer's rigid constraints: each planet turns with its crank; each disc translates relative to

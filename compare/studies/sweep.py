@@ -788,7 +788,7 @@ def _sideband_spacing(plan, signal) -> float:
     return f_carrier if f_carrier > 0 else math.inf
 
 
-def _window(result, names, start: float, freqs: np.ndarray, singularities=None):
+def _window(result, names, start: float, freqs: np.ndarray, singularities):
     """(statistics {metric: per quantity}, complex harmonics at ``freqs`` (lines x quantities), sampling rate,
     window span) of ``result``'s quantities ``names`` over t >= ``start``, corrected for the jumps and changes of
     slope at ``singularities(names, t0, t1)`` (each quantity's own, :meth:`~gearcheck.compare.engine.plan.
@@ -799,7 +799,7 @@ def _window(result, names, start: float, freqs: np.ndarray, singularities=None):
     x = result.values[window][:, [result._index[n] for n in names]]
     fs = (t.size - 1) / (t[-1] - t[0])
     stats = {"mean": x.mean(axis=0), "rms": np.sqrt(np.mean(x**2, axis=0)), "peak_to_peak": np.ptp(x, axis=0)}
-    singular = singularities(names, tw[0], tw[-1]) if singularities is not None and tw.size > 1 else ((), ())
+    singular = singularities(names, tw[0], tw[-1]) if tw.size > 1 else ((), ())
     return stats, harmonics(tw, x, freqs, fs, *singular), fs, (tw[-1] - tw[0] if tw.size > 1 else 0.0)
 
 

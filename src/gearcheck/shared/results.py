@@ -303,10 +303,13 @@ def signal_jumps(spec) -> dict[str, Jumps]:
     geometry, while its mass matrix follows the planet's displaced place, so the carrier takes a torque of the
     force's jump times a lever of the order of the planet's displacement (on demo-3p 14 um, 4.5e-4 of the sun's
     lever; the lumped model's carrier does not jump).  Small as it is, on the carrier's small lines it aliases."""
+    carrier_of = {mid: f"{m.stage}.carrier" for mid, m in spec.members.items() if m.orbits}
+    carried: dict[str, list[str]] = {}
+    for mid, carrier in carrier_of.items():
+        carried.setdefault(carrier, []).append(mid)
     groups = {mid: {mid} for mid in spec.members}
-    for mid, member in spec.members.items():
-        carrier = f"{member.stage}.carrier"
-        if member.torsional and member.orbits and carrier in groups:
+    for mid, carrier in carrier_of.items():
+        if spec.members[mid].torsional and carrier in groups:
             group = groups[mid] | groups[carrier]
             for m in group:
                 groups[m] = group
@@ -324,21 +327,20 @@ def signal_jumps(spec) -> dict[str, Jumps]:
         return tuple(sorted(set().union(*(meshes_of[m] for m in members))))
 
     own = {f"{mesh.id}.": j for j, mesh in enumerate(spec.meshes)}
-    carriers = {f"{mid}.bearing_": (mid, f"{m.stage}.carrier") for mid, m in spec.members.items() if m.orbits}
+    bearings = {f"{part.member}.bearing_": part.joined() for part in spec.parts if part.element == "bearing"}
     everything = tuple(range(len(spec.meshes)))
     out = {}
     for s in train_signals(spec):
         member = next((m for m in spec.members if s.name.startswith(f"{m}.")), None)
         mesh = next((j for prefix, j in own.items() if s.name.startswith(prefix)), None)
-        bearing = next((pair for prefix, pair in carriers.items() if s.name.startswith(prefix)), None)
+        bearing = next((pair for prefix, pair in bearings.items() if s.name.startswith(prefix)), None)
         if s.kind in SMOOTH_KINDS:
             out[s.name] = Jumps((), False, None)
         elif s.kind in OWN_MESH_KINDS and mesh is not None:
             out[s.name] = Jumps((mesh,), False, jumping(spec.meshes[mesh].joined()))
         elif s.kind in ACCELERATION_KINDS and member is not None:
-            carried = [m for m, other in spec.members.items() if other.orbits and f"{other.stage}.carrier" == member]
-            turning = jumping(carried) if s.kind == "angular_acceleration" else ()
-            out[s.name] = Jumps(tuple(sorted(set(jumping([member]) + turning))), True, jumping(joined[member]))
+            turning = carried.get(member, []) if s.kind == "angular_acceleration" else []
+            out[s.name] = Jumps(jumping([member] + turning), True, jumping(joined[member]))
         elif s.kind == "bearing_force" and bearing is not None:
             out[s.name] = Jumps((), False, jumping(bearing))
         elif s.kind == "pin_force" and member is not None:

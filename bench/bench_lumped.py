@@ -47,7 +47,7 @@ from gearcheck.lumped.time_solver import default_step, simulate
 from gearcheck.train.variants import chained, edited, wide_stage
 from gearcheck.shared.errors import SolverError
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS
+from gearcheck.shared.stepping import STAGE_OFFSETS, STAGE_SIDES
 
 LIGHT_BACKLASH = [(r"^damping = \{ ratio = 0.05 \}", "damping = { ratio = 0.05 }\nbacklash_um = 40.0\n"
                    "ste = [{ harmonic = 1, amplitude_um = 5.0 }]"), (r"^output_torque = .*", "output_torque = 30.0")]
@@ -106,7 +106,7 @@ def yardstick_cost(model, dt: float, steps: int, repeats: int = 5) -> float:
     mesh stiffness and torques sampled as the solver samples them, best of ``repeats``."""
     exc = model.excitation
     times = (np.arange(steps)[:, None] + np.array(STAGE_OFFSETS)[None, :]) * dt
-    k = exc.stiffness(times)
+    k = exc.stiffness(times, np.array(STAGE_SIDES))
     t_in, t_out = exc.torques(times)
     F = model.F_static + np.multiply.outer(t_in, model.b_input) + np.multiply.outer(t_out, model.b_output)
     minv = 1.0 / np.diag(model.M)

@@ -111,7 +111,7 @@ class Chunk(NamedTuple):
     whole step when ``ends[r]``; ``times`` (sub-steps, 3) its stage times t, t + h/2, t + h; the drive (mesh
     stiffness ``k``, transmission error ``e`` and its rate ``de``, torques ``tin`` and ``tout``, the relieved
     meshes' tooth pairs ``pairs`` (k_j, e_j) or None) with time along axes (0, 1): the stage times of
-    :data:`~gearcheck.shared.stepping.STAGE_OFFSETS`."""
+    :data:`~gearcheck.shared.stepping.STAGE_OFFSETS`, read at :data:`~gearcheck.shared.stepping.STAGE_SIDES`."""
 
     lengths: np.ndarray
     ends: np.ndarray

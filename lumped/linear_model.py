@@ -39,6 +39,7 @@ from functools import cached_property
 import numpy as np
 
 from gearcheck.shared.errors import TrainFileError, did_you_mean
+from gearcheck.shared.stepping import LIMIT_CYCLES
 from gearcheck.train.kinematics import kinematics
 
 SYMMETRY_TOLERANCE = 1e-9  # relative asymmetry of M, K, C accepted as round-off
@@ -69,12 +70,14 @@ class Periodic:
     def mean(self) -> np.ndarray:
         return self.samples.mean(axis=0) if self.samples is not None else self.mean_value
 
-    def __call__(self, t) -> np.ndarray:
-        """The value at time ``t`` (s), or at each of an array of times (along the leading axes)."""
+    def __call__(self, t, side=0) -> np.ndarray:
+        """The value at time ``t`` (s), or at each of an array of times (along the leading axes); ``side`` (+1, -1
+        or 0, broadcast with t) the right-hand or left-hand limit of held samples that change at t,
+        :data:`~gearcheck.shared.stepping.LIMIT_CYCLES` of a period on."""
         t = np.asarray(t, dtype=float)
         if self.samples is not None:
             n = len(self.samples)
-            x = (t / self.period % 1.0) * n
+            x = ((t / self.period + np.multiply(side, LIMIT_CYCLES)) % 1.0) * n
             i = np.floor(x).astype(int) % n
             if self.interpolation == "hold":
                 return self.samples[i]
@@ -116,20 +119,21 @@ class Mesh:
     damping: float = 0.0
     error: Periodic | None = None
 
-    def transmission_error(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """(e, e') at time ``t`` (s) or at each of an array of times: zero when the mesh has none."""
+    def transmission_error(self, t, side=0) -> tuple[np.ndarray, np.ndarray]:
+        """(e, e') at time ``t`` (s) or at each of an array of times (``side``: :meth:`Periodic.__call__`): zero
+        when the mesh has none."""
         if self.error is None:
             return np.zeros(np.shape(t)), np.zeros(np.shape(t))
-        return self.error(t), self._error_rate(t)
+        return self.error(t, side), self._error_rate(t, side)
 
     @cached_property
     def _error_rate(self) -> Periodic:
         return self.error.rate()
 
-    def k(self, t) -> np.ndarray:
-        """The stiffness at time ``t`` (s), or at each of an array of times."""
+    def k(self, t, side=0) -> np.ndarray:
+        """The stiffness at time ``t`` (s), or at each of an array of times (``side``: :meth:`Periodic.__call__`)."""
         if isinstance(self.stiffness, Periodic):
-            return self.stiffness(t)
+            return self.stiffness(t, side)
         return np.full(np.shape(t), float(self.stiffness))
 
     @property
@@ -264,11 +268,14 @@ class LinearModel:
                               f"speed ({dict(SPEED_FORMS)[name]})")
         return (input_speed / self.operating_speed) ** power * A
 
-    def F_at(self, t: float) -> np.ndarray:
-        return self.matrix("F") if self.forcing is None else np.asarray(self.forcing(t), dtype=float)
+    def F_at(self, t: float, side: int = 0) -> np.ndarray:
+        """The forcing at time t (``side``: :meth:`Periodic.__call__`; a callable forcing is read at t itself)."""
+        if self.forcing is None:
+            return self.matrix("F")
+        return np.asarray(self.forcing(t, side) if isinstance(self.forcing, Periodic) else self.forcing(t), dtype=float)
 
-    def K_at(self, t: float) -> np.ndarray:
-        return self.matrix("K") if self.stiffness is None else self.stiffness(t)
+    def K_at(self, t: float, side: int = 0) -> np.ndarray:
+        return self.matrix("K") if self.stiffness is None else self.stiffness(t, side)
 
     # -- validation ---------------------------------------------------------------------------------------
 

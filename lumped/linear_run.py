@@ -144,7 +144,8 @@ def simulate_linear(model, settings: RunSettings, train=None, progress=None, y0=
 
 def _rates(model, stage_t: np.ndarray):
     """q'' = M^-1 (f(t) - D q' - (K(t) + K_omega + sum_m k_m(t) a_m a_m^T) q) at the stage times ``stage_t``
-    (steps x stages): ``rates(i, s, Q, V)`` for states as the columns of Q, V, the forcing f(t) = F(t) +
+    (steps x stages, each read at its one-sided limit, :data:`~gearcheck.shared.stepping.STAGE_SIDES`):
+    ``rates(i, s, Q, V)`` for states as the columns of Q, V, the forcing f(t) = F(t) +
     sum_m a_m (k_m e_m + c_m e_m') acting on the last column alone -- one column is a run; the unit states
     beside a last zero one give a period's monodromy matrix and its particular response.  M^-1 is applied to
     each matrix once, not at every stage.  ``rates.chunk(first, last)``: the arrays of a run's compiled steps
@@ -155,23 +156,25 @@ def _rates(model, stage_t: np.ndarray):
     MD, MA = M_inv @ model.damping, M_inv @ A.T
     MK = M_inv @ (model.matrix("K") + K_omega) if model.stiffness is None else None
     MF = M_inv @ model.matrix("F") if model.forcing is None else None
-    errors = [m.transmission_error(stage_t) for m in model.meshes]
-    k_mesh = _along_last([m.k(stage_t) for m in model.meshes], stage_t.shape)
+    sides = np.broadcast_to(stepping.STAGE_SIDES, stage_t.shape)
+    errors = [m.transmission_error(stage_t, sides) for m in model.meshes]
+    k_mesh = _along_last([m.k(stage_t, sides) for m in model.meshes], stage_t.shape)
     mesh_forcing = k_mesh * _along_last([e for e, _ in errors], stage_t.shape) + _along_last(
         [m.damping * de for m, (_, de) in zip(model.meshes, errors)], stage_t.shape)
 
     def rates(i, s, Q, V):
-        ti = stage_t[i, s]
-        stiffness = MK if MK is not None else M_inv @ (model.K_at(ti) + K_omega)
+        ti, side = stage_t[i, s], stepping.STAGE_SIDES[s]
+        stiffness = MK if MK is not None else M_inv @ (model.K_at(ti, side) + K_omega)
         out = -(MD @ V) - stiffness @ Q - MA @ (k_mesh[i, s][:, None] * (A @ Q))
-        out[:, -1] += (MF if MF is not None else M_inv @ model.F_at(ti)) + MA @ mesh_forcing[i, s]
+        out[:, -1] += (MF if MF is not None else M_inv @ model.F_at(ti, side)) + MA @ mesh_forcing[i, s]
         return out
 
     def chunk(first, last):
         """The arrays of :func:`_rk4_steps` over steps ``first`` to ``last``: the matrices, the meshes' stiffness
         and the forcing M^-1 f(t) at the stage times."""
         times = stage_t[first:last]
-        F = MF if MF is not None else np.array([model.F_at(t) for t in times.ravel()]).reshape(
+        F = MF if MF is not None else np.array([model.F_at(t, side) for t, side in zip(
+            times.ravel(), sides[first:last].ravel())]).reshape(
             *times.shape, model.n) @ M_inv.T
         return (MD, MK, MA, A, np.ascontiguousarray(k_mesh[first:last]), F + mesh_forcing[first:last] @ MA.T,
                 np.empty(A.shape[0]), np.empty((4, model.n)))
@@ -327,8 +330,8 @@ def _train_signals(model, train, t, q, v, qdd, q0, taken=frozenset()):
     static = {}
     for m in model.meshes:
         row = np.asarray(m.row, dtype=float)
-        k = m.k(t)
-        e, de = m.transmission_error(t)
+        k = m.k(t, stepping.STAGE_SIDES[0])  # the drive of the step that starts at t, as the stages read it
+        e, de = m.transmission_error(t, stepping.STAGE_SIDES[0])
         delta = q @ row
         force = k * (delta - e) + m.damping * (v @ row - de)
         static_force = m.k_mean * float(row @ q0)

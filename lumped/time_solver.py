@@ -10,10 +10,11 @@ f the backlash dead zone.  The start is the static deflection under the mean loa
 
 Time step: :mod:`gearcheck.shared.stepping` (the rule the MuJoCo runner follows too), from the
 highest natural frequency of this model with every mesh at its cycle-maximum stiffness.
-The drive is sampled at each RK4 stage's own time, t + h (eps, 1/2, 1/2, 1 - eps)
-(:data:`~gearcheck.shared.stepping.STAGE_OFFSETS`), as the MuJoCo runner drives its stages: the
-textbook RK4, fourth order for a drive smooth over the step.  A step inside which a mesh stiffness
-jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as the MuJoCo runner does), so
+The drive is sampled at each RK4 stage's own time, t + h (0, 1/2, 1/2, 1), its right-hand limit at the
+step's start and its left-hand one at the end (:data:`~gearcheck.shared.stepping.STAGE_SIDES`), as the
+MuJoCo runner drives its stages: the textbook RK4, fourth order for a drive smooth over the step.  A step
+inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as the
+MuJoCo runner does), so
 the stiffness is smooth over every sub-step and RK4 keeps its order.
 
 The RK4 steps run compiled (:mod:`gearcheck.lumped.compiled_steps`), a chunk of steps at a time: Python samples
@@ -42,7 +43,7 @@ from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together,
 from gearcheck.shared.results import TimeResult, bearing_names, tilting_meshes, train_result, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS
+from gearcheck.shared.stepping import STAGE_OFFSETS, STAGE_SIDES
 from gearcheck.train.history import check_duration
 
 CHUNK = 20000  # steps between divergence checks and progress reports
@@ -97,13 +98,14 @@ class _System:
         pairs = self.exc.tooth_pairs(0.0)[0]
         self.switches = switching_count(self.kernel[1], self.kernel[2], 0 if pairs is None else pairs.shape[-1])
 
-    def drive(self, t):
+    def drive(self, t, side=0):
         """Excitation at times t: (k, e, de, T_in, T_out, pairs), arrays with time along axis 0; ``pairs``
-        the relieved meshes' tooth pairs (k_j, e_j), or None."""
-        k = self.exc.stiffness(t)
+        the relieved meshes' tooth pairs (k_j, e_j), or None; ``side`` the one-sided limit read where a mesh's
+        drive jumps (:meth:`~gearcheck.train.excitation.Excitation.mesh_position`)."""
+        k = self.exc.stiffness(t, side)
         e, de = self.exc.transmission_error(t)
         t_in, t_out = self.exc.torques(t)
-        kp, ep = self.exc.tooth_pairs(t)
+        kp, ep = self.exc.tooth_pairs(t, side)
         return k, e, de, t_in, t_out, None if kp is None else np.stack([kp, ep], axis=-1)
 
     def mesh_force(self, q, v, k, e, de, pairs=None):
@@ -241,7 +243,6 @@ def _chunk(sys, h, start, stop, t0: float = 0.0) -> Chunk:
     (:func:`~gearcheck.shared.stepping.split_steps`)."""
     steps = np.arange(start, stop)
     lengths = np.full(steps.size, h)
-    sample = t0 + (steps[:, None] + np.array(STAGE_OFFSETS)[None, :]) * h
     begins = t0 + steps * h
     ends = np.ones(steps.size, dtype=bool)
     split = stepping.split_steps(h, start, stop, sys.exc.switch_times(t0 + start * h, t0 + stop * h), t0)
@@ -250,7 +251,7 @@ def _chunk(sys, h, start, stop, t0: float = 0.0) -> Chunk:
         for i, inner in split.items():
             counts[i - start] = inner.size + 1
         row = np.repeat(np.arange(steps.size), counts)
-        lengths, sample, begins = lengths[row], sample[row], begins[row]
+        lengths, begins = lengths[row], begins[row]
         first = np.cumsum(counts) - counts
         ends = np.zeros(row.size, dtype=bool)
         ends[first + counts - 1] = True
@@ -258,9 +259,8 @@ def _chunk(sys, h, start, stop, t0: float = 0.0) -> Chunk:
             a, length = stepping.sub_steps(t0 + i * h, h, inner)
             r = first[i - start] + np.arange(a.size)
             begins[r], lengths[r] = a, length
-            sample[r] = a[:, None] + length[:, None] * np.array(STAGE_OFFSETS)[None, :]
-    times = begins[:, None] + np.array([0.0, 0.5, 1.0])[None, :] * lengths[:, None]
-    return Chunk(lengths, ends, times, *sys.drive(sample))
+    times = begins[:, None] + np.array(STAGE_OFFSETS)[None, :] * lengths[:, None]
+    return Chunk(lengths, ends, times, *sys.drive(times, np.array(STAGE_SIDES)))
 
 
 def _chunk_steps(sys) -> int:
@@ -406,7 +406,7 @@ def _adaptive(sys, q0, v0, h, n_steps, every, method, rtol, atol, t0: float = 0.
 
 def _result(model, sys, t, q, v, static, settle, info, wanted=None) -> TimeResult:
     # outputs at t_n see the drive of the step that starts there (as the MuJoCo runner's sensors do)
-    k, e, de, tin, tout, pairs = sys.drive(t + STAGE_OFFSETS[0] * info["dt_s"])
+    k, e, de, tin, tout, pairs = sys.drive(t, STAGE_SIDES[0])
     qdd = sys.acceleration(q, v, k, e, de, tin[:, None], tout[:, None], t, pairs)
     delta, force = sys.mesh_force(q, v, k, e, de, pairs)
     k = sys.contact_stiffness(q, k, e, pairs)

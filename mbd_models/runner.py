@@ -83,7 +83,7 @@ from gearcheck.shared.events import (MAX_EVENTS, MIN_FRACTION, crossed_together,
 from gearcheck.shared.results import TimeResult, train_result, train_signals
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
-from gearcheck.shared.stepping import STAGE_OFFSETS
+from gearcheck.shared.stepping import STAGE_OFFSETS, STAGE_SIDES
 from gearcheck.train.history import check_duration
 
 CHUNK = 10000
@@ -113,18 +113,19 @@ class _Drive:
         u[..., a["output_load"]] = t_out
         return u
 
-    def at(self, t: np.ndarray):
+    def at(self, t: np.ndarray, side=0):
         """(k, u, e, de, pairs) at times t (e, de None without a transmission error; pairs, the relieved meshes'
-        tooth pairs (k_j, e_j) along the last axis, None without tip relief)."""
+        tooth pairs (k_j, e_j) along the last axis, None without tip relief); ``side`` the one-sided limit read
+        where a mesh's drive jumps (:meth:`~gearcheck.train.excitation.Excitation.mesh_position`)."""
         e, de = self.exc.transmission_error(t) if self.has_te else (None, None)
-        kp, ep = self.exc.tooth_pairs(t)
+        kp, ep = self.exc.tooth_pairs(t, side)
         pairs = None if kp is None else np.stack([kp, ep], axis=-1)
-        return self.exc.stiffness(t), self.controls(t), e, de, pairs
+        return self.exc.stiffness(t, side), self.controls(t), e, de, pairs
 
     def steps(self, t0: np.ndarray, h):
         """(k, u, e, de, pairs) for steps starting at t0 (h one step length, or one per row), each with time along
-        axes (0, 1): the step, its stage times t0 + h STAGE_OFFSETS (t, t + h/2, t + h)."""
-        return self.at(t0[:, None] + np.reshape(h, (-1, 1)) * np.array(STAGE_OFFSETS)[None, :])
+        axes (0, 1): the step, its stage times t0 + h STAGE_OFFSETS (t, t + h/2, t + h) at STAGE_SIDES."""
+        return self.at(t0[:, None] + np.reshape(h, (-1, 1)) * np.array(STAGE_OFFSETS)[None, :], np.array(STAGE_SIDES))
 
 
 class _ToothContacts:
@@ -310,7 +311,7 @@ class _Stepper:
 
     def finish(self, t_end: float) -> None:
         """Sample the final state (the drive of the step that would start there)."""
-        values = self.drive.at(np.array([t_end + STAGE_OFFSETS[0] * self.h]))
+        values = self.drive.at(np.array([t_end]), STAGE_SIDES[0])
         self.set_stage(*(None if x is None else x[0] for x in values))
         mujoco.mj_forward(self.m, self.d)
         self.sample()
@@ -611,7 +612,7 @@ def _result(mb: MbdModel, stepper: _Stepper, t, static: StaticState, settle, inf
 
     delta = columns("deflection", 0, [m.label for m in spec.meshes])
     mesh_force, mesh_moment, bearing_force = stepper.reader.forces(stepper.forces[:stepper.j])
-    k = (mb.excitation.stiffness(t + STAGE_OFFSETS[0] * info["dt_s"]) if stepper.stiffness is None
+    k = (mb.excitation.stiffness(t, STAGE_SIDES[0]) if stepper.stiffness is None
          else stepper.stiffness[:stepper.j])
     raw = {}
     for name, (adr, dim) in mb.sensor.items():

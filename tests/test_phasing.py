@@ -45,3 +45,24 @@ def test_selection_rule(preset, harmonic, central, excited):
             continue
         assert a < 1e-9, f"{t} mode excited ({a:.2e}) by harmonic {harmonic} of {central}"
     assert max(a for a, t in zip(eta, types) if t == excited) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("preset", ["demo-3p", "demo-4p", "hub-drive", "helical-planetary"])
+def test_every_mesh_reads_a_switch_on_the_same_side_however_late_in_a_run(preset):
+    """The stages' one-sided limits (``STAGE_SIDES``): at each of its stiffness switches (and tooth pairs' entries
+    and exits) a mesh read on the right is as a hundred-thousandth of a cycle later, on the left as one earlier, at
+    0, 8 and 60 s into a run, so every mesh, and every planet of a phased set, sees a switch that falls on a step
+    boundary on one side.  The limit is read along the cycle, 1e-9 cycle on, far above the round-off of the cycle
+    position (1.5e-11 cycle after 66,000 cycles).  Read in time, 1e-9 of a step on (the old rule), it sank into the
+    round-off of t: at a sixteenth of the default step, 60 s in, demo-3p read 48 of its 96 limits on the wrong side,
+    and a 0.5 s run past 2.4 million steps broke its planets' symmetry."""
+    exc = build_model(load_train(preset)).excitation
+    d = 1e-5 / exc.frequency.max()
+    for t0 in (0.0, 8.0, 60.0):
+        t = exc.switch_times(t0, t0 + 4.0 / exc.frequency.min())
+        assert t.size >= 30
+        for side, shifted in ((1, t + d), (-1, t - d)):
+            np.testing.assert_allclose(exc.stiffness(t, side), exc.stiffness(shifted), rtol=1e-3)
+            pairs, pairs_shifted = exc.tooth_pairs(t, side)[0], exc.tooth_pairs(shifted)[0]
+            if pairs is not None:
+                np.testing.assert_allclose(pairs, pairs_shifted, rtol=1e-3)

@@ -27,23 +27,37 @@ POINTS_PER_PERIOD = 20
 POINTS_PER_MESH_CYCLE = 64
 ORDER = 4  # of both solvers' RK4, the drive set at every stage and contact events located (a test asserts it)
 
-STAGE_OFFSETS = (1e-9, 0.5, 1.0 - 1e-9)
-"""Where a fixed-step solver samples the drive within a step [t, t + h]: just after t, at the
-midpoint, just before t + h.  A stiffness switch that falls on a step boundary is then seen
-on the same side by every mesh, whatever the round-off in its phase (planets with equal
-phases stay identical, so the symmetry that mesh phasing relies on survives)."""
+STAGE_OFFSETS = (0.0, 0.5, 1.0)
+"""Where a fixed-step solver samples the drive within a step [t, t + h]: its start, midpoint and end."""
+
+STAGE_SIDES = (1, 0, -1)
+"""Which one-sided limit each stage sample takes of a drive that jumps there: the right-hand one at a step's start,
+the left-hand one at its end (:data:`LIMIT_CYCLES`).  A stiffness switch that falls on a step boundary is then
+seen on the same side by every mesh, whatever the round-off in its phase (planets with equal phases stay identical,
+so the symmetry that mesh phasing relies on survives)."""
+
+LIMIT_CYCLES = 1e-9
+"""How far along its cycle a mesh's one-sided limit is read: far above the round-off of the cycle position
+xi = f t - phase (eps f t, 3.6e-12 cycle after 16,000 cycles: 8 s at 2 kHz), far below any feature of a stiffness.
+The limit was once read in time, 1e-9 of a step past t, which past a million steps fell within the round-off of t
+itself: demo-3p at h/16 over 0.5 s, the sun's 1x line that three planets' phasing cancels read 0.33 rad/s^2 in
+both solvers alike (0.0086 at h/4), the planets no longer seeing their switches on one side."""
+
+SPLIT_MARGIN = 1e-9
+"""A jump within this fraction of a step of a step boundary is left to the stages' one-sided limits (it lies well
+inside :data:`LIMIT_CYCLES` of its mesh, a step being a small fraction of a mesh cycle) rather than split off."""
 
 
 def split_steps(h: float, start: int, stop: int, switches, origin: float = 0.0) -> dict[int, np.ndarray]:
     """The steps among start..stop-1 (step i spans [origin + i h, origin + (i + 1) h]) inside which the drive jumps,
     each with the times of its jumps: both solvers end a sub-step there, so a rectangular mesh stiffness is
     constant over every (sub-)step and RK4 keeps its fourth order (a jump inside a step, seen as the step's mean,
-    costs an error of the order of h).  A jump within ``STAGE_OFFSETS[0]`` h of a step boundary is left
-    to the stage sampling, which sees it on the same side in every mesh; jumps that close together are
-    one."""
+    costs an error of the order of h).  A jump within ``SPLIT_MARGIN`` h of a step boundary is left to the
+    stages' one-sided limits (:data:`STAGE_SIDES`), which see it on the same side in every mesh; jumps that close
+    together are one."""
     switches = np.asarray(switches, dtype=float)
     since = switches - origin
-    tol = STAGE_OFFSETS[0] * h
+    tol = SPLIT_MARGIN * h
     index = np.floor(since / h).astype(int)
     inside = ((since - index * h) > tol) & (((index + 1) * h - since) > tol) & (index >= start) & (index < stop)
     out: dict[int, np.ndarray] = {}

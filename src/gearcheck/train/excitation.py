@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from gearcheck.shared.errors import GearcheckError, one_line, shown
+from gearcheck.shared.stepping import LIMIT_CYCLES
 from gearcheck.shared.trust import named_code
 from gearcheck.train.expression import Expression
 from gearcheck.train.history import Clock, speed_clock, torque_clock
@@ -97,30 +98,32 @@ class Excitation:
                             history.end)
 
     # ------------------------------------------------------------------ meshes
-    def mesh_position(self, t, mesh: int | None = None) -> np.ndarray:
+    def mesh_position(self, t, mesh: int | None = None, side=0) -> np.ndarray:
         """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...), or (...) for the one
-        mesh of index ``mesh``."""
+        mesh of index ``mesh``.  ``side`` (+1, -1 or 0, broadcast with t): read the right-hand or left-hand limit
+        of a drive that jumps at t, :data:`~gearcheck.shared.stepping.LIMIT_CYCLES` along the cycle."""
         t = np.asarray(t, dtype=float)
+        shift = np.multiply(side, LIMIT_CYCLES)
         if mesh is not None:
-            return self.frequency[mesh] * self.nominal_time(t) - self.phase[mesh]
-        return np.multiply.outer(self.nominal_time(t), self.frequency) - self.phase
+            return self.frequency[mesh] * self.nominal_time(t) - self.phase[mesh] + shift
+        return np.multiply.outer(self.nominal_time(t), self.frequency) - self.phase + np.expand_dims(shift, -1)
 
-    def stiffness(self, t) -> np.ndarray:
-        """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...)."""
+    def stiffness(self, t, side=0) -> np.ndarray:
+        """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...); ``side`` as in :meth:`mesh_position`."""
         t = np.asarray(t, dtype=float)
         k = np.empty(t.shape + (len(self.models),))
         for j, model in enumerate(self.models):  # one mesh at a time: no (..., n_mesh) temporary
-            k[..., j] = model(self.mesh_position(t, j))
+            k[..., j] = model(self.mesh_position(t, j, side))
         return k
 
-    def tooth_pairs(self, t):
+    def tooth_pairs(self, t, side=0):
         """(k_j, e_j) of the relieved meshes' tooth pairs (:class:`~gearcheck.train.tooth_pairs.ToothPairs`):
         shape (..., n_relieved, pairs) for t of shape (...), each mesh's pairs padded to the largest count
-        with k = 0, e = inf; (None, None) when no mesh is relieved.  The mesh force is
-        sum_j k_j max(0, delta - e(t) - e_j) + c (d delta/dt - de/dt)."""
+        with k = 0, e = inf; (None, None) when no mesh is relieved; ``side`` as in :meth:`mesh_position`.  The
+        mesh force is sum_j k_j max(0, delta - e(t) - e_j) + c (d delta/dt - de/dt)."""
         if not self._pairs:
             return None, None
-        xi = self.mesh_position(t)[..., self.relieved]
+        xi = self.mesh_position(t, side=side)[..., self.relieved]
         size = max(p.size for p in self._pairs)
         k = np.zeros(xi.shape + (size,))
         e = np.full(xi.shape + (size,), np.inf)

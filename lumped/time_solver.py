@@ -14,8 +14,7 @@ The drive is sampled at each RK4 stage's own time, t + h (0, 1/2, 1/2, 1), its r
 step's start and its left-hand one at the end (:data:`~gearcheck.shared.stepping.STAGE_SIDES`), as the
 MuJoCo runner drives its stages: the textbook RK4, fourth order for a drive smooth over the step.  A step
 inside which a mesh stiffness jumps is split there (:func:`~gearcheck.shared.stepping.split_steps`, as the
-MuJoCo runner does), so
-the stiffness is smooth over every sub-step and RK4 keeps its order.
+MuJoCo runner does), so the stiffness is smooth over every sub-step and RK4 keeps its order.
 
 The RK4 steps run compiled (:mod:`gearcheck.lumped.compiled_steps`), a chunk of steps at a time: Python samples
 the chunk's drive (and the rows of the turning elements at the stage times), vectorised, then checks the

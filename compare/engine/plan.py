@@ -84,26 +84,8 @@ class TrainPlan:
         return signal_jumps(self.spec)
 
     def singularities(self, names, t0: float, t1: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
-        """For each of ``names``, the instants in (t0, t1) at which it may jump, and those at which only its slope may
-        (:func:`~gearcheck.shared.results.signal_jumps`; every switch for a signal it does not know): the
-        ``switches`` and ``kinks`` of :func:`~gearcheck.compare.engine.line_projection.harmonics`.  Read with its own
-        switches alone, a signal's jumps stay apart: at hub-drive's step, 20 of the 724 switches of all its meshes in
-        0.15 s at 1100 rpm lie within three samples of another, where they can only be measured together, and a
-        signal that does not jump at one of them would take the other's jump."""
-        found: dict = {}
-
-        def at(meshes, corners: bool) -> np.ndarray:
-            if (meshes, corners) not in found:
-                found[meshes, corners] = self.switch_times(t0, t1, meshes, corners)
-            return found[meshes, corners]
-
-        switches, kinks = [], []
-        for name in names:
-            where = self._jumps.get(name)
-            switches.append(at(None, True) if where is None else at(where.meshes, where.corners))
-            kinks.append(at(None, True) if where is None else np.empty(0) if where.kinks is None else
-                         at(where.kinks, True))
-        return switches, kinks
+        """:func:`signal_singularities` of ``names`` in this plan's runs."""
+        return signal_singularities(self._jumps, self.switch_times, names, t0, t1)
 
     def needed_duration(self) -> float | None:
         """The shortest run whose steady state the decay of the free vibration guarantees."""
@@ -145,6 +127,30 @@ class TrainPlan:
             return [("acceleration", central_radius(self.spec, member))]
         return []
 
+
+def signal_singularities(rule: dict, switch_times, names, t0: float,
+                         t1: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """For each of ``names``, the instants in (t0, t1) at which it may jump, and those at which only its slope may,
+    by ``rule`` (:func:`~gearcheck.shared.results.signal_jumps`; every switch for a signal it does not know) and
+    ``switch_times`` (:meth:`~gearcheck.train.excitation.Excitation.switch_times`): the ``switches`` and ``kinks`` of
+    :func:`~gearcheck.compare.engine.line_projection.harmonics`.  Read with its own switches alone, a signal's
+    jumps stay apart: at hub-drive's step, 20 of the 724 switches of all its meshes in 0.15 s at 1100 rpm lie
+    within three samples of another, where they can only be measured together, and a signal that does not jump at
+    one of them would take the other's jump."""
+    found: dict = {}
+
+    def at(meshes, corners: bool) -> np.ndarray:
+        if (meshes, corners) not in found:
+            found[meshes, corners] = switch_times(t0, t1, meshes, corners)
+        return found[meshes, corners]
+
+    switches, kinks = [], []
+    for name in names:
+        where = rule.get(name)
+        switches.append(at(None, True) if where is None else at(where.meshes, where.corners))
+        kinks.append(at(None, True) if where is None else np.empty(0) if where.kinks is None else
+                     at(where.kinks, True))
+    return switches, kinks
 
 @dataclass(frozen=True)
 class TransientPlan:

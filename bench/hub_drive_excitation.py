@@ -25,7 +25,8 @@ from gearcheck.shared.settings import RunSettings
 CASES = {
     "everything": [],
     "no transmission error": [(r"^ste = .*$", "")],
-    "transmission error only": [(r'^stiffness = \{ model = "energy" \}', 'stiffness = { model = "constant", mean = 3.0e9 }')],
+    "transmission error only": [(r'^stiffness = \{ model = "energy" \}',
+                                 'stiffness = { model = "constant", mean = 3.0e9 }')],
 }
 
 

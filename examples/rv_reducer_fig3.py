@@ -83,7 +83,8 @@ summary = {"mean_time_rad": time_lines[0], "mean_hb_rad": hb_lines[0],
            "ac_rms_time_rad": float(np.std(theta[window])),
            "ac_rms_hb_rad": float(np.std(hb[:, labels.index("rv.carrier.theta")])),
            "mesh_share_of_ac_power": float(share_mesh),
-           "pin_pass_over_first_mesh_line": float(time_lines[39] / time_lines[69]), "max_translation_m": float(translation),
+           "pin_pass_over_first_mesh_line": float(time_lines[39] / time_lines[69]),
+           "max_translation_m": float(translation),
            "f_mesh_hz": f_mesh, "f_eccentric_hz": f_e, "hb_orders": orders}
 for key, value in summary.items():
     print(f"{key}: {value}")

@@ -52,7 +52,8 @@ def test_transmission_error_drives_the_mesh_frequency_line():
 
 
 def test_load_ramp_settles_to_the_state_reached_from_the_static_start():
-    ramped = build_model(edited("demo-3p", [(r"^input_shaft_damping = .*", "input_shaft_damping = 2.0\nramp_s = 0.01")]))
+    ramped = build_model(edited("demo-3p", [(r"^input_shaft_damping = .*",
+                                             "input_shaft_damping = 2.0\nramp_s = 0.01")]))
     static = build_model(load_train("demo-3p"))
     a, b = simulate(ramped, RunSettings(0.08)), simulate(static, RunSettings(0.08))
     fa, fb, name = a.select("mesh_force"), b.select("mesh_force"), "stage1.planet1.sun.force"

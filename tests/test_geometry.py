@@ -32,7 +32,8 @@ def test_internal_contact_ratio_closed_form():
     g = mesh_geometry(gear(62, internal=True), gear(20))
     a20 = math.radians(20)
     rbp, rbr = 30 * math.cos(a20), 93 * math.cos(a20)
-    expected = (math.sqrt(33**2 - rbp**2) - math.sqrt(90**2 - rbr**2) + 63 * math.sin(a20)) / (3 * math.pi * math.cos(a20))
+    expected = ((math.sqrt(33**2 - rbp**2) - math.sqrt(90**2 - rbr**2) + 63 * math.sin(a20))
+                / (3 * math.pi * math.cos(a20)))
     assert g.contact_ratio == pytest.approx(expected, rel=1e-12)
     assert g.centre_distance == pytest.approx(0.063, rel=1e-12)
 

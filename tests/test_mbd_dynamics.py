@@ -190,9 +190,9 @@ def test_time_response_matches_lumped():
 
     Measured (0.05 s, steady window from 0.025 s), default step -> half step: mesh force 2.9e-5 ->
     1.8e-5, ring world axes 1.70e-4 -> 1.70e-4, ring carrier axes 1.63e-4 -> 1.31e-4.  Both solvers
-    drive their steps alike and the input servo is exact, so what is left is not the step but the models: MuJoCo turns the real geometry
-    by the carrier's finite wind-up and refreshes its mesh coefficients every step, the linear model
-    does neither (second order).  Before the integrated-velocity servo the differences were 5.2e-4
+    drive their steps alike and the input servo is exact, so what is left is not the step but the models: MuJoCo
+    turns the real geometry by the carrier's finite wind-up and refreshes its mesh coefficients every step, the
+    linear model does neither (second order).  Before the integrated-velocity servo the differences were 5.2e-4
     and 1.7e-3 and halved with the step.
     """
     spec = load_train("demo-3p")

@@ -25,7 +25,8 @@ def test_the_twins_modes_are_the_reference_modes(preset):
     pairing = pair_modes(spec.name, lumped, mujoco)
     assert pairing.paired.min() >= 1.0 - 1e-6, pairing.paired
     assert pairing.findings == []
-    np.testing.assert_allclose(mujoco.physical_modes(mujoco.modes())[1], lumped.model.M, atol=1e-9 * lumped.model.M.max())
+    np.testing.assert_allclose(mujoco.physical_modes(mujoco.modes())[1], lumped.model.M,
+                               atol=1e-9 * lumped.model.M.max())
 
 
 def broken(side, permutation=None, drop=None):

@@ -44,7 +44,8 @@ def test_notebook_runs_and_ends_with_physics(path, tmp_path):
     assert missing is None, f"cannot run {path.name}: {missing}"
     nb = nbformat.read(path, as_version=4)
     for cell in nb.cells:
-        assert cell.cell_type != "code" or not cell.outputs, f"{path.name}: stored outputs; clear them before committing"
+        assert cell.cell_type != "code" or not cell.outputs, \
+            f"{path.name}: stored outputs; clear them before committing"
     os.environ.setdefault("MPLBACKEND", "Agg")
     client = nbclient.NotebookClient(nb, timeout=CELL_TIMEOUT_S, kernel_name="python3",
                                      resources={"metadata": {"path": str(tmp_path)}})  # any cwd: not the repo

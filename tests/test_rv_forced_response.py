@@ -41,8 +41,8 @@ def test_closed_form_sensitivity_matches_finite_differences(parameter, method):
 def test_equation_15_misses_what_the_eccentricity_does_to_the_forcing():
     """The eccentricity moves the stiffness variation and the static deflection, which Eq. (15) holds fixed:
     on the output's largest mesh harmonic (the 3rd, at 746 Hz) it gets the size wrong by more than half
-    (measured: the wrong sign, -0.42 times the true derivative).  For an inertia the forcing -Delta K q_mean does not move and Eq. (15) is
-    exact."""
+    (measured: the wrong sign, -0.42 times the true derivative).  For an inertia the forcing -Delta K q_mean does
+    not move and Eq. (15) is exact."""
     e = sensitivity(ECCENTRICITY, "Fourier series")
     carrier = build_model(edited("rv-reducer", [])).dofs("rv.carrier", "theta")
     row = int(np.argmax(np.abs(e.response.amplitudes[:, carrier]) * (e.response.harmonics[:, 1] == 0)))

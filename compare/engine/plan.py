@@ -152,6 +152,7 @@ def signal_singularities(rule: dict, switch_times, names, t0: float,
                      at(where.kinks, True))
     return switches, kinks
 
+
 @dataclass(frozen=True)
 class TransientPlan:
     frequencies: np.ndarray  # the reference's natural frequencies, Hz

@@ -147,11 +147,13 @@ def run_up(train, start_rpm: float, stop_rpm: float, duration: float, solvers=("
         # meshes switch; at the default sampling a jump measured beside those kinks reads them (demo-3p, 2500 rpm/s:
         # the sun's 2x translation line 0.75 -> 5.7 from the stepped sweep's), and even at 1e-5 s its jumps and kinks
         # taken out leave the sun's and ring's lines 10-26 % from the sweep's (26-115 % left in): left in
-        switches, _ = signal_singularities(rule, excitation.switch_times, names, result.t[0], result.t[-1])
-        for name, at in zip(names, switches):
+        own = [name for name in names if name.rsplit(".", 1)[0] in meshes]
+        switches = dict(zip(own, signal_singularities(rule, excitation.switch_times, own, result.t[0],
+                                                      result.t[-1])[0]))
+        for name in names:
             units[name] = result.signal(name).unit
             x = result[name]
-            times, sizes = jumps(result.t, x[:, None], at if name.rsplit(".", 1)[0] in meshes else ())
+            times, sizes = jumps(result.t, x[:, None], switches.get(name, ()))
             tracks[(solver, name)] = order_track(
                 result.t, x - step_series(result.t, times, sizes)[:, 0], angle, [o for *_, o in orders],
                 revs_per_block=REVS_PER_BLOCK, overlap=OVERLAP, steps=(f_in * nominal.time(times), sizes[:, 0]))

@@ -19,6 +19,13 @@ verdict: a stretch continues its own share of points (94 % from 1000 to 1150 rpm
     OPENBLAS_NUM_THREADS=1 python bench/bench_sweep.py --span 1000:1100 --no-dask --gains
 
 and in full without ``--span``.
+
+``--floor`` runs the stretch once more in this process and splits a point's CPU into the two solvers' compiled
+step loops and everything else, and sets it against its floor: the MuJoCo forward passes its points took (every
+RK4 stage of every run, the integration checks' and the discarded attempts' included) at the cost of a pass in
+MuJoCo's own C ``rollout`` of the same model on this machine (sensors off), plus the lumped kernel's own time.
+The target asks 2 cores x 180 s / 181 points = 1.99 CPU s a point; the floor says whether these steps can meet it
+here at all.
 """
 
 from __future__ import annotations
@@ -61,6 +68,64 @@ def timed(label, count, speeds, args, continuation=True, check="subset", **backe
             "checked": float(np.mean(frame["checked"] != "no")), "bytes": result.parquet()}
 
 
+def floor(speeds, args) -> None:
+    """Where a point's CPU goes, in this process: MuJoCo's compiled step loop, the lumped kernel, and the rest, and
+    the points' floor (their forward passes at ``rollout``'s cost, plus the lumped kernel)."""
+    from bench_runner import rollout_step_cost
+
+    from gearcheck.lumped import time_solver
+    from gearcheck.mbd_models import compiled
+    from gearcheck.mbd_models.side import MujocoSide
+    from gearcheck.mbd_models.twin import compile_train
+    from gearcheck.train.loader import load_train
+
+    spent = {"mujoco": 0.0, "lumped": 0.0}
+    passes = [0]
+
+    def timed_kernel(kernel, solver):
+        def run(*a, **k):
+            started = time.process_time()
+            try:
+                return kernel(*a, **k)
+            finally:
+                spent[solver] += time.process_time() - started
+        return run
+
+    def counted(run_from):
+        def run(self, *a, **k):
+            result, state = run_from(self, *a, **k)
+            passes[0] += result.info.rhs_calls
+            return result, state
+        return run
+
+    patches = [(compiled, "run_steps", timed_kernel(compiled.run_steps, "mujoco")),
+               (time_solver, "rk4_steps", timed_kernel(time_solver.rk4_steps, "lumped")),
+               (MujocoSide, "run_from", counted(MujocoSide.run_from))]
+    kept = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
+    for owner, name, value in patches:
+        setattr(owner, name, value)
+    try:
+        row = timed("in-process (1), kernels timed", 1, speeds, args, workers=1)
+    finally:
+        for owner, name, value in kept:
+            setattr(owner, name, value)
+    mb = compile_train(load_train(args.train, speeds[len(speeds) // 2]))
+    dt = MujocoSide(load_train(args.train, speeds[len(speeds) // 2])).default_step()
+    per_pass = min(rollout_step_cost(mb, 20000, dt, sensors=False) for _ in range(3)) / 4
+    n, cpu = len(speeds), row["cpu"]
+    rest = cpu - (spent["mujoco"] + spent["lumped"]) / n
+    at_floor = (passes[0] * per_pass + spent["lumped"]) / n
+    print(f"\nwhere a point's CPU goes (in-process, {n} points, load {row['load']:.1f} after): {cpu:.3f} s")
+    print(f"  MuJoCo's compiled step loop   {spent['mujoco'] / n:7.3f} s  {spent['mujoco'] / n / cpu:5.1%}  "
+          f"{passes[0] / n:,.0f} forward passes, {1e6 * spent['mujoco'] / passes[0]:.2f} us each")
+    print(f"  the lumped compiled kernel    {spent['lumped'] / n:7.3f} s  {spent['lumped'] / n / cpu:5.1%}")
+    print(f"  the rest (drives, results, reductions, plans, static states, modes) {rest:.3f} s  {rest / cpu:5.1%}")
+    print(f"floor: the same forward passes at rollout's {1e6 * per_pass:.2f} us (sensors off, this machine) plus the "
+          f"lumped kernel: {at_floor:.3f} s a point; these points cost {cpu / at_floor:.2f} times their floor")
+    print(f"the target's {2 * TARGET_S / TARGET_POINTS:.2f} CPU s a point (2 cores, {TARGET_S:.0f} s, {TARGET_POINTS} "
+          f"points) is {2 * TARGET_S / TARGET_POINTS / at_floor:.2f} times this stretch's floor")
+
+
 def memory(train: str, speed: float) -> tuple[float, float]:
     """Peak memory (MB, numpy's allocations by tracemalloc) of one point from rest and of the next, continued, in
     this process, both solvers, no integration check."""
@@ -94,6 +159,7 @@ def main(argv=None):
     p.add_argument("--no-dask", action="store_true", help="leave the Dask LocalCluster out")
     p.add_argument("--gains", action="store_true", help="also run each saving on its own (on the most workers)")
     p.add_argument("--memory", action="store_true", help="also measure a point's peak memory, from rest and continued")
+    p.add_argument("--floor", action="store_true", help="also split a point's CPU and set it against its floor")
     args = p.parse_args(argv)
     grid = np.linspace(args.low, args.high, args.points) if args.points > 1 else np.array([args.low])
     if args.span:
@@ -137,6 +203,8 @@ def main(argv=None):
         for g in gains:
             print(f"{g['label']:<40} {g['cpu']:>11.3f} {gains[0]['cpu'] / g['cpu']:>6.2f} {g['wall']:>9.2f} "
                   f"{g['continued']:>9.0%} {g['checked']:>8.0%} {g['load']:>5.1f}")
+    if args.floor:
+        floor(speeds, args)
     if args.memory:
         rest, going_on = memory(args.train, speeds[len(speeds) // 2])
         print(f"\npeak memory of a point (numpy's allocations, both solvers, no check): from rest {rest:.0f} MB, "

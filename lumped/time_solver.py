@@ -246,18 +246,17 @@ def _chunk(sys, h, start, stop, t0: float = 0.0) -> Chunk:
     ends = np.ones(steps.size, dtype=bool)
     split = stepping.split_steps(h, start, stop, sys.exc.switch_times(t0 + start * h, t0 + stop * h), t0)
     if split:
+        parts, sub_begins, sub_lengths = stepping.sub_steps(t0, h, split)
+        at = np.array(sorted(split)) - start
         counts = np.ones(steps.size, dtype=int)
-        for i, inner in split.items():
-            counts[i - start] = inner.size + 1
+        counts[at] = parts
         row = np.repeat(np.arange(steps.size), counts)
         lengths, begins = lengths[row], begins[row]
         first = np.cumsum(counts) - counts
         ends = np.zeros(row.size, dtype=bool)
         ends[first + counts - 1] = True
-        for i, inner in split.items():
-            a, length = stepping.sub_steps(t0 + i * h, h, inner)
-            r = first[i - start] + np.arange(a.size)
-            begins[r], lengths[r] = a, length
+        inside = np.isin(row, at)  # the sub-steps of the split steps, in their order
+        begins[inside], lengths[inside] = sub_begins, sub_lengths
     times = begins[:, None] + np.array(STAGE_OFFSETS)[None, :] * lengths[:, None]
     return Chunk(lengths, ends, times, *sys.drive(times, np.array(STAGE_SIDES)))
 

@@ -277,7 +277,7 @@ class _Stepper:
             if step not in split:
                 self.step(self.h, [None if x is None else x[i] for x in values], sample)
                 continue
-            starts, lengths = stepping.sub_steps(self.t0 + step * self.h, self.h, split[step])
+            _, starts, lengths = stepping.sub_steps(self.t0, self.h, {step: split[step]})
             for n, (rows, length) in enumerate(zip(zip(*(_rows(x) for x in self.drive.steps(starts, lengths))),
                                                    lengths)):
                 self.step(length, rows, sample and n == 0)
@@ -416,14 +416,10 @@ class _CompiledStepper(_Stepper):
     def run(self, start, stop, every, values, split) -> None:
         rows = stop - start
         first, count = np.zeros(rows, dtype=np.int64), np.zeros(rows, dtype=np.int64)
-        starts, lengths = [], []
-        for step in sorted(split):
-            a, length = stepping.sub_steps(self.t0 + step * self.h, self.h, split[step])
-            first[step - start], count[step - start] = len(lengths), len(length)
-            starts += list(a)
-            lengths += list(length)
-        lengths = np.array(lengths, dtype=float)
-        sub = self.drive.steps(np.array(starts, dtype=float), lengths) if lengths.size else [None] * 5
+        parts, starts, lengths = stepping.sub_steps(self.t0, self.h, split)
+        at = np.array(sorted(split), dtype=np.int64) - start
+        first[at], count[at] = np.cumsum(parts) - parts, parts
+        sub = self.drive.steps(starts, lengths) if lengths.size else [None] * 5
         self.j = compiled.run_steps(self.c, *self.twin, self._arrays(values, rows),
                                     compiled.Split(first, count, lengths, self._arrays(sub, lengths.size)),
                                     self.flags, self.outputs, self.h, start, stop, every, self.j, self.switches,

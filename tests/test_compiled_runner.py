@@ -90,6 +90,16 @@ def test_the_compiled_loop_repeats_the_python_loop(twins, name):
         assert fast.static[key] == slow.static[key]
 
 
+def test_sub_steps_end_each_split_step_at_its_jumps():
+    """Steps 2 and 5 of a 0.5 s step from t = 10 s, split at their inner instants: the sub-steps of each split step in
+    step order, from the step's start or a jump to the next jump or the step's end (the layout both solvers step)."""
+    counts, starts, lengths = stepping.sub_steps(10.0, 0.5, {5: np.array([12.75]), 2: np.array([11.1, 11.3])})
+    np.testing.assert_array_equal(counts, [3, 2])
+    np.testing.assert_allclose(starts, [11.0, 11.1, 11.3, 12.5, 12.75], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(lengths, [0.1, 0.2, 0.2, 0.25, 0.25], rtol=0, atol=1e-12)
+    assert stepping.sub_steps(0.0, 1.0, {})[1].size == 0
+
+
 def test_sampling_every_few_steps_and_through_split_steps(twins):
     """Samples every third step (some of them split at a stiffness jump) and the run's model left as it was.  The
     steps between samples go without MuJoCo's sensors, which feed nothing back: against the same steps sampled at

@@ -101,27 +101,28 @@ def singularities(t: np.ndarray, x: np.ndarray, switches, kinks=()) -> tuple[np.
     if n < 2 * _SIDE + 1 or events.size == 0:
         return none
     after = np.searchsorted(t, events - 1e-6 * h)  # the first sample that holds the value after the instant
-    groups = np.split(np.arange(events.size), np.where(np.diff(after) >= _SIDE)[0] + 1)
-    times, sizes, slopes = [], [], []
-    for g in groups:
-        first, last = after[g[0]], after[g[-1]]
-        if first < _SIDE or last + _SIDE > n:
-            continue
-        switched = events[g][jumping[g]]
-        s = float(switched.mean() if switched.size else events[g].mean())
-        u = (s - t[first - 1]) / h  # before: samples at u = 0, -1, -2
-        x0, x1, x2 = x[first - 1], x[first - 2], x[first - 3]
-        before = (x0 * (u + 1) * (u + 2) / 2 - x1 * u * (u + 2) + x2 * u * (u + 1) / 2)
-        v = (s - t[last]) / h  # after: samples at v = 0, 1, 2
-        y0, y1, y2 = x[last], x[last + 1], x[last + 2]
-        after_value = (y0 * (v - 1) * (v - 2) / 2 - y1 * v * (v - 2) + y2 * v * (v - 1) / 2)
-        times.append(s)
-        sizes.append(after_value - before if switched.size else np.zeros(x.shape[1]))
-        slopes.append((y0 * (2 * v - 3) / 2 - y1 * (2 * v - 2) + y2 * (2 * v - 1) / 2
-                       - x0 * (2 * u + 3) / 2 + x1 * (2 * u + 2) - x2 * (2 * u + 1) / 2) / h)
-    if not times:
+    starts = np.concatenate([[0], np.where(np.diff(after) >= _SIDE)[0] + 1])  # each group's first event
+    ends = np.append(starts[1:], events.size)
+    first, last = after[starts], after[ends - 1]
+    inside = (first >= _SIDE) & (last + _SIDE <= n)
+    if not inside.any():
         return none
-    return np.array(times), np.array(sizes), np.array(slopes)
+    starts, ends, first, last = starts[inside], ends[inside], first[inside], last[inside]
+    switched = np.add.reduceat(jumping, starts) > 0
+    s = events[starts]  # a lone instant is its own mean; a group's is the mean of its switches, else of its kinks
+    for i in np.flatnonzero(ends - starts > 1):
+        group = events[starts[i]:ends[i]]
+        s[i] = (group[jumping[starts[i]:ends[i]]] if switched[i] else group).mean()
+    u = ((s - t[first - 1]) / h)[:, None]  # before: samples at u = 0, -1, -2
+    x0, x1, x2 = x[first - 1], x[first - 2], x[first - 3]
+    before = (x0 * (u + 1) * (u + 2) / 2 - x1 * u * (u + 2) + x2 * u * (u + 1) / 2)
+    v = ((s - t[last]) / h)[:, None]  # after: samples at v = 0, 1, 2
+    y0, y1, y2 = x[last], x[last + 1], x[last + 2]
+    after_value = (y0 * (v - 1) * (v - 2) / 2 - y1 * v * (v - 2) + y2 * v * (v - 1) / 2)
+    sizes = np.where(switched[:, None], after_value - before, 0.0)
+    slopes = (y0 * (2 * v - 3) / 2 - y1 * (2 * v - 2) + y2 * (2 * v - 1) / 2
+              - x0 * (2 * u + 3) / 2 + x1 * (2 * u + 2) - x2 * (2 * u + 1) / 2) / h
+    return s, sizes, slopes
 
 
 def step_series(t: np.ndarray, times: np.ndarray, sizes: np.ndarray) -> np.ndarray:

@@ -70,10 +70,23 @@ def split_steps(h: float, start: int, stop: int, switches, origin: float = 0.0) 
     return out
 
 
-def sub_steps(t0: float, h: float, inner) -> tuple[np.ndarray, np.ndarray]:
-    """(starts, lengths) of the sub-steps of the step [t0, t0 + h] ended at the sorted times ``inner``."""
-    bounds = np.concatenate([[t0], inner, [t0 + h]])
-    return bounds[:-1], np.diff(bounds)
+def sub_steps(t0: float, h: float, split: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sub-steps of the ``split`` steps (:func:`split_steps`; step i spans [t0 + i h, t0 + (i + 1) h]), in the
+    order of their steps: (each split step's count of sub-steps, the sub-steps' starts, their lengths), each step
+    ended at its sorted inner times."""
+    steps = sorted(split)
+    counts = np.array([split[i].size + 1 for i in steps], dtype=np.int64)
+    begins = t0 + np.array(steps, dtype=float) * h
+    inner = np.concatenate([split[i] for i in steps]) if steps else np.empty(0)
+    first = np.cumsum(counts) - counts
+    starts, ends = np.empty(inner.size + counts.size), np.empty(inner.size + counts.size)
+    later = np.ones(starts.size, dtype=bool)
+    later[first] = False
+    starts[first], starts[later] = begins, inner
+    earlier = np.ones(ends.size, dtype=bool)
+    earlier[first + counts - 1] = False
+    ends[~earlier], ends[earlier] = begins + h, inner
+    return counts, starts, ends - starts
 
 
 def commensurate_step(h_max: float, mesh_frequencies, points_per_cycle: int) -> float:

@@ -101,17 +101,23 @@ def floor(speeds, args) -> None:
     patches = [(compiled, "run_steps", timed_kernel(compiled.run_steps, "mujoco")),
                (time_solver, "rk4_steps", timed_kernel(time_solver.rk4_steps, "lumped")),
                (MujocoSide, "run_from", counted(MujocoSide.run_from))]
+    mb = compile_train(load_train(args.train, speeds[len(speeds) // 2]))
+    dt = MujocoSide(load_train(args.train, speeds[len(speeds) // 2])).default_step()
+
+    def rollout_pass() -> float:
+        return min(rollout_step_cost(mb, 20000, dt, sensors=False) for _ in range(3)) / 4
+
     kept = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
     for owner, name, value in patches:
         setattr(owner, name, value)
+    before = rollout_pass()
     try:
         row = timed("in-process (1), kernels timed", 1, speeds, args, workers=1)
     finally:
         for owner, name, value in kept:
             setattr(owner, name, value)
-    mb = compile_train(load_train(args.train, speeds[len(speeds) // 2]))
-    dt = MujocoSide(load_train(args.train, speeds[len(speeds) // 2])).default_step()
-    per_pass = min(rollout_step_cost(mb, 20000, dt, sensors=False) for _ in range(3)) / 4
+    after = rollout_pass()
+    per_pass = 0.5 * (before + after)  # the machine's speed drifts: its mean over the run
     n, cpu = len(speeds), row["cpu"]
     rest = cpu - (spent["mujoco"] + spent["lumped"]) / n
     at_floor = (passes[0] * per_pass + spent["lumped"]) / n
@@ -120,8 +126,9 @@ def floor(speeds, args) -> None:
           f"{passes[0] / n:,.0f} forward passes, {1e6 * spent['mujoco'] / passes[0]:.2f} us each")
     print(f"  the lumped compiled kernel    {spent['lumped'] / n:7.3f} s  {spent['lumped'] / n / cpu:5.1%}")
     print(f"  the rest (drives, results, reductions, plans, static states, modes) {rest:.3f} s  {rest / cpu:5.1%}")
-    print(f"floor: the same forward passes at rollout's {1e6 * per_pass:.2f} us (sensors off, this machine) plus the "
-          f"lumped kernel: {at_floor:.3f} s a point; these points cost {cpu / at_floor:.2f} times their floor")
+    print(f"floor: the same forward passes at rollout's {1e6 * per_pass:.2f} us (sensors off, this machine; "
+          f"{1e6 * before:.2f} before the stretch, {1e6 * after:.2f} after) plus the lumped kernel: {at_floor:.3f} s a "
+          f"point; these points cost {cpu / at_floor:.2f} times their floor")
     print(f"the target's {2 * TARGET_S / TARGET_POINTS:.2f} CPU s a point (2 cores, {TARGET_S:.0f} s, {TARGET_POINTS} "
           f"points) is {2 * TARGET_S / TARGET_POINTS / at_floor:.2f} times this stretch's floor")
 

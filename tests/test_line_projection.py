@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from gearcheck.compare.engine.line_projection import harmonics, jumps
+from gearcheck.compare.engine.line_projection import harmonics, jumps, singularities
 
 F = 270.0  # Hz, the "mesh" frequency
 DUTY = 0.37  # of the pulse: +1 on [0, DUTY / F) of each period, -1 elsewhere
@@ -102,3 +102,17 @@ def test_each_column_is_corrected_at_its_own_switches():
     assert shared.ravel() == pytest.approx(together[:, :2].ravel(), rel=1e-13)
     with pytest.raises(ValueError, match="2 arrays of switches for 3 columns"):
         harmonics(t, columns, lines, fs, own[:2])
+
+
+def test_a_kink_alone_takes_no_jump_whatever_lies_beyond_the_window_edge():
+    """Instants are measured in groups (closer than three samples), and a group of kinks alone changes the slope and
+    takes no jump, to the bit, even where a switch lies past it among the samples left out at the window's end (a
+    cubic, so the two sides' quadratic extrapolations do not meet by themselves)."""
+    t = np.linspace(0.0, 1.0, 101)
+    x = t**3 + 2.0 * np.maximum(t - 0.5, 0.0) + (t >= 0.995)
+    times, sizes, slopes = singularities(t, x[:, None], [0.995], [0.25, 0.5])
+    assert times.tolist() == [0.25, 0.5]
+    assert sizes.tolist() == [[0.0], [0.0]]
+    assert slopes[:, 0] == pytest.approx([0.0, 2.0], abs=1e-3)
+    times, sizes, _ = singularities(t, x[:, None], [0.5], [0.25])  # a switch of its own: its jump is measured
+    assert sizes[1, 0] == pytest.approx(0.0, abs=1e-5) and sizes[1, 0] != 0.0

@@ -104,11 +104,11 @@ def singularities(t: np.ndarray, x: np.ndarray, switches, kinks=()) -> tuple[np.
     starts = np.concatenate([[0], np.where(np.diff(after) >= _SIDE)[0] + 1])  # each group's first event
     ends = np.append(starts[1:], events.size)
     first, last = after[starts], after[ends - 1]
+    switched = np.add.reduceat(jumping, starts) > 0  # over every group, each to the next one's start
     inside = (first >= _SIDE) & (last + _SIDE <= n)
     if not inside.any():
         return none
-    starts, ends, first, last = starts[inside], ends[inside], first[inside], last[inside]
-    switched = np.add.reduceat(jumping, starts) > 0
+    starts, ends, first, last, switched = starts[inside], ends[inside], first[inside], last[inside], switched[inside]
     s = events[starts]  # a lone instant is its own mean; a group's is the mean of its switches, else of its kinks
     for i in np.flatnonzero(ends - starts > 1):
         group = events[starts[i]:ends[i]]

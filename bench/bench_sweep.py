@@ -23,7 +23,8 @@ and in full without ``--span``.
 ``--floor`` runs the stretch once more in this process and splits a point's CPU into the two solvers' compiled
 step loops and everything else, and sets it against its floor: the MuJoCo forward passes its points took (every
 RK4 stage of every run, the integration checks' and the discarded attempts' included) at the cost of a pass in
-MuJoCo's own C ``rollout`` of the same model on this machine (sensors off), plus the lumped kernel's own time.
+MuJoCo's own C ``rollout`` of the same model on this machine (with its sensors for the passes of sampled runs,
+without them for the settling stretches, sampled only at their ends), plus the lumped kernel's own time.
 The target asks 2 cores x 180 s / 181 points = 1.99 CPU s a point; the floor says whether these steps can meet it
 here at all.
 """
@@ -80,7 +81,7 @@ def floor(speeds, args) -> None:
     from gearcheck.train.loader import load_train
 
     spent = {"mujoco": 0.0, "lumped": 0.0}
-    passes = [0]
+    passes = {True: 0, False: 0}  # sampled at every step or not
 
     def timed_kernel(kernel, solver):
         def run(*a, **k):
@@ -92,9 +93,9 @@ def floor(speeds, args) -> None:
         return run
 
     def counted(run_from):
-        def run(self, *a, **k):
-            result, state = run_from(self, *a, **k)
-            passes[0] += result.info.rhs_calls
+        def run(self, settings, *a, **k):
+            result, state = run_from(self, settings, *a, **k)
+            passes[settings.output_dt is None] += result.info.rhs_calls
             return result, state
         return run
 
@@ -104,8 +105,9 @@ def floor(speeds, args) -> None:
     mb = compile_train(load_train(args.train, speeds[len(speeds) // 2]))
     dt = MujocoSide(load_train(args.train, speeds[len(speeds) // 2])).default_step()
 
-    def rollout_pass() -> float:
-        return min(rollout_step_cost(mb, 20000, dt, sensors=False) for _ in range(3)) / 4
+    def rollout_pass() -> np.ndarray:  # (with sensors, without), s a pass
+        return np.array([min(rollout_step_cost(mb, 20000, dt, sensors=on) for _ in range(3)) / 4
+                         for on in (True, False)])
 
     kept = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
     for owner, name, value in patches:
@@ -120,14 +122,17 @@ def floor(speeds, args) -> None:
     per_pass = 0.5 * (before + after)  # the machine's speed drifts: its mean over the run
     n, cpu = len(speeds), row["cpu"]
     rest = cpu - (spent["mujoco"] + spent["lumped"]) / n
-    at_floor = (passes[0] * per_pass + spent["lumped"]) / n
+    total = passes[True] + passes[False]
+    at_floor = (passes[True] * per_pass[0] + passes[False] * per_pass[1] + spent["lumped"]) / n
     print(f"\nwhere a point's CPU goes (in-process, {n} points, load {row['load']:.1f} after): {cpu:.3f} s")
     print(f"  MuJoCo's compiled step loop   {spent['mujoco'] / n:7.3f} s  {spent['mujoco'] / n / cpu:5.1%}  "
-          f"{passes[0] / n:,.0f} forward passes, {1e6 * spent['mujoco'] / passes[0]:.2f} us each")
+          f"{total / n:,.0f} forward passes ({passes[True] / total:.0%} sampled), "
+          f"{1e6 * spent['mujoco'] / total:.2f} us each")
     print(f"  the lumped compiled kernel    {spent['lumped'] / n:7.3f} s  {spent['lumped'] / n / cpu:5.1%}")
     print(f"  the rest (drives, results, reductions, plans, static states, modes) {rest:.3f} s  {rest / cpu:5.1%}")
-    print(f"floor: the same forward passes at rollout's {1e6 * per_pass:.2f} us (sensors off, this machine; "
-          f"{1e6 * before:.2f} before the stretch, {1e6 * after:.2f} after) plus the lumped kernel: {at_floor:.3f} s a "
+    print(f"floor: the same forward passes at rollout's {1e6 * per_pass[0]:.2f} us sampled and {1e6 * per_pass[1]:.2f} "
+          f"us not (sensors on and off, this machine; {1e6 * before[0]:.2f} and {1e6 * before[1]:.2f} before the "
+          f"stretch, {1e6 * after[0]:.2f} and {1e6 * after[1]:.2f} after) plus the lumped kernel: {at_floor:.3f} s a "
           f"point; these points cost {cpu / at_floor:.2f} times their floor")
     print(f"the target's {2 * TARGET_S / TARGET_POINTS:.2f} CPU s a point (2 cores, {TARGET_S:.0f} s, {TARGET_POINTS} "
           f"points) is {2 * TARGET_S / TARGET_POINTS / at_floor:.2f} times this stretch's floor")

@@ -77,7 +77,6 @@ def floor(speeds, args) -> None:
     from gearcheck.lumped import time_solver
     from gearcheck.mbd_models import compiled
     from gearcheck.mbd_models.side import MujocoSide
-    from gearcheck.mbd_models.twin import compile_train
     from gearcheck.train.loader import load_train
 
     spent = {"mujoco": 0.0, "lumped": 0.0}
@@ -102,8 +101,8 @@ def floor(speeds, args) -> None:
     patches = [(compiled, "run_steps", timed_kernel(compiled.run_steps, "mujoco")),
                (time_solver, "rk4_steps", timed_kernel(time_solver.rk4_steps, "lumped")),
                (MujocoSide, "run_from", counted(MujocoSide.run_from))]
-    mb = compile_train(load_train(args.train, speeds[len(speeds) // 2]))
-    dt = MujocoSide(load_train(args.train, speeds[len(speeds) // 2])).default_step()
+    twin = MujocoSide(load_train(args.train, speeds[len(speeds) // 2]))
+    mb, dt = twin.model, twin.default_step()
 
     def rollout_pass() -> np.ndarray:  # (with sensors, without), s a pass
         return np.array([min(rollout_step_cost(mb, 20000, dt, sensors=on) for _ in range(3)) / 4

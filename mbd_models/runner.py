@@ -471,22 +471,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     use_compiled = engine != "python" and not unsupported
     spec, m = mb.spec, mb.model
     what = f"MuJoCo model of {spec.name}"
-    nominal, history = mb.excitation.clock, spec.operating.history
-    check_duration(history, settings.duration, what)
-    settings.check_start(initial_state, history, what)
+    dt, n_steps, every, static, (qpos0, qvel0, act0) = prepare(mb, settings, initial_state, static)
     t0 = settings.start
-    frequency = mb.excitation.frequency * (1.0 if nominal is None else max(1.0, nominal.top(settings.duration)))
-    dt = stepping.default_step(mb.limits, frequency) if settings.dt is None else settings.dt
-    stepping.check_step(dt, mb.limits, frequency, what)
-    n_steps, every = settings.check_work(dt, m.nsensordata + len(train_signals(spec)), what)
-    static = static_state(mb) if static is None else static
-    if initial_state is None and history is not None and history.start == "rest":
-        qpos0, qvel0 = m.qpos0.copy(), np.zeros(m.nv)  # every body at rest at its nominal place, undeformed
-    elif initial_state is None:
-        start = static if spec.operating.ramp == 0 else static_state(mb, 0.0)
-        qpos0, qvel0 = start.qpos, start.qvel
-    else:
-        qpos0, qvel0, *act0 = (np.asarray(x, dtype=float) for x in initial_state)
 
     d = mujoco.MjData(m)
     saved = (m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy(), m.opt.enableflags,
@@ -496,8 +482,8 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
     if record_energy:
         m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     d.qpos[:], d.qvel[:] = qpos0, qvel0
-    if initial_state is not None and act0:
-        d.act[:] = act0[0]
+    if act0 is not None:
+        d.act[:] = act0
     kind = _CompiledStepper if use_compiled else _Stepper
     stepper = kind(mb, d, dt, n_steps // every + 1, stiffness_clock == "bodies", record_energy, t0)
     scale = divergence.deflection_scale(static.mesh_deflection, mb.half_backlash)
@@ -533,6 +519,31 @@ def simulate_mujoco(mb: MbdModel, settings: RunSettings, progress=None, stiffnes
         "contact_events_located": stepper.located})
     result = _result(mb, stepper, t, static, settings.settle_time(spec.operating.ramp), info, settings.signals)
     return (result, (d.qpos.copy(), d.qvel.copy(), d.act.copy())) if return_state else result
+
+
+def prepare(mb: MbdModel, settings: RunSettings, initial_state=None, static: StaticState | None = None):
+    """A run's step, its steps, the steps between samples, the twin's static state and the start (qpos, qvel, act;
+    act None: the model's own), checked as :func:`simulate_mujoco` checks them."""
+    spec, m = mb.spec, mb.model
+    what = f"MuJoCo model of {spec.name}"
+    nominal, history = mb.excitation.clock, spec.operating.history
+    check_duration(history, settings.duration, what)
+    settings.check_start(initial_state, history, what)
+    frequency = mb.excitation.frequency * (1.0 if nominal is None else max(1.0, nominal.top(settings.duration)))
+    dt = stepping.default_step(mb.limits, frequency) if settings.dt is None else settings.dt
+    stepping.check_step(dt, mb.limits, frequency, what)
+    n_steps, every = settings.check_work(dt, m.nsensordata + len(train_signals(spec)), what)
+    static = static_state(mb) if static is None else static
+    act0 = None
+    if initial_state is None and history is not None and history.start == "rest":
+        qpos0, qvel0 = m.qpos0.copy(), np.zeros(m.nv)  # every body at rest at its nominal place, undeformed
+    elif initial_state is None:
+        start = static if spec.operating.ramp == 0 else static_state(mb, 0.0)
+        qpos0, qvel0 = start.qpos, start.qvel
+    else:
+        qpos0, qvel0, *rest = (np.asarray(x, dtype=float) for x in initial_state)
+        act0 = rest[0] if rest else None
+    return dt, n_steps, every, static, (qpos0, qvel0, act0)
 
 
 def simulate_mujoco_many(twins, settings, threads: int | None = None, **options) -> list[TimeResult]:

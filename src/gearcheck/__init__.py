@@ -17,7 +17,8 @@ The front door:
 * :func:`kinematics`, :class:`Excitation` -- a train's nominal speeds and mesh frequencies, and its excitation
   (mesh stiffness and transmission error over time): the pieces of a user's own model;
 * :func:`modes` -- natural frequencies and mode types, either solver;
-* :func:`simulate` -- a time run, either solver: a :class:`TimeResult` with named signals;
+* :func:`simulate` -- a time run, either solver: a :class:`TimeResult` with named signals; :func:`simulate_batch`
+  the MuJoCo twin at many speeds at once (MJX, on a GPU where JAX has one);
 * :func:`mjcf` -- the MuJoCo model of a train;
 * :func:`crosscheck` -- both solvers compared, with measurements, tolerances and baselines;
 * :func:`harmonic_response`, :func:`sensitivity` -- the steady forced response by harmonic methods and its
@@ -55,7 +56,7 @@ _PACKAGES = ("train", "lumped", "mbd_models", "compare", "shared")
 _DEFINED_IN = {  # module -> the public names it defines, imported on first use: ``gearcheck --version`` loads none
     "api": ("SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model",
             "harmonic_response", "load", "mjcf", "mode_pairing", "modes", "pin_loads", "preset_data", "presets",
-            "runup", "sensitivity", "simulate", "sweep", "write_report"),
+            "runup", "sensitivity", "simulate", "simulate_batch", "sweep", "write_report"),
     "compare.engine.comparison": ("CrosscheckResult",),
     "lumped.linear_model": ("LinearModel", "Mesh", "Periodic"),
     "session": ("Train",),
@@ -91,6 +92,7 @@ if TYPE_CHECKING:  # what type checkers read; at run time :func:`__getattr__` im
                                runup,
                                sensitivity,
                                simulate,
+                               simulate_batch,
                                sweep,
                                write_report,
     )
@@ -122,5 +124,5 @@ __all__ = ["SOLVERS", "CrosscheckResult", "DivergenceError", "Excitation", "Gear
            "ModalResult", "Periodic", "SolverError", "TimeResult", "Train", "TrainFileError", "TrainSpec",
            "__version__", "allow_data", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "edited",
            "export_model", "harmonic_response", "kinematics", "load", "load_text", "mjcf", "mode_pairing", "modes",
-           "pin_loads", "preset_data", "preset_text", "presets", "runup", "sensitivity", "simulate", "sweep", "trust",
-           "write_report"]
+           "pin_loads", "preset_data", "preset_text", "presets", "runup", "sensitivity", "simulate", "simulate_batch",
+           "sweep", "trust", "write_report"]

@@ -36,7 +36,8 @@ from gearcheck.shared.settings import RunSettings
 
 __all__ = ["SOLVERS", "calibrate", "campbell", "crosscheck", "dashboard", "describe", "export_model",
            "harmonic_response", "load", "mjcf", "mode_pairing", "pin_loads",
-           "modes", "preset_data", "presets", "runup", "sensitivity", "simulate", "sweep", "write_report"]
+           "modes", "preset_data", "presets", "runup", "sensitivity", "simulate", "simulate_batch", "sweep",
+           "write_report"]
 
 
 def presets() -> list[str]:
@@ -209,6 +210,38 @@ def simulate(train, solver: str = "lumped", duration: float = 0.2, *, speed: flo
     """
     return Train(train, speed).simulate(solver, duration, dt=dt, output_dt=output_dt, settle=settle, method=method,
                                         progress=progress)
+
+
+def simulate_batch(train, speeds, duration: float = 0.2, *, dt: float | None = None, output_dt: float | None = None,
+                   settle: float | None = None, progress=None) -> list[TimeResult]:
+    """Time runs of the MuJoCo twin at several input speeds at once: the batched runner, MJX in float64, its
+    worlds stepped together on a GPU where JAX has one (CPU otherwise); each equal to :func:`simulate`'s
+    "mujoco" run at that speed to round-off (``pip install 'gearcheck[gpu]'``, and JAX's CUDA build on a GPU).
+
+    Parameters
+    ----------
+    train : str, path or TrainSpec
+        The train.
+    speeds : sequence of float
+        Input speeds in rpm, one world each.
+    duration, dt, output_dt, settle
+        As :func:`simulate` (the default step is each speed's own).
+    progress : callable, optional
+        Called with the fraction done.
+
+    Returns
+    -------
+    list of TimeResult
+        One per speed, in order; ``info.settings["device"]`` names the device that ran them.
+    """
+    from gearcheck.mbd_models.batched import simulate_mujoco_batch
+    from gearcheck.mbd_models.twin import compile_train
+
+    if (isinstance(speeds, (str, bytes)) or not hasattr(speeds, "__len__") or not len(speeds)
+            or not all(isinstance(s, (int, float)) and not isinstance(s, bool) for s in speeds)):
+        raise GearcheckError(f"speeds must be a non-empty sequence of input speeds in rpm, not {speeds!r}")
+    twins = [compile_train(load_train(train, float(speed))) for speed in speeds]
+    return simulate_mujoco_batch(twins, RunSettings(duration, dt=dt, output_dt=output_dt, settle=settle), progress)
 
 
 def sweep(train, *, speeds=None, fields=None, distributions=None, samples: int | None = None, seed: int = 0,

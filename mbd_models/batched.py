@@ -11,21 +11,23 @@ sub-steps ended there; a backlash's edges crossed inside a step are located on t
 the switching functions and the step is taken again in parts (Hairer, Norsett & Wanner 1993, sec. II.6), at most
 :data:`~gearcheck.shared.events.MAX_EVENTS` a step.  The worlds' steps run as one ``lax.scan`` over sub-step
 slots: each world has its own list of sub-steps (its own step, splits and length of run), padded with steps of
-length zero, which leave a state as it is; a located event retakes the step of every world that has one, in a
-branch taken only when some world has (``lax.cond``).
+length zero, which leave a state as it is.  Every world takes its whole step; those with a contact event are
+gathered, a :data:`GROUP` of the worlds at a time, and retake theirs in parts, the others waiting for none of it.
+RK4's stages run as one loop and the parts of a retaken step as another, so that one forward dynamics is compiled.
 
-The drive (the excitation's functions of time) is computed on the host, as the CPU runner computes it
-(its ``_Drive``), a chunk of steps at a time.  At every sampled step the device
-keeps MuJoCo's sensors and the force reader's generalized forces of two probe models
-(:class:`~gearcheck.mbd_models.forces.ForceReader`, ``mj_passive`` there, MJX's ``passive`` here), and the host
-builds each world's :class:`~gearcheck.shared.results.TimeResult` from them as the CPU runner does.
+The drive (the excitation's functions of time) is computed on the host, as the CPU runner computes it (its
+``_Drive``), a chunk of steps at a time.  At every sampled step the device keeps MuJoCo's sensors and the force
+reader's generalized forces of two probe models (:class:`~gearcheck.mbd_models.forces.ForceReader`, ``mj_passive``
+there, MJX's ``passive`` here), and the host builds each world's :class:`~gearcheck.shared.results.TimeResult`
+from them as the CPU runner does.
 
-Precision: float64 (``jax_enable_x64``).  The twin's joints really turn (about 105 rad in 0.5 s at 2000 rpm),
-which float32 resolves to about 1e-5 rad, some 10 % of a mesh deflection: MuJoCo Warp, float32 only, is not used.
+Precision: float64 (``jax_enable_x64``, set for the whole process when the runner is first used).  The twin's
+joints really turn (about 105 rad in 0.5 s at 2000 rpm), which float32 resolves to about 1e-5 rad, some 10 % of a
+mesh deflection: MuJoCo Warp, float32 only, is not used.
 
 Not batched (refused with the reason, :func:`batched_unsupported`): an RV reducer's moving pin contacts, tip
 relief's tooth pairs, torsional planets (their mesh forces are read one mesh at a time), joints other than hinges
-and slides, and the "bodies" stiffness clock.
+and slides, tendons other than fixed ones or with armature; the stiffness runs on the nominal clock.
 """
 
 from __future__ import annotations
@@ -51,7 +53,8 @@ from gearcheck.shared.events import APART, MAX_EVENTS, MIN_FRACTION, SIMULTANEOU
 from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 
-CHUNK = 4096  # steps of every world computed on the host and sent to the device at once
+CHUNK = 4096  # steps of every world computed on the host and sent to the device at once, at most
+WORLD_STEPS = 2**18  # and world-steps (a chunk's drive and samples: about 1 GB with hub-drive's sensors)
 _HERMITE = hermite.py_func  # the event numerics' cubic, on JAX's arrays
 GROUP = 0.25  # the fraction of the worlds whose steps with contact events are retaken together
 BUCKET = 512  # a chunk's slots and samples are padded to a multiple of this
@@ -161,13 +164,14 @@ def simulate_mujoco_batch(twins, settings, progress=None, initial_states=None) -
     wall = clock.perf_counter() - started
     timing.update(prepare_s=started - began, loop_s=wall)
     results = []
-    for w in worlds:
+    for i, w in enumerate(worlds):
         mb, s = w.mb, w.stepper
         t = w.settings.start + w.dt * w.every * np.arange(s.j)
         columns = [mb.sensor[f"{mesh.label}_deflection"][0] for mesh in mb.spec.meshes]
         divergence.check(t, s.sensors[:s.j][:, columns],
                          divergence.deflection_scale(w.static.mesh_deflection, mb.half_backlash),
-                         f"MuJoCo model of {mb.spec.name}")
+                         f"MuJoCo model of {mb.spec.name} at {mb.spec.operating.input_speed * 30 / math.pi:.6g} rpm "
+                         f"(world {i})")
         info = RunInfo("mujoco-batched", w.n_steps, 4, 4 * w.sub_steps, wall, {
             "method": "mujoco-rk4", "integrator": "RK4", "dt_s": w.dt, "steps": w.n_steps, "wall_time_s": wall,
             "omega_max_rad_s": mb.omega_max, "stable_step_s": stepping.stable_step(mb.limits),
@@ -513,8 +517,9 @@ class _Program:
         state = tuple(jnp.asarray(np.stack([getattr(w.stepper.d, name) for w in worlds]))
                       for name in ("qpos", "qvel", "act"))
         total = max(w.n_steps for w in worlds)
-        for start in range(0, total + 1, CHUNK):
-            stop = start + CHUNK
+        chunk = max(BUCKET, min(CHUNK, WORLD_STEPS // len(worlds) // BUCKET * BUCKET))
+        for start in range(0, total + 1, chunk):
+            stop = start + chunk
             began = clock.perf_counter()
             layouts = [self._layout(w, start, stop, start <= w.n_steps < stop) for w in worlds]
             slots = _bucket(max(len(lay[0]) for lay in layouts))  # few shapes: each is compiled once

@@ -87,16 +87,16 @@ def nominal_speeds(mb) -> np.ndarray:
     return qvel
 
 
-def _nominal(mb, q: np.ndarray):
+def _nominal(q: np.ndarray, speeds: np.ndarray, turning):
     """State (qpos, qvel) and the steady-rotation acceleration of deflection q at t = 0.
 
-    Every body turns at its nominal speed (:func:`nominal_speeds`), and a central member's world-frame
+    Every body turns at its nominal speed (``speeds``, :func:`nominal_speeds`), and a central member's world-frame
     deflection (its slides, and its tilts when it tilts: :func:`~gearcheck.mbd_models.mjcf_text.world_pairs`) turns
-    with its carrier: x' = Omega k x x, x'' = -Omega^2 x.
+    with its carrier (``turning``, :func:`world_turning`): x' = Omega k x x, x'' = -Omega^2 x.
     """
-    qvel = nominal_speeds(mb)
+    qvel = speeds.copy()
     target = np.zeros_like(q)
-    for (ix, iy), omega in world_turning(mb):
+    for (ix, iy), omega in turning:
         qvel[ix], qvel[iy] = -omega * q[iy], omega * q[ix]
         target[ix], target[iy] = -omega**2 * q[ix], -omega**2 * q[iy]
     return q.copy(), qvel, target
@@ -194,12 +194,13 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
     t = mb.mesh_tendon
     correction = DampingCorrection(mb, d)
     pins = _PinContacts(mb, d) if mb.moving_contacts else None
+    speeds, turning = nominal_speeds(mb), world_turning(mb)  # constants of the solve
     try:
         m.tendon_stiffness[t] = mb.excitation.mean_stiffness
         _set_static_drive(mb, d, load_scale)
 
         def residual(q):
-            qpos, qvel, target = _nominal(mb, q)
+            qpos, qvel, target = _nominal(q, speeds, turning)
             d.qpos[:], d.qvel[:] = qpos, qvel
             mb.refresh(d.qpos)
             if pins is not None:
@@ -230,7 +231,7 @@ def static_state(mb, load_scale: float = 1.0, tol: float = 1e-13, max_iter: int 
         sample = np.empty((1, reader.width))
         reader.sample(sample[0])
         force, _, bearing = (f[0] for f in reader.forces(sample))
-        qpos, qvel, _ = _nominal(mb, q)
+        qpos, qvel, _ = _nominal(q, speeds, turning)
         touching, pin_force = (None, None) if pins is None else (pins.touching, pins.forces())
         return StaticState(qpos, qvel, d.ten_length[t].copy(), force, bearing, iterations, res, touching, pin_force)
     finally:

@@ -212,34 +212,38 @@ class _Program:
         self.n_mesh = len(mb.mesh_tendon)
         self.n_corr = len(mb.corrected)
         self.nu = m.nu
-        quiet = copy.copy(m)
+        # MJX's models may share their arrays' memory with the MuJoCo models they were put from: these copies are
+        # the program's own, kept as long as it is (the twin's model is written by every run, the force reader's
+        # probes go with their run)
+        self.host = (copy.copy(m), copy.copy(m), copy.copy(reader.probe), copy.copy(reader.joints_only))
+        quiet, sensing, probe, joints_only = self.host
         quiet.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
         self.model = mjx.put_model(quiet)  # RK4's stages: no sensors (nothing reads them)
-        self.sensing = mjx.put_model(m)  # a sampled step's first stage
-        self.probe = mjx.put_model(reader.probe)
-        self.joints_only = mjx.put_model(reader.joints_only)
+        self.sensing = mjx.put_model(sensing)  # a sampled step's first stage
+        self.probe = mjx.put_model(probe)
+        self.joints_only = mjx.put_model(joints_only)
         self.data = mjx.make_data(self.model)
         tc = mb.turning
         jnp = jax.numpy
-        self.tc = dict(wraps=jnp.asarray(tc.wraps), base=jnp.asarray(tc.base), carrier=jnp.asarray(tc.carrier_qadr),
-                       tendon=jnp.asarray(tc.tendon), joint_qadr=jnp.asarray(tc.joint_qadr),
-                       joint_dof=jnp.asarray(tc.joint_dof))
+        self.tc = dict(wraps=jnp.array(tc.wraps), base=jnp.array(tc.base), carrier=jnp.array(tc.carrier_qadr),
+                       tendon=jnp.array(tc.tendon), joint_qadr=jnp.array(tc.joint_qadr),
+                       joint_dof=jnp.array(tc.joint_dof))
         correction = DampingCorrection(mb, world.stepper.d)
-        self.J0 = jnp.asarray(tendon_rows(m, mb.corrected))
-        self.c_wrap = jnp.asarray(correction.c_wrap)
-        self.c = jnp.asarray(correction.c)
+        self.J0 = jnp.array(tendon_rows(m, mb.corrected))
+        self.c_wrap = jnp.array(correction.c_wrap)
+        self.c = jnp.array(correction.c)
         self.half = len(tc.wraps) // 2
-        self.wrap_prm = jnp.asarray(m.wrap_prm)
-        self.lo_hi = jnp.asarray(np.stack([-mb.half_backlash, mb.half_backlash], axis=1))
-        self.lengthspring = jnp.asarray(m.tendon_lengthspring)
-        self.stiffness = jnp.asarray(m.tendon_stiffness)
+        self.wrap_prm = jnp.array(m.wrap_prm)
+        self.lo_hi = jnp.array(np.stack([-mb.half_backlash, mb.half_backlash], axis=1))
+        self.lengthspring = jnp.array(m.tendon_lengthspring)
+        self.stiffness = jnp.array(m.tendon_stiffness)
         sw = runner.mesh_switches(mb)
         self.n_switch = sw.count
         segment = np.repeat(np.arange(len(sw.tendons)), np.diff(sw.starts))
-        self.sw = dict(wraps=jnp.asarray(sw.wraps), qadr=jnp.asarray(sw.qadr), dofs=jnp.asarray(sw.dofs),
-                       segment=jnp.asarray(segment), tendons=jnp.asarray(sw.tendons),
-                       half=jnp.asarray(sw.half_backlash), count=len(sw.tendons))
-        self.reader = dict(dofs=jnp.asarray(reader.dofs), slides=jnp.asarray(reader.slides))
+        self.sw = dict(wraps=jnp.array(sw.wraps), qadr=jnp.array(sw.qadr), dofs=jnp.array(sw.dofs),
+                       segment=jnp.array(segment), tendons=jnp.array(sw.tendons),
+                       half=jnp.array(sw.half_backlash), count=len(sw.tendons))
+        self.reader = dict(dofs=jnp.array(reader.dofs), slides=jnp.array(reader.slides))
         self._chunk = jax.jit(self._scan)
 
     # ------------------------------------------------------------------ one world's physics (vmapped)
@@ -514,7 +518,7 @@ class _Program:
         drive and on the device (its compiling included), and the slots stepped."""
         jnp = self.jax.numpy
         timing = {"drive_s": 0.0, "device_s": 0.0, "slots": 0}
-        state = tuple(jnp.asarray(np.stack([getattr(w.stepper.d, name) for w in worlds]))
+        state = tuple(jnp.array(np.stack([getattr(w.stepper.d, name) for w in worlds]))
                       for name in ("qpos", "qvel", "act"))
         total = max(w.n_steps for w in worlds)
         chunk = max(BUCKET, min(CHUNK, WORLD_STEPS // len(worlds) // BUCKET * BUCKET))
@@ -543,9 +547,9 @@ class _Program:
             sent = clock.perf_counter()
             timing["drive_s"] += sent - began
             with _turning_tendons():
-                state, sensors, rows, located = self._chunk(state, jnp.asarray(h), [jnp.asarray(x) for x in drive],
-                                                            jnp.asarray(take))
-            sensors, rows, located = np.asarray(sensors), np.asarray(rows), np.asarray(located)
+                state, sensors, rows, located = self._chunk(state, jnp.array(h), [jnp.array(x) for x in drive],
+                                                            jnp.array(take))
+            sensors, rows, located = np.array(sensors), np.array(rows), np.array(located)
             timing["device_s"] += clock.perf_counter() - sent
             timing["slots"] += slots
             for i, (w, count) in enumerate(zip(worlds, counts)):
@@ -557,7 +561,7 @@ class _Program:
                 w.sub_steps += 2 * int(located[i])
             if progress is not None:
                 progress(min(1.0, stop / total))
-        final = [np.asarray(x) for x in state]
+        final = [np.array(x) for x in state]
         for i, w in enumerate(worlds):
             w.stepper.d.qpos[:], w.stepper.d.qvel[:], w.stepper.d.act[:] = final[0][i], final[1][i], final[2][i]
         return timing

@@ -29,7 +29,10 @@ ROUND_OFF = 1e-8
 
 
 def _worst(a, b) -> float:
-    """The largest difference over every signal, over its peak."""
+    """The largest difference over every signal, over its peak (both runs' signals finite)."""
+    for run in (a, b):
+        bad = [n for n in run.names() if not np.all(np.isfinite(run[n]))]
+        assert not bad, f"{run.info.engine}: not finite: {bad[:5]}"
     return max(float(np.max(np.abs(a[n] - b[n]))) / (float(np.max(np.abs(a[n]))) or 1.0) for n in a.names())
 
 

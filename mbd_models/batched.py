@@ -16,10 +16,12 @@ gathered, a :data:`GROUP` of the worlds at a time, and retake theirs in parts, t
 RK4's stages run as one loop and the parts of a retaken step as another, so that one forward dynamics is compiled.
 
 The drive (the excitation's functions of time) is computed on the host, as the CPU runner computes it (its
-``_Drive``), a chunk of steps at a time.  At every sampled step the device keeps MuJoCo's sensors and the force
-reader's generalized forces of two probe models (:class:`~gearcheck.mbd_models.forces.ForceReader`, ``mj_passive``
-there, MJX's ``passive`` here), and the host builds each world's :class:`~gearcheck.shared.results.TimeResult`
-from them as the CPU runner does.
+``_Drive``), a chunk of steps at a time.  The device returns the states at the sampled steps, and the host takes
+the samples there as the CPU runner takes them: the stage set, MuJoCo's C ``mj_forward``, its sensors and the force
+reader's rows (:class:`~gearcheck.mbd_models.forces.ForceReader`), then each world's
+:class:`~gearcheck.shared.results.TimeResult` as the CPU runner builds it.  (Samples taken on the device with MJX's
+sensors came back, in two of four CI runs, with a hub-drive world's accelerations not finite at some samples, which
+no rerun reproduced.)
 
 Precision: float64 (``jax_enable_x64``, set for the whole process when the runner is first used).  The twin's
 joints really turn (about 105 rad in 0.5 s at 2000 rpm), which float32 resolves to about 1e-5 rad, some 10 % of a
@@ -54,7 +56,7 @@ from gearcheck.shared.run_info import RunInfo
 from gearcheck.shared.settings import RunSettings
 
 CHUNK = 4096  # steps of every world computed on the host and sent to the device at once, at most
-WORLD_STEPS = 2**18  # and world-steps (a chunk's drive and samples: about 1 GB with hub-drive's sensors)
+WORLD_STEPS = 2**18  # and world-steps (a chunk's drive and states: about 450 MB on hub-drive)
 _HERMITE = hermite.py_func  # the event numerics' cubic, on JAX's arrays
 GROUP = 0.25  # the fraction of the worlds whose steps with contact events are retaken together
 BUCKET = 512  # a chunk's slots and samples are padded to a multiple of this
@@ -185,6 +187,23 @@ def simulate_mujoco_batch(twins, settings, progress=None, initial_states=None) -
     return results
 
 
+def _sample(stepper: runner._Stepper, states, drive) -> None:
+    """The CPU runner's samples at the device's ``states`` (qpos, qvel, act; one row a sample), each with the drive
+    of its step's first stage (k, u, e, de; e and de None without a transmission error): the stage set and
+    ``mj_forward`` by MuJoCo's C library, the sensors and the force reader's row as the CPU runner takes them, on its
+    twin's model, whose fields are restored after."""
+    m, d = stepper.m, stepper.d
+    saved = m.tendon_stiffness.copy(), m.tendon_lengthspring.copy(), m.wrap_prm.copy()
+    try:
+        for row, (qpos, qvel, act) in enumerate(zip(*states)):
+            d.qpos[:], d.qvel[:], d.act[:] = qpos, qvel, act
+            stepper.set_stage(*(None if x is None else x[row] for x in drive))
+            mujoco.mj_forward(m, d)
+            stepper.sample()
+    finally:
+        m.tendon_stiffness[:], m.tendon_lengthspring[:], m.wrap_prm[:] = saved
+
+
 _PROGRAMS: dict = {}  # one compiled program per twin's model (its MJCF but for the step), kept for later runs
 
 
@@ -208,20 +227,14 @@ class _Program:
         self.jax, self.mjx = jax, mjx
         mb = world.mb
         m = mb.model
-        reader = world.stepper.reader
         self.n_mesh = len(mb.mesh_tendon)
         self.n_corr = len(mb.corrected)
         self.nu = m.nu
-        # MJX's models may share their arrays' memory with the MuJoCo models they were put from: these copies are
-        # the program's own, kept as long as it is (the twin's model is written by every run, the force reader's
-        # probes go with their run)
-        self.host = (copy.copy(m), copy.copy(m), copy.copy(reader.probe), copy.copy(reader.joints_only))
-        quiet, sensing, probe, joints_only = self.host
-        quiet.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
-        self.model = mjx.put_model(quiet)  # RK4's stages: no sensors (nothing reads them)
-        self.sensing = mjx.put_model(sensing)  # a sampled step's first stage
-        self.probe = mjx.put_model(probe)
-        self.joints_only = mjx.put_model(joints_only)
+        # the program's own copy of the model, kept as long as it is (the twin's model is written by every run),
+        # without sensors: the samples are taken on the host
+        self.host = copy.copy(m)
+        self.host.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
+        self.model = mjx.put_model(self.host)
         self.data = mjx.make_data(self.model)
         tc = mb.turning
         jnp = jax.numpy
@@ -243,7 +256,6 @@ class _Program:
         self.sw = dict(wraps=jnp.array(sw.wraps), qadr=jnp.array(sw.qadr), dofs=jnp.array(sw.dofs),
                        segment=jnp.array(segment), tendons=jnp.array(sw.tendons),
                        half=jnp.array(sw.half_backlash), count=len(sw.tendons))
-        self.reader = dict(dofs=jnp.array(reader.dofs), slides=jnp.array(reader.slides))
         self._chunk = jax.jit(self._scan)
 
     # ------------------------------------------------------------------ one world's physics (vmapped)
@@ -280,23 +292,6 @@ class _Program:
         mx, dx, wrap_prm = self._set(self.model, qpos, qvel, act, *drive)
         dx = _forward(self.mjx, mx, dx, wrap_prm)
         return dx.qacc, dx.act_dot
-
-    def _sample(self, qpos, qvel, act, drive):
-        """Sensors and the force reader's row at a state (``_Stepper.sample``)."""
-        jnp = self.jax.numpy
-        mx, dx, wrap_prm = self._set(self.sensing, qpos, qvel, act, *drive)
-        dx = _forward(self.mjx, mx, dx, wrap_prm)
-        if dx._impl.efc_J.size == 0:  # MJX's forward leaves the acceleration sensors out without constraints
-            dx = self.mjx.sensor_acc(mx, dx)
-        n = self.n_corr
-        probe = self.probe.replace(tendon_stiffness=self.probe.tendon_stiffness.at[:n].set(mx.tendon_stiffness[:n]),
-                                   tendon_lengthspring=self.probe.tendon_lengthspring.at[:n].set(
-                                       mx.tendon_lengthspring[:n]))
-        mesh = self.mjx.passive(probe, dx).qfrc_passive
-        bearing = self.mjx.passive(self.joints_only, dx).qfrc_passive
-        dofs = self.reader["dofs"]
-        row = jnp.concatenate([mesh[dofs], dx.qfrc_applied[dofs], bearing[self.reader["slides"]]])
-        return dx.sensordata, row
 
     def _rk4(self, state, h, drive):
         """One RK4 (sub-)step of length h, the drive (k, u, e, de) at its stage times t, t + h/2, t + h; its four
@@ -465,10 +460,9 @@ class _Program:
 
     def _scan(self, state, h, drive, take):
         """The worlds' slots of one chunk: ``h`` (slots, worlds), ``drive`` four arrays (slots, worlds, 3, ...),
-        ``take`` (worlds, samples) the slots whose first stage is sampled; the state after them, the samples'
-        sensors and force rows, and the events located per world."""
+        ``take`` (worlds, samples) the slots whose first stage is sampled; the state after them, the states at the
+        sampled slots' starts, and the events located per world."""
         jax, jnp = self.jax, self.jax.numpy
-        sample = jax.vmap(self._sample)
 
         def body(carry, slot):
             state, located = carry
@@ -478,12 +472,7 @@ class _Program:
 
         (state, located), before = jax.lax.scan(body, (state, jnp.zeros(h.shape[1], dtype=jnp.int64)), (h, drive))
         worlds = jnp.arange(h.shape[1])[:, None]
-        picked = [x[take, worlds] for x in before]  # (worlds, samples, ...)
-        first = [x[take, worlds, 0] for x in drive]
-        flat = lambda x: x.reshape((-1,) + x.shape[2:])
-        sensors, rows = sample(*(flat(x) for x in picked), [flat(x) for x in first])
-        shape = take.shape
-        return state, sensors.reshape(shape + sensors.shape[1:]), rows.reshape(shape + rows.shape[1:]), located
+        return state, [x[take, worlds] for x in before], located  # the sampled slots' states (worlds, samples, .)
 
     def _layout(self, w: _World, start: int, stop: int, final: bool):
         """One world's sub-steps over its steps start..stop-1 (none past its run), the final sample's zero-length
@@ -517,7 +506,7 @@ class _Program:
         """Step ``worlds`` over their runs, their samples into their steppers; the seconds spent on the host's
         drive and on the device (its compiling included), and the slots stepped."""
         jnp = self.jax.numpy
-        timing = {"drive_s": 0.0, "device_s": 0.0, "slots": 0}
+        timing = {"drive_s": 0.0, "device_s": 0.0, "samples_s": 0.0, "slots": 0}
         state = tuple(jnp.array(np.stack([getattr(w.stepper.d, name) for w in worlds]))
                       for name in ("qpos", "qvel", "act"))
         total = max(w.n_steps for w in worlds)
@@ -547,18 +536,20 @@ class _Program:
             sent = clock.perf_counter()
             timing["drive_s"] += sent - began
             with _turning_tendons():
-                state, sensors, rows, located = self._chunk(state, jnp.array(h), [jnp.array(x) for x in drive],
-                                                            jnp.array(take))
-            sensors, rows, located = np.array(sensors), np.array(rows), np.array(located)
+                state, picked, located = self._chunk(state, jnp.array(h), [jnp.array(x) for x in drive],
+                                                     jnp.array(take))
+            picked, located = [np.array(x) for x in picked], np.array(located)
             timing["device_s"] += clock.perf_counter() - sent
             timing["slots"] += slots
+            began = clock.perf_counter()
             for i, (w, count) in enumerate(zip(worlds, counts)):
-                s = w.stepper
-                s.sensors[s.j:s.j + count] = sensors[i, :count]
-                s.forces[s.j:s.j + count] = rows[i, :count]
-                s.j += count
+                slots_taken = take[i, :count]
+                _sample(w.stepper, [x[i, :count] for x in picked],
+                        [x[slots_taken, i, 0] if w.stepper.drive.has_te or j < 2 else None
+                         for j, x in enumerate(drive)])
                 w.located += int(located[i])
                 w.sub_steps += 2 * int(located[i])
+            timing["samples_s"] += clock.perf_counter() - began
             if progress is not None:
                 progress(min(1.0, stop / total))
         final = [np.array(x) for x in state]

@@ -20,7 +20,7 @@ The drive (the excitation's functions of time) is computed on the host, as the C
 the samples there as the CPU runner takes them: the stage set, MuJoCo's C ``mj_forward``, its sensors and the force
 reader's rows (:class:`~gearcheck.mbd_models.forces.ForceReader`), then each world's
 :class:`~gearcheck.shared.results.TimeResult` as the CPU runner builds it.  (Samples taken on the device with MJX's
-sensors came back, in two of four CI runs, with a hub-drive world's accelerations not finite at some samples, which
+sensors came back, in two of three CI runs, with a hub-drive world's accelerations not finite at some samples, which
 no rerun reproduced.)
 
 Precision: float64 (``jax_enable_x64``, set for the whole process when the runner is first used).  The twin's

@@ -47,7 +47,6 @@ import numpy as np
 
 from gearcheck.mbd_models import runner
 from gearcheck.mbd_models.jacobians import tendon_rows
-from gearcheck.mbd_models.static_state import DampingCorrection
 from gearcheck.mbd_models.twin import MbdModel
 from gearcheck.shared import divergence, stepping
 from gearcheck.shared.errors import SolverError
@@ -241,7 +240,7 @@ class _Program:
         self.tc = dict(wraps=jnp.array(tc.wraps), base=jnp.array(tc.base), carrier=jnp.array(tc.carrier_qadr),
                        tendon=jnp.array(tc.tendon), joint_qadr=jnp.array(tc.joint_qadr),
                        joint_dof=jnp.array(tc.joint_dof))
-        correction = DampingCorrection(mb, world.stepper.d)
+        correction = world.stepper.correction  # its damping per turning wrap, as the CPU runner applies it
         self.J0 = jnp.array(tendon_rows(m, mb.corrected))
         self.c_wrap = jnp.array(correction.c_wrap)
         self.c = jnp.array(correction.c)

@@ -292,7 +292,8 @@ def _rk4(sys, q, v, h, n_steps, every, progress, runaway, stage_by_stage=False, 
         steps_of = _python_steps if stage_by_stage else sys.compiled_steps
         written = steps_of(sys, q, v, steps, out, located) if stage_by_stage else steps_of(q, v, steps, out, located)
         t_out[j:j + written] = t0 + h * (every * (start // every + 1 + np.arange(written)))
-        runaway(np.append(t_out[j:j + written], t0 + stop * h), np.vstack([q_out[j:j + written], q[None]]))
+        runaway(t_out[j:j + written], q_out[j:j + written])
+        runaway(np.array([t0 + stop * h]), q[None])  # the chunk's last state, sampled or not
         j += written
         if progress is not None:
             progress(stop / n_steps)

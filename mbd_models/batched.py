@@ -196,22 +196,22 @@ def _sample(stepper: runner._Stepper, states, drive) -> None:
     try:
         for row, (qpos, qvel, act) in enumerate(zip(*states)):
             d.qpos[:], d.qvel[:], d.act[:] = qpos, qvel, act
-            stepper.set_stage(*(None if x is None else x[row] for x in drive))
-            mujoco.mj_forward(m, d)
-            stepper.sample()
+            stepper.sample_at(drive, row)
     finally:
         m.tendon_stiffness[:], m.tendon_lengthspring[:], m.wrap_prm[:] = saved
 
 
-_PROGRAMS: dict = {}  # one compiled program per twin's model (its MJCF but for the step), kept for later runs
+_PROGRAMS: dict = {}  # compiled programs by twin's model (its MJCF but for the step), the latest used last
+KEPT = 4  # programs kept for later runs (each holds its model on the device and its compiled chunks)
 
 
 def _program(world: _World) -> "_Program":
     key = _TIMESTEP.sub("", world.mb.xml)
-    if key not in _PROGRAMS:
-        _PROGRAMS.clear()  # one twin's program at a time: a program holds its model on the device
-        _PROGRAMS[key] = _Program(world)
-    return _PROGRAMS[key]
+    program = _PROGRAMS.pop(key, None) or _Program(world)
+    _PROGRAMS[key] = program
+    while len(_PROGRAMS) > KEPT:
+        del _PROGRAMS[next(iter(_PROGRAMS))]
+    return program
 
 
 class _Program:
@@ -509,7 +509,7 @@ class _Program:
         state = tuple(jnp.array(np.stack([getattr(w.stepper.d, name) for w in worlds]))
                       for name in ("qpos", "qvel", "act"))
         total = max(w.n_steps for w in worlds)
-        chunk = max(BUCKET, min(CHUNK, WORLD_STEPS // len(worlds) // BUCKET * BUCKET))
+        chunk = min(CHUNK, max(BUCKET, WORLD_STEPS // len(worlds) // BUCKET * BUCKET))
         for start in range(0, total + 1, chunk):
             stop = start + chunk
             began = clock.perf_counter()

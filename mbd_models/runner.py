@@ -311,8 +311,12 @@ class _Stepper:
 
     def finish(self, t_end: float) -> None:
         """Sample the final state (the drive of the step that would start there)."""
-        values = self.drive.at(np.array([t_end]), STAGE_SIDES[0])
-        self.set_stage(*(None if x is None else x[0] for x in values))
+        self.sample_at(self.drive.at(np.array([t_end]), STAGE_SIDES[0]), 0)
+
+    def sample_at(self, drive, row: int) -> None:
+        """Sample the state in ``d`` with row ``row`` of ``drive`` (k, u, e, de, ...; None where absent) set as its
+        stage: ``mj_forward``, then the sensors and the force reader's row."""
+        self.set_stage(*(None if x is None else x[row] for x in drive))
         mujoco.mj_forward(self.m, self.d)
         self.sample()
 

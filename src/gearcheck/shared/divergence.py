@@ -22,8 +22,7 @@ def deflection_scale(static_deflection, half_backlash) -> float:
 def check(t: np.ndarray, deflection: np.ndarray, scale: float, model: str) -> None:
     """Raise :class:`DivergenceError` at the first of the times ``t`` whose mesh ``deflection`` row is not
     finite or exceeds ``FACTOR * scale``."""
-    bad = ~np.all(np.isfinite(deflection), axis=1) | (np.max(np.abs(np.nan_to_num(deflection, nan=np.inf)), axis=1,
-                                                             initial=0.0) > FACTOR * scale)
+    bad = ~(np.max(np.abs(deflection), axis=1, initial=0.0) <= FACTOR * scale)  # NaN compares False: bad
     if np.any(bad):
         i = int(np.argmax(bad))
         worst = np.max(np.abs(deflection[i]))

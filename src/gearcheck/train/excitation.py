@@ -111,9 +111,15 @@ class Excitation:
     def stiffness(self, t, side=0) -> np.ndarray:
         """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...); ``side`` as in :meth:`mesh_position`."""
         t = np.asarray(t, dtype=float)
+        angle = self.nominal_time(t)
+        shift = np.broadcast_to(np.multiply(side, LIMIT_CYCLES), t.shape)
         k = np.empty(t.shape + (len(self.models),))
+        xi = np.empty(t.shape)
         for j, model in enumerate(self.models):  # one mesh at a time: no (..., n_mesh) temporary
-            k[..., j] = model(self.mesh_position(t, j, side))
+            np.multiply(self.frequency[j], angle, out=xi)  # mesh_position(t, j, side), its operations in its order
+            xi -= self.phase[j]
+            xi += shift
+            k[..., j] = model(xi)
         return k
 
     def tooth_pairs(self, t, side=0):
@@ -200,17 +206,23 @@ class Excitation:
     def transmission_error(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Static transmission error e(t) and its rate per mesh, in m and m/s; shape (..., n_mesh)."""
         t = np.asarray(t, dtype=float)
-        e = np.zeros(t.shape + (len(self.mesh_ids),))
-        de = np.zeros(e.shape)  # not zeros_like, which writes its zeros: zeros maps zero pages until they are written
-        if not self.has_transmission_error:
-            return e, de
+        shape = t.shape + (len(self.mesh_ids),)
+        if not self.has_transmission_error:  # zeros map zero pages until they are written (zeros_like writes them)
+            return np.zeros(shape), np.zeros(shape)
         from gearcheck.train.compiled_excitation import add_terms  # numba on first use, not when a file is read
 
-        angle = self.nominal_time(t)  # the angles turn at lambda times their speeds
-        scale = np.ones(t.shape) if self.clock is None else np.broadcast_to(self.clock.scale(t), t.shape)
-        add_terms(np.ravel(angle), np.ravel(scale), self.frequency, self.phase, *self._terms,
-                  e.reshape(-1, e.shape[-1]), de.reshape(-1, de.shape[-1]))
-        return e, de
+        flat = np.ravel(t)
+        new = np.ones(flat.size, dtype=bool)  # a time equal to the one before it (a step's end and the next step's
+        new[1:] = flat[1:] != flat[:-1]       # start, most often) takes its terms: the same bits, less work
+        times = flat[new]
+        angle = self.nominal_time(times)  # the angles turn at lambda times their speeds
+        scale = np.ones(times.size) if self.clock is None else np.broadcast_to(self.clock.scale(times), times.shape)
+        e, de = np.zeros((2, times.size, shape[-1]))
+        add_terms(angle, np.ascontiguousarray(scale), self.frequency, self.phase, *self._terms, e, de)
+        if times.size < flat.size:
+            at = np.cumsum(new) - 1
+            e, de = e[at], de[at]
+        return e.reshape(shape), de.reshape(shape)
 
     @staticmethod
     def _eccentric_terms(spec, kin):

@@ -277,14 +277,15 @@ def rk4_steps(q, v, matrices, meshes, turning, chunk, out, switches, located):
             np.empty(3), np.empty(pairs.shape[1:]))  # the drive of a part of a step: times, k, e, de, tin, tout, pairs
     step = first_step
     written = 0
-    for r in range(lengths.size):
+    start, end = np.int64(0), np.int64(2)  # the samples at a step's ends, as int64: literals 0 and 2 would
+    for r in range(lengths.size):           # each compile _switching once more
         h = lengths[r]
         _rk4(q, v, h, times[r], k[r], e[r], de[r], tin[r], tout[r], pairs[r], Q, V, acc, matrices, meshes, turning)
         if switches > 0:
             done, span = 0.0, h
-            _switching(Q[0], V[0], times[r, 0], e[r, 0], de[r, 0], pairs[r], 0, h, meshes, turning, g0, r0)
+            _switching(Q[0], V[0], times[r, 0], e[r, 0], de[r, 0], pairs[r], start, h, meshes, turning, g0, r0)
             for _ in range(MAX_EVENTS):
-                _switching(q, v, times[r, 2], e[r, 2], de[r, 2], pairs[r], 2, h, meshes, turning, g1, r1)
+                _switching(q, v, times[r, 2], e[r, 2], de[r, 2], pairs[r], end, h, meshes, turning, g1, r1)
                 theta, crossed = first_crossing(g0, r0, g1, r1, span)
                 if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
                     break
@@ -295,7 +296,7 @@ def rk4_steps(q, v, matrices, meshes, turning, chunk, out, switches, located):
                 _rk4(q, v, (at - done) * h, part[0], part[1], part[2], part[3], part[4], part[5], part[6], Q, V, acc,
                      matrices, meshes, turning)
                 located[0] += 1
-                _switching(q, v, part[0][2], part[2][2], part[3][2], part[6], 2, (at - done) * h, meshes,
+                _switching(q, v, part[0][2], part[2][2], part[3][2], part[6], end, (at - done) * h, meshes,
                            turning, g0, r0)
                 crossed_together(g0, r0, (at - done) * h, crossed)
                 done, span = at, (1.0 - at) * h

@@ -451,7 +451,7 @@ def _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stag
     return j
 
 
-@numba.njit(cache=True, inline="always", _nrt=False)
+@numba.njit(cache=True, _nrt=False)
 def _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, s, span, flags, g, rate, motion,
                measure):
     """The contact switching functions of the twin's state into g and their rates into ``rate``: each mesh
@@ -522,9 +522,12 @@ def _step(c, pointers, model, data, turning, contacts, work, reader, moving, sta
     ``switches`` has any (:mod:`gearcheck.shared.events`: the step taken again to the first crossing of a switching
     function, :func:`_switching`, and on from there; counted into ``events.located[0]``).  Returns the next row."""
     g0, r0, g1, r1, part, located, motion, carried = events
+    # a part's row, the samples at a step's ends, sampling and measuring, typed as r, s, sample and measure are:
+    # literals would compile _rk4 and _switching once more for each
+    first, start, end, unsampled, measure = np.int64(0), np.int64(0), np.int64(2), np.bool_(False), np.bool_(True)
     if g0.size:
-        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 0, h, flags, g0, r0, motion,
-                   not carried[0])
+        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, start, h, flags, g0, r0,
+                   motion, not carried[0])
         carried[0] = False
     j = _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, drive, r, h, flags, outputs,
              sample, j)
@@ -532,8 +535,8 @@ def _step(c, pointers, model, data, turning, contacts, work, reader, moving, sta
         return j
     done, span = 0.0, h
     for _ in range(MAX_EVENTS):
-        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, 2, h, flags, g1, r1, motion,
-                   True)
+        _switching(c, pointers, model, data, turning, work, moving, switches, drive, r, end, h, flags, g1, r1, motion,
+                   measure)
         theta, crossed = first_crossing(g0, r0, g1, r1, span)
         if not MIN_FRACTION < theta < 1.0 - MIN_FRACTION:
             carried[0] = True  # the step's end, where the next step starts, measured
@@ -541,16 +544,16 @@ def _step(c, pointers, model, data, turning, contacts, work, reader, moving, sta
         at = done + theta * (1.0 - done)  # the crossing, a fraction of the whole step
         _restart(stages, data)
         _part_of(drive, r, done, at, part)
-        _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, part, 0, (at - done) * h,
-             flags, outputs, False, j)
+        _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, part, first, (at - done) * h,
+             flags, outputs, unsampled, j)
         located[0] += 1
-        _switching(c, pointers, model, data, turning, work, moving, switches, part, 0, 2, (at - done) * h, flags,
-                   g0, r0, motion, True)
+        _switching(c, pointers, model, data, turning, work, moving, switches, part, first, end, (at - done) * h,
+                   flags, g0, r0, motion, measure)
         crossed_together(g0, r0, (at - done) * h, crossed)
         done, span = at, (1.0 - at) * h
         _part_of(drive, r, done, 1.0, part)
-        _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, part, 0, span, flags,
-             outputs, False, j)
+        _rk4(c, pointers, model, data, turning, contacts, work, reader, moving, stages, part, first, span, flags,
+             outputs, unsampled, j)
     return j
 
 

@@ -5,6 +5,7 @@ per side and this test file (DESIGN.md 8)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import ClassVar, NamedTuple
 
 import mujoco
@@ -15,6 +16,7 @@ from numba.core.caching import NullCache
 
 import gearcheck
 from gearcheck.lumped.assembly import build_model, sum_outer
+from gearcheck.lumped import compiled_steps
 from gearcheck.lumped.compiled_steps import rk4_steps
 from gearcheck.lumped.elements import ELEMENTS as LUMPED
 from gearcheck.lumped.elements import base as lumped_base
@@ -221,7 +223,10 @@ def test_a_part_whose_forces_move_with_time_runs_in_the_compiled_steps(monkeypat
     kernel changed, and agree with the same RK4 taken stage by stage in Python (the reference, which calls
     ``forces``) to rounding, while the beat moves the response by far more."""
     monkeypatch.setitem(LUMPED._kinds, "test-beating-torsion", beating_rows)
-    monkeypatch.setattr(rk4_steps, "_cache", NullCache())  # numba's disk cache cannot hold a test module's types
+    kernels = (rk4_steps, compiled_steps._rk4, compiled_steps._switching)  # each takes the groups' types: a cache
+    indexes = [Path(kernel._cache._cache_file._index_path) for kernel in kernels]  # entry naming this module's
+    for kernel in kernels:  # would break every later process that cannot import it (numba unpickles the whole
+        monkeypatch.setattr(kernel, "_cache", NullCache())  # index of a function to load any of its entries)
     monkeypatch.setattr(lumped_base, "GROUPS", list(lumped_base.GROUPS))
     monkeypatch.setattr(lumped_base.FORCES, "functions", dict(lumped_base.FORCES.functions))
     compiled_group(Beats, beat_forces)
@@ -235,6 +240,8 @@ def test_a_part_whose_forces_move_with_time_runs_in_the_compiled_steps(monkeypat
     scale = np.max(np.abs(python[name]))
     assert np.max(np.abs(compiled[name] - python[name])) < 1e-9 * scale
     assert np.max(np.abs(compiled[name] - plain[name])) > 1e-3 * scale
+    for index in indexes:
+        assert not index.exists() or b"test_elements" not in index.read_bytes(), index
 
 
 @pytest.mark.parametrize("chunk_bytes", [1 << 23, 8 * 12 * 12 * 7, 1])

@@ -352,7 +352,7 @@ def compile_kernels() -> None:
     """Compile the solvers' numba kernels now, or load them from numba's disk cache: a few steps of demo-3p in each
     solver and in its exported linear model (a user's model's run).  A process about to start others that run
     gearcheck (a test session before its workers) calls it once, so that they read the cache instead of each
-    compiling (some 10 s of CPU in a fresh environment)."""
+    compiling (about 30 s of CPU in a fresh environment)."""
     train = Train("demo-3p")
     for solver in SOLVERS:
         train.simulate(solver, duration=0.003)

@@ -98,15 +98,25 @@ class Excitation:
                             history.end)
 
     # ------------------------------------------------------------------ meshes
-    def mesh_position(self, t, mesh: int | None = None, side=0) -> np.ndarray:
-        """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...), or (...) for the one
-        mesh of index ``mesh``.  ``side`` (+1, -1 or 0, broadcast with t): read the right-hand or left-hand limit
-        of a drive that jumps at t, :data:`~gearcheck.shared.stepping.LIMIT_CYCLES` along the cycle."""
+    def mesh_position(self, t, side=0) -> np.ndarray:
+        """Mesh cycles elapsed (xi = f t - phase); shape (..., n_mesh) for t of shape (...).  ``side`` (+1, -1 or 0,
+        broadcast with t): read the right-hand or left-hand limit of a drive that jumps at t,
+        :data:`~gearcheck.shared.stepping.LIMIT_CYCLES` along the cycle."""
         t = np.asarray(t, dtype=float)
         shift = np.multiply(side, LIMIT_CYCLES)
-        if mesh is not None:
-            return self.frequency[mesh] * self.nominal_time(t) - self.phase[mesh] + shift
-        return np.multiply.outer(self.nominal_time(t), self.frequency) - self.phase + np.expand_dims(shift, -1)
+        angle = np.broadcast_to(self.nominal_time(t), np.broadcast_shapes(t.shape, np.shape(shift)))
+        xi = np.empty(angle.shape + (len(self.models),))
+        for j in range(len(self.models)):
+            self._cycles(j, angle, shift, xi[..., j])
+        return xi
+
+    def _cycles(self, j: int, angle, shift, out) -> np.ndarray:
+        """Mesh j's cycles elapsed at the nominal times ``angle``, shifted by ``shift`` cycles, into ``out``:
+        f_j angle - phase_j + shift, in that order (the bits :meth:`mesh_position` gives)."""
+        np.multiply(self.frequency[j], angle, out=out)
+        out -= self.phase[j]
+        out += shift
+        return out
 
     def stiffness(self, t, side=0) -> np.ndarray:
         """k(t) per mesh in N/m; shape (..., n_mesh) for t of shape (...); ``side`` as in :meth:`mesh_position`."""
@@ -116,10 +126,7 @@ class Excitation:
         k = np.empty(t.shape + (len(self.models),))
         xi = np.empty(t.shape)
         for j, model in enumerate(self.models):  # one mesh at a time: no (..., n_mesh) temporary
-            np.multiply(self.frequency[j], angle, out=xi)  # mesh_position(t, j, side), its operations in its order
-            xi -= self.phase[j]
-            xi += shift
-            k[..., j] = model(xi)
+            k[..., j] = model(self._cycles(j, angle, shift, xi))
         return k
 
     def tooth_pairs(self, t, side=0):
